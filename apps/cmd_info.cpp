@@ -1,0 +1,98 @@
+// `treelobes info FILE...`: format, version, counts, bounds, attributes and CRS of point
+// clouds, meshes and skeletons. Every file is reported; the exit code is 2 if any failed.
+#include "apps/command.hpp"
+#include "core/error.hpp"
+#include "core/file_info.hpp"
+#include "core/version.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+namespace treelobes::cli {
+
+namespace {
+
+struct InfoOptions {
+    std::vector<std::string> files;
+};
+
+nlohmann::json to_json(const FileInfo& info) {
+    nlohmann::json j = {{"path", info.path},
+                        {"kind", info.kind},
+                        {"format", info.format},
+                        {"points", info.point_count},
+                        {"bounds", {{"min", {info.bounds_min.x(), info.bounds_min.y(), info.bounds_min.z()}},
+                                    {"max", {info.bounds_max.x(), info.bounds_max.y(), info.bounds_max.z()}}}}};
+    if (!info.version.empty()) j["version"] = info.version;
+    if (info.las_point_format >= 0) {
+        j["point_format"] = info.las_point_format;
+        j["scale"] = {info.las_scale.x(), info.las_scale.y(), info.las_scale.z()};
+        j["offset"] = {info.las_offset.x(), info.las_offset.y(), info.las_offset.z()};
+    }
+    if (info.kind == "mesh") j["faces"] = info.face_count;
+    if (info.kind == "skeleton") {
+        j["tips"] = info.tip_count;
+        j["total_length"] = info.total_length;
+    }
+    if (info.dropped_non_finite) j["dropped_non_finite"] = info.dropped_non_finite;
+    j["attributes"] = nlohmann::json::array();
+    for (const auto& [name, type] : info.attributes) j["attributes"].push_back({{"name", name}, {"type", type}});
+    j["crs"] = info.crs;
+    return j;
+}
+
+void print_human(const FileInfo& info) {
+    std::cout << info.path << "\n";
+    std::cout << "  " << info.kind << ", " << info.format;
+    if (!info.version.empty()) std::cout << " " << info.version;
+    if (info.las_point_format >= 0) std::cout << ", point format " << info.las_point_format;
+    std::cout << "\n";
+    const char* noun = info.kind == "point cloud" ? "points" : info.kind == "mesh" ? "vertices" : "nodes";
+    std::cout << "  " << info.point_count << " " << noun;
+    if (info.kind == "mesh") std::cout << ", " << info.face_count << " faces";
+    if (info.kind == "skeleton") std::cout << ", " << info.tip_count << " tips, total length " << info.total_length << " m";
+    if (info.dropped_non_finite) std::cout << " (" << info.dropped_non_finite << " NaN/inf points dropped)";
+    std::cout << "\n";
+    char line[256];
+    std::snprintf(line, sizeof line, "  bounds x %.3f .. %.3f, y %.3f .. %.3f, z %.3f .. %.3f\n", info.bounds_min.x(),
+                  info.bounds_max.x(), info.bounds_min.y(), info.bounds_max.y(), info.bounds_min.z(), info.bounds_max.z());
+    std::cout << line;
+    if (!info.attributes.empty()) {
+        std::cout << "  attributes:";
+        for (const auto& [name, type] : info.attributes) std::cout << " " << name << " (" << type << ")";
+        std::cout << "\n";
+    }
+    if (!info.crs.empty()) std::cout << "  crs: " << info.crs.substr(0, 120) << (info.crs.size() > 120 ? "..." : "") << "\n";
+}
+
+int run_info(const InfoOptions& options, const GlobalOptions& global) {
+    nlohmann::json files = nlohmann::json::array();
+    int exit_code = 0;
+    for (const auto& file : options.files) {
+        try {
+            const FileInfo info = describe_file(file);
+            if (global.json) files.push_back(to_json(info));
+            else print_human(info);
+        } catch (const Error& e) {
+            std::cerr << "treelobes: error: " << e.what() << "\n";
+            if (global.json) files.push_back({{"path", file}, {"error", e.what()}});
+            exit_code = static_cast<int>(e.code());
+        }
+    }
+    if (global.json) std::cout << nlohmann::json{{"treelobes", kVersion}, {"files", files}}.dump(2) << "\n";
+    return exit_code;
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job) {
+    auto options = std::make_shared<InfoOptions>();
+    CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, PLY, PCD, XYZ/CSV), meshes and skeletons");
+    sub->add_option("files", options->files, "Files to describe")->required();
+    sub->callback([options, &global, &job] { job = [options, &global] { return run_info(*options, global); }; });
+}
+
+}  // namespace treelobes::cli

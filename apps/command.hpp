@@ -1,0 +1,24 @@
+// How subcommands plug into the `treelobes` CLI. Each apps/cmd_<name>.cpp defines one
+// `add_<name>_command` that declares its CLI11 subcommand, binds flags onto the stage's
+// options struct and, when selected, stores the job to run in `job`. main.cpp calls the job
+// inside one error handler that maps treelobes::Error to exit codes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <string>
+
+namespace treelobes::cli {
+
+struct GlobalOptions {
+    int threads = 0;                 // 0 = all cores
+    std::string log_level = "info";
+    bool json = false;               // machine-readable summary on stdout
+};
+
+using Job = std::function<int()>;  // returns the process exit code
+
+void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job);
+
+}  // namespace treelobes::cli

@@ -1,0 +1,35 @@
+// What `treelobes info` reports about a file: its kind (point cloud, mesh, skeleton), format,
+// counts, bounds in original coordinates, attributes and CRS.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace treelobes {
+
+struct FileInfo {
+    std::string path;
+    std::string kind;     // "point cloud", "mesh" or "skeleton"
+    std::string format;   // "las", "ply", "pcd", "xyz", "obj", ...
+    std::string version;  // LAS "1.2", PLY "binary_little_endian", ...
+    int las_point_format = -1;
+    Eigen::Vector3d las_scale{0, 0, 0}, las_offset{0, 0, 0};
+    std::size_t point_count = 0;  // points, mesh vertices or skeleton nodes
+    std::size_t dropped_non_finite = 0;
+    Eigen::Vector3d bounds_min{0, 0, 0}, bounds_max{0, 0, 0};  // original coordinates
+    std::vector<std::pair<std::string, std::string>> attributes;  // name, storage type
+    std::string crs;
+    std::size_t face_count = 0;  // meshes
+    std::size_t tip_count = 0;   // skeletons
+    double total_length = 0.0;   // skeletons, metres
+};
+
+// Reads the file fully (so that a truncated file is reported) and describes it. Throws
+// Error(InvalidInput) like the readers do.
+FileInfo describe_file(const std::filesystem::path& path);
+
+}  // namespace treelobes

@@ -1,0 +1,113 @@
+// Mesh files through OpenMesh (PLY, OBJ, OFF, STL, OM). Points are read in double precision
+// so georeferenced meshes keep their precision; the origin is moved into TriangleMesh::origin.
+#include "core/mesh_io.hpp"
+
+#include "core/atomic_file.hpp"
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+#include "core/georef_sidecar.hpp"
+
+#include <OpenMesh/Core/IO/MeshIO.hh>
+#include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
+
+#include <array>
+#include <cmath>
+
+namespace fs = std::filesystem;
+
+namespace treelobes {
+
+namespace {
+
+struct DoubleTraits : OpenMesh::DefaultTraits {
+    using Point = OpenMesh::Vec3d;
+    using Normal = OpenMesh::Vec3d;
+};
+using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
+
+bool is_mesh_extension(const std::string& ext) {
+    return ext == "ply" || ext == "obj" || ext == "off" || ext == "stl" || ext == "om";
+}
+
+// OpenMesh reports problems on its own error stream; we turn them into one Error line.
+void silence_openmesh() {
+    omerr().disable();
+    omlog().disable();
+}
+
+Eigen::Vector3d origin_for(const PolyMesh& mesh) {
+    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+    if (mesh.n_vertices() == 0) return origin;
+    const auto& p = mesh.point(*mesh.vertices_begin());
+    for (int k = 0; k < 3; ++k)
+        if (std::abs(p[k]) >= 1e4) origin[k] = std::round(p[k] / 1000.0) * 1000.0;
+    return origin;
+}
+
+}  // namespace
+
+TriangleMesh read_mesh(const fs::path& path) {
+    const std::string name = path.string();
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw Error::input(name, "no such file");
+    if (fs::is_directory(path, ec)) throw Error::input(name, "is a directory, expected a mesh file");
+    if (fs::file_size(path, ec) == 0) throw Error::input(name, "empty file");
+    if (!is_mesh_extension(file_extension(path)))
+        throw Error::input(name, "unknown mesh format (expected .ply, .obj, .off, .stl)");
+
+    silence_openmesh();
+    PolyMesh mesh;
+    OpenMesh::IO::Options options;
+    if (!OpenMesh::IO::read_mesh(mesh, name, options))
+        throw Error::input(name, "cannot read mesh (malformed or truncated file)");
+
+    TriangleMesh out;
+    out.origin = origin_for(mesh);
+    out.vertices.reserve(mesh.n_vertices());
+    for (const auto& v : mesh.vertices()) {
+        const auto& p = mesh.point(v);
+        const Eigen::Vector3d q(p[0], p[1], p[2]);
+        if (!q.allFinite()) throw Error::input(name, "vertex " + std::to_string(v.idx()) + " has a NaN/inf coordinate");
+        out.vertices.push_back((q - out.origin).cast<float>());
+    }
+    for (const auto& f : mesh.faces()) {  // fan triangulation of polygons
+        std::vector<int> corners;
+        for (const auto& v : mesh.fv_range(f)) corners.push_back(v.idx());
+        for (std::size_t k = 1; k + 1 < corners.size(); ++k) out.faces.push_back({corners[0], corners[k], corners[k + 1]});
+    }
+    return out;
+}
+
+void write_mesh(const TriangleMesh& mesh, const fs::path& path) {
+    const std::string ext = file_extension(path);
+    if (ext != "ply" && ext != "obj" && ext != "off")
+        throw Error::usage(path.string() + ": unknown mesh format '." + ext + "' (expected .ply, .obj, .off)");
+    silence_openmesh();
+    PolyMesh out;
+    std::vector<PolyMesh::VertexHandle> handles;
+    handles.reserve(mesh.vertices.size());
+    for (const auto& v : mesh.vertices) handles.push_back(out.add_vertex(PolyMesh::Point(v.x(), v.y(), v.z())));
+    for (const auto& f : mesh.faces) {
+        for (int corner : f)
+            if (corner < 0 || corner >= static_cast<int>(handles.size()))
+                throw Error(ExitCode::Internal, "write_mesh: face refers to vertex " + std::to_string(corner));
+        // A halfedge mesh cannot hold non-manifold configurations (leaf quads touching a
+        // branch, for example): such a face gets its own copies of its corners instead of
+        // being dropped, so the written geometry is complete.
+        if (!out.add_face(handles[f[0]], handles[f[1]], handles[f[2]]).is_valid()) {
+            std::array<PolyMesh::VertexHandle, 3> copies;
+            for (int k = 0; k < 3; ++k) copies[k] = out.add_vertex(out.point(handles[f[k]]));
+            out.add_face(copies[0], copies[1], copies[2]);
+        }
+    }
+    OpenMesh::IO::Options options;
+    if (ext == "ply") options += OpenMesh::IO::Options::Binary;
+    write_atomically_via_path(path, [&](const fs::path& temporary) {
+        if (!OpenMesh::IO::write_mesh(out, temporary.string(), options, 10))
+            throw Error::input(path.string(), "cannot write mesh");
+    });
+    write_georef_sidecar(path, mesh.origin, {});
+}
+
+}  // namespace treelobes

@@ -1,0 +1,156 @@
+// PCD through PCL's reader and writer. Fields x y z are required; intensity, rgb/rgba and
+// label map to the standard attributes; every other single-valued field becomes an extra.
+#include "core/atomic_file.hpp"
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+#include "core/georef_sidecar.hpp"
+#include "core/log.hpp"
+
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/console/print.h>
+#include <pcl/io/pcd_io.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace fs = std::filesystem;
+
+namespace treelobes {
+
+namespace {
+
+// Reads field `f` of point `i` as double whatever its stored type.
+double field_value(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, std::size_t i) {
+    const std::uint8_t* p = blob.data.data() + i * blob.point_step + f.offset;
+    auto get = [p]<typename T>(T) {
+        T v;
+        std::memcpy(&v, p, sizeof v);
+        return static_cast<double>(v);
+    };
+    switch (f.datatype) {
+        case pcl::PCLPointField::INT8: return get(std::int8_t{});
+        case pcl::PCLPointField::UINT8: return get(std::uint8_t{});
+        case pcl::PCLPointField::INT16: return get(std::int16_t{});
+        case pcl::PCLPointField::UINT16: return get(std::uint16_t{});
+        case pcl::PCLPointField::INT32: return get(std::int32_t{});
+        case pcl::PCLPointField::UINT32: return get(std::uint32_t{});
+        case pcl::PCLPointField::FLOAT32: return get(float{});
+        default: return get(double{});
+    }
+}
+
+AttributeType attribute_type(std::uint8_t datatype) {
+    switch (datatype) {
+        case pcl::PCLPointField::INT8: return AttributeType::Int8;
+        case pcl::PCLPointField::UINT8: return AttributeType::UInt8;
+        case pcl::PCLPointField::INT16: return AttributeType::Int16;
+        case pcl::PCLPointField::UINT16: return AttributeType::UInt16;
+        case pcl::PCLPointField::INT32: return AttributeType::Int32;
+        case pcl::PCLPointField::UINT32: return AttributeType::UInt32;
+        case pcl::PCLPointField::FLOAT32: return AttributeType::Float32;
+        default: return AttributeType::Float64;
+    }
+}
+
+const pcl::PCLPointField* find_field(const pcl::PCLPointCloud2& blob, const std::string& name) {
+    for (const auto& f : blob.fields)
+        if (f.name == name) return &f;
+    return nullptr;
+}
+
+void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, const std::vector<std::size_t>& kept,
+                 PointCloud& cloud) {
+    if (f.count != 1 || f.name == "x" || f.name == "y" || f.name == "z" || f.name == "_") return;
+    if (f.name == "rgb" || f.name == "rgba") {
+        for (std::size_t i : kept) {
+            std::uint32_t packed;
+            std::memcpy(&packed, blob.data.data() + i * blob.point_step + f.offset, 4);
+            cloud.rgb.push_back({static_cast<std::uint16_t>((packed >> 16) & 0xff), static_cast<std::uint16_t>((packed >> 8) & 0xff),
+                                 static_cast<std::uint16_t>(packed & 0xff)});
+        }
+        return;
+    }
+    std::vector<double> values;
+    values.reserve(kept.size());
+    for (std::size_t i : kept) values.push_back(field_value(blob, f, i));
+    if (f.name == "intensity") {
+        for (double v : values) cloud.intensity.push_back(static_cast<std::uint16_t>(std::clamp(v, 0.0, 65535.0)));
+    } else if (f.name == "classification") {
+        for (double v : values) cloud.classification.push_back(static_cast<std::uint8_t>(std::clamp(v, 0.0, 255.0)));
+    } else {
+        cloud.extras.push_back({f.name, attribute_type(f.datatype), "", std::nullopt, std::move(values)});
+    }
+}
+
+}  // namespace
+
+PointCloud read_pcd(const fs::path& path) {
+    const std::string name = path.string();
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // errors become our one-line message
+    pcl::PCLPointCloud2 blob;
+    pcl::PCDReader reader;
+    if (reader.read(name, blob) < 0) throw Error::input(name, "cannot read PCD (malformed or truncated file)");
+    const auto* fx = find_field(blob, "x");
+    const auto* fy = find_field(blob, "y");
+    const auto* fz = find_field(blob, "z");
+    if (!fx || !fy || !fz) throw Error::input(name, "PCD has no x, y, z fields");
+    const std::size_t n = static_cast<std::size_t>(blob.width) * blob.height;
+    if (blob.data.size() < n * blob.point_step) throw Error::input(name, "PCD data is shorter than its header declares");
+
+    PointCloud cloud;
+    cloud.source.format = "pcd";
+    std::vector<std::size_t> kept;
+    for (std::size_t i = 0; i < n; ++i) {
+        const Eigen::Vector3d p(field_value(blob, *fx, i), field_value(blob, *fy, i), field_value(blob, *fz, i));
+        if (!p.allFinite()) continue;  // PCL marks invalid points of organised clouds with NaN
+        if (kept.empty())
+            for (int k = 0; k < 3; ++k) cloud.origin[k] = std::abs(p[k]) >= 1e4 ? std::round(p[k] / 1000.0) * 1000.0 : 0.0;
+        kept.push_back(i);
+        cloud.positions.push_back((p - cloud.origin).cast<float>());
+    }
+    if (cloud.empty()) throw Error::input(name, n ? "all points have NaN/inf coordinates" : "PCD has no points");
+    for (const auto& f : blob.fields) store_field(blob, f, kept, cloud);
+    cloud.source.dropped_non_finite = n - kept.size();
+    if (cloud.source.dropped_non_finite)
+        log_warn(name + ": dropped " + std::to_string(cloud.source.dropped_non_finite) + " point(s) with NaN/inf coordinates");
+    return cloud;
+}
+
+void write_pcd(const PointCloud& cloud, const fs::path& path) {
+    cloud.check_consistent(path.string());
+    // Local float coordinates (PCD is a float format); the origin goes into the sidecar.
+    pcl::PCLPointCloud2 blob;
+    blob.width = static_cast<std::uint32_t>(cloud.size());
+    blob.height = 1;
+    blob.is_dense = true;
+    std::uint32_t offset = 0;
+    auto add_field = [&](const std::string& name) {
+        pcl::PCLPointField f;
+        f.name = name;
+        f.offset = offset;
+        f.datatype = pcl::PCLPointField::FLOAT32;
+        f.count = 1;
+        offset += 4;
+        blob.fields.push_back(f);
+    };
+    for (const char* axis : {"x", "y", "z"}) add_field(axis);
+    if (!cloud.intensity.empty()) add_field("intensity");
+    for (const auto& attribute : cloud.extras) add_field(attribute.name);
+    blob.point_step = offset;
+    blob.row_step = offset * blob.width;
+    blob.data.resize(static_cast<std::size_t>(blob.row_step));
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        std::vector<float> row{cloud.positions[i].x(), cloud.positions[i].y(), cloud.positions[i].z()};
+        if (!cloud.intensity.empty()) row.push_back(cloud.intensity[i]);
+        for (const auto& attribute : cloud.extras) row.push_back(static_cast<float>(attribute.values[i]));
+        std::memcpy(blob.data.data() + i * blob.point_step, row.data(), blob.point_step);
+    }
+    write_atomically_via_path(path, [&](const fs::path& temporary) {
+        pcl::PCDWriter writer;
+        if (writer.writeBinary(temporary.string(), blob) < 0) throw Error::input(path.string(), "cannot write PCD");
+    });
+    write_georef_sidecar(path, cloud.origin, cloud.georef);
+}
+
+}  // namespace treelobes

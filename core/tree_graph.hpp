@@ -1,0 +1,54 @@
+// TreeGraph: a rooted tree skeleton. Node 0 is the root; every other node has a parent.
+// Children are ordered with the main child first (the continuation of the branch), the
+// order that DBF6 coding, LOD and the multiresolution chain rely on.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace treelobes {
+
+struct TreeNode {
+    Eigen::Vector3f position{0, 0, 0};  // local coordinates (metres)
+    float radius = 0.0f;                // metres
+    int parent = -1;                    // -1 for the root only
+    std::vector<int> children;          // main child first
+};
+
+class TreeGraph {
+public:
+    Eigen::Vector3d origin{0, 0, 0};  // add to local positions for original coordinates
+    std::vector<TreeNode> nodes;
+
+    std::size_t size() const { return nodes.size(); }
+    bool empty() const { return nodes.empty(); }
+
+    // Adds a node; parent -1 only for the first node (the root). Returns its index.
+    int add_node(const Eigen::Vector3f& position, float radius, int parent);
+
+    // Depth-first pre-order from the root, main child first (the project's one traversal order).
+    std::vector<int> preorder() const;
+
+    // Length of the edge from node to its parent (0 for the root).
+    float edge_length(int node) const;
+    // Total length of all edges below each node (l(u) of seed 001 Eq. 1), indexed by node.
+    std::vector<float> subtree_lengths() const;
+    // Branch order per node: 0 on the trunk, +1 each time a lateral (non-first) child is taken.
+    std::vector<int> branch_orders() const;
+    // Sum of all edge lengths.
+    float total_length() const;
+    // Number of nodes without children.
+    std::size_t tip_count() const;
+
+    // Reorders every node's children so that the one with the largest subtree length comes
+    // first (ties: smallest direction change, then lowest index).
+    void order_children_by_subtree_length();
+
+    // Throws Error(InvalidInput) naming `context` when the parent/children links are not one
+    // rooted tree with node 0 as root, or a position/radius is not finite.
+    void validate(const std::string& context) const;
+};
+
+}  // namespace treelobes

@@ -1,0 +1,60 @@
+// End-to-end tests of the CLI plumbing and `treelobes info` (exit codes, one-line errors, JSON).
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+using treelobes::test::run_cli;
+using treelobes::test::TempDir;
+using treelobes::test::write_text;
+
+namespace {
+int line_count(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+    const auto version = run_cli("--version");
+    EXPECT_EQ(version.exit_code, 0);
+    EXPECT_NE(version.out.find("treelobes"), std::string::npos);
+    const auto help = run_cli("--help");
+    EXPECT_EQ(help.exit_code, 0);
+    EXPECT_NE(help.out.find("info"), std::string::npos);
+    EXPECT_EQ(run_cli("info --help").exit_code, 0);
+}
+
+TEST(Cli, UsageErrorsExitWithOne) {
+    EXPECT_EQ(run_cli("").exit_code, 1);
+    EXPECT_EQ(run_cli("no-such-command").exit_code, 1);
+    EXPECT_EQ(run_cli("info").exit_code, 1);
+    EXPECT_EQ(run_cli("--log-level loud info x.xyz").exit_code, 1);
+}
+
+TEST(Cli, InfoDescribesACloudAsJson) {
+    TempDir dir;
+    write_text(dir / "a.xyz", "1 2 3\n4 5 6\n-1 0 9\n");
+    const auto result = run_cli("info --json '" + (dir / "a.xyz").string() + "'");
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    const auto json = nlohmann::json::parse(result.out);
+    const auto& file = json["files"][0];
+    EXPECT_EQ(file["points"], 3);
+    EXPECT_EQ(file["format"], "xyz");
+    EXPECT_DOUBLE_EQ(file["bounds"]["max"][2].get<double>(), 9.0);
+}
+
+TEST(Cli, BadInputGivesExitTwoAndOneLine) {
+    TempDir dir;
+    write_text(dir / "t.laz", "LASF whatever");
+    write_text(dir / "trunc.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
+                                  "property float y\nproperty float z\nend_header\nabc");
+    write_text(dir / "empty.xyz", "");
+    for (const std::string name : {"t.laz", "trunc.ply", "empty.xyz", "missing.las"}) {
+        const auto result = run_cli("info '" + (dir / name).string() + "'");
+        EXPECT_EQ(result.exit_code, 2) << name;
+        EXPECT_EQ(line_count(result.err), 1) << name << ": " << result.err;
+        EXPECT_NE(result.err.find(name), std::string::npos) << result.err;
+    }
+    const auto directory = run_cli("info '" + dir.path().string() + "'");
+    EXPECT_EQ(directory.exit_code, 2);
+    const auto laz = run_cli("info '" + (dir / "t.laz").string() + "'");
+    EXPECT_NE(laz.err.find("LAZ is not supported yet: decompress with"), std::string::npos);
+}

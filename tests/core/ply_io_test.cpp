@@ -1,0 +1,206 @@
+#include "core/atomic_file.hpp"
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+#include "core/georef_sidecar.hpp"
+#include "core/mesh_io.hpp"
+#include "core/skeleton_io.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+
+using namespace treelobes;
+using treelobes::test::TempDir;
+using treelobes::test::write_text;
+
+namespace {
+
+template <typename F>
+ExitCode error_code_of(F&& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.code();
+    }
+    return ExitCode::Ok;
+}
+
+PointCloud sample_cloud() {
+    PointCloud cloud;
+    cloud.positions = {{0, 0, 0}, {1.5f, -2.25f, 3}, {0.001f, 0.002f, 0.003f}};
+    cloud.intensity = {1, 2, 65535};
+    cloud.classification = {2, 5, 1};
+    cloud.rgb = {{{255, 0, 0}}, {{0, 255, 0}}, {{0, 0, 255}}};
+    cloud.add_extra("geodesic", AttributeType::Float32).values = {0.5, 1.5, 2.5};
+    cloud.add_extra("internode", AttributeType::Int32).values = {0, 7, -1};
+    return cloud;
+}
+
+void expect_same(const PointCloud& a, const PointCloud& b) {
+    ASSERT_EQ(a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i) EXPECT_LT((a.global(i) - b.global(i)).norm(), 1e-6);
+    EXPECT_EQ(a.intensity, b.intensity);
+    EXPECT_EQ(a.classification, b.classification);
+    EXPECT_EQ(a.rgb, b.rgb);
+    ASSERT_EQ(a.extras.size(), b.extras.size());
+    for (std::size_t k = 0; k < a.extras.size(); ++k) {
+        EXPECT_EQ(a.extras[k].name, b.extras[k].name);
+        EXPECT_EQ(a.extras[k].values, b.extras[k].values);
+    }
+}
+
+}  // namespace
+
+TEST(PlyCloud, BinaryAndAsciiRoundTripKeepScalarFields) {
+    TempDir dir;
+    const PointCloud cloud = sample_cloud();
+    write_ply_cloud(cloud, dir / "b.ply", true);
+    write_ply_cloud(cloud, dir / "a.ply", false);
+    expect_same(cloud, read_point_cloud(dir / "b.ply"));
+    expect_same(cloud, read_point_cloud(dir / "a.ply"));
+    // CloudCompare convention: scalar fields are stored as scalar_<name>.
+    const std::string text = read_file(dir / "a.ply");
+    EXPECT_NE(text.find("property float scalar_geodesic"), std::string::npos);
+    EXPECT_NE(text.find("property int scalar_internode"), std::string::npos);
+}
+
+TEST(PlyCloud, ReadsAnyPropertyOrderAndBigEndian) {
+    TempDir dir;
+    write_text(dir / "order.ply",
+               "ply\nformat ascii 1.0\nelement vertex 2\nproperty float scalar_w\nproperty double z\n"
+               "property float x\nproperty float y\nelement face 0\nproperty list uchar int vertex_indices\nend_header\n"
+               "9 3 1 2\n8 6 4 5\n");
+    const PointCloud cloud = read_point_cloud(dir / "order.ply");
+    ASSERT_EQ(cloud.size(), 2u);
+    EXPECT_FLOAT_EQ(cloud.positions[1].x(), 4);
+    EXPECT_FLOAT_EQ(cloud.positions[1].z(), 6);
+    EXPECT_DOUBLE_EQ(cloud.extra("w")->values[0], 9);
+
+    std::string be = "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    for (float v : {1.0f, 2.0f, 3.0f}) {
+        std::uint32_t bits;
+        std::memcpy(&bits, &v, 4);
+        for (int shift = 24; shift >= 0; shift -= 8) be.push_back(static_cast<char>((bits >> shift) & 0xff));
+    }
+    write_text(dir / "be.ply", be);
+    EXPECT_FLOAT_EQ(read_point_cloud(dir / "be.ply").positions[0].y(), 2.0f);
+}
+
+TEST(PlyCloud, TruncatedOrLyingHeadersAreRejected) {
+    TempDir dir;
+    write_ply_cloud(sample_cloud(), dir / "ok.ply", true);
+    const std::string bytes = read_file(dir / "ok.ply");
+    write_text(dir / "truncated.ply", bytes.substr(0, bytes.size() - 5));
+    EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "truncated.ply"); }), ExitCode::InvalidInput);
+
+    write_text(dir / "huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\nproperty float x\n"
+                                 "property float y\nproperty float z\nend_header\n");
+    EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "huge.ply"); }), ExitCode::InvalidInput);
+    write_text(dir / "noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n");
+    EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "noend.ply"); }), ExitCode::InvalidInput);
+    write_text(dir / "garbage.ply", "\x7f" "ELF\x02\x01 binary garbage");
+    EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "garbage.ply"); }), ExitCode::InvalidInput);
+    write_text(dir / "nan.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+                                "end_header\nnan 0 0\n1 2 3\n");
+    const PointCloud kept = read_point_cloud(dir / "nan.ply");
+    EXPECT_EQ(kept.size(), 1u);
+    EXPECT_EQ(kept.source.dropped_non_finite, 1u);
+}
+
+TEST(PlyCloud, UtmOriginSurvivesRoundTripAndWritesSidecar) {
+    TempDir dir;
+    PointCloud cloud;
+    cloud.origin = {650000.0, 5800000.0, 0.0};
+    cloud.positions = {{0.1234f, 0.5678f, 101.25f}, {10.0001f, 20.9999f, 99.5f}};
+    write_point_cloud(cloud, dir / "utm.ply");
+    EXPECT_TRUE(std::filesystem::exists(georef_sidecar_path(dir / "utm.ply")));
+    const PointCloud back = read_point_cloud(dir / "utm.ply");
+    EXPECT_LT((back.global(1) - cloud.global(1)).norm(), 1e-3);
+    EXPECT_NEAR(back.global(0).x(), 650000.1234, 1e-3);
+}
+
+TEST(PlyCloud, UnwritableOutputIsAnInputErrorAndLeavesNothing) {
+    TempDir dir;
+    EXPECT_EQ(error_code_of([&] { write_point_cloud(sample_cloud(), dir / "missing" / "a.ply"); }), ExitCode::InvalidInput);
+    std::filesystem::create_directory(dir / "folder.ply");
+    EXPECT_EQ(error_code_of([&] { write_point_cloud(sample_cloud(), dir / "folder.ply"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { write_point_cloud(sample_cloud(), dir / "a.unknown"); }), ExitCode::Usage);
+    // Nothing but the folder we made: no partial output, no temporary files.
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator()), 1);
+}
+
+TEST(SkeletonPly, RoundTripKeepsTopologyRadiiAndChildOrder) {
+    TempDir dir;
+    TreeGraph tree;
+    tree.origin = {1000.5, 2000.25, 3.0};
+    tree.add_node({0, 0, 0}, 0.3f, -1);
+    tree.add_node({0, 0, 1}, 0.25f, 0);
+    tree.add_node({0.5f, 0, 1.5f}, 0.1f, 1);  // lateral listed first on purpose
+    tree.add_node({0, 0, 2}, 0.2f, 1);
+    tree.nodes[1].children = {3, 2};          // main child first
+    write_skeleton_ply(tree, dir / "s.ply");
+    const TreeGraph back = read_skeleton_ply(dir / "s.ply");
+    ASSERT_EQ(back.size(), 4u);
+    EXPECT_EQ(back.nodes[1].children, (std::vector<int>{3, 2}));
+    EXPECT_FLOAT_EQ(back.nodes[2].radius, 0.1f);
+    EXPECT_EQ(back.origin, tree.origin);
+    EXPECT_EQ(back.nodes[3].parent, 1);
+}
+
+TEST(SkeletonPly, AcceptsUnorientedEdgesAndRejectsCyclesAndForests) {
+    TempDir dir;
+    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element edge 2\nproperty int vertex1\nproperty int vertex2\nend_header\n0 0 0\n0 0 1\n0 0 2\n";
+    write_text(dir / "unoriented.ply", header + "1 0\n2 1\n");
+    const TreeGraph tree = read_skeleton_ply(dir / "unoriented.ply");
+    EXPECT_EQ(tree.nodes[2].parent, 1);
+    write_text(dir / "cycle.ply", header + "0 1\n1 0\n");
+    EXPECT_EQ(error_code_of([&] { read_skeleton_ply(dir / "cycle.ply"); }), ExitCode::InvalidInput);
+    write_text(dir / "bad_index.ply", header + "0 1\n1 7\n");
+    EXPECT_EQ(error_code_of([&] { read_skeleton_ply(dir / "bad_index.ply"); }), ExitCode::InvalidInput);
+}
+
+TEST(MeshIo, PlyObjOffRoundTrip) {
+    TempDir dir;
+    TriangleMesh mesh;  // a tetrahedron, outward oriented
+    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    mesh.faces = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+    for (const char* name : {"t.ply", "t.obj", "t.off"}) {
+        write_mesh(mesh, dir / name);
+        const TriangleMesh back = read_mesh(dir / name);
+        EXPECT_EQ(back.vertex_count(), 4u) << name;
+        EXPECT_EQ(back.face_count(), 4u) << name;
+        EXPECT_NEAR(back.signed_volume(), 1.0 / 6.0, 1e-6) << name;
+    }
+    write_text(dir / "empty.off", "");
+    EXPECT_EQ(error_code_of([&] { read_mesh(dir / "empty.off"); }), ExitCode::InvalidInput);
+}
+
+TEST(MeshIo, NonManifoldFacesAreKeptNotDropped) {
+    TempDir dir;
+    TriangleMesh mesh;  // three triangles sharing one edge: not representable as a halfedge mesh
+    mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
+    mesh.faces = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+    write_mesh(mesh, dir / "nm.ply");
+    EXPECT_EQ(read_mesh(dir / "nm.ply").face_count(), 3u);
+}
+
+TEST(PcdIo, RoundTripWithIntensityAndExtras) {
+    TempDir dir;
+    PointCloud cloud;
+    cloud.positions = {{1, 2, 3}, {4, 5, 6}};
+    cloud.intensity = {7, 8};
+    cloud.add_extra("label", AttributeType::Float32, 3.0);
+    write_point_cloud(cloud, dir / "c.pcd");
+    const PointCloud back = read_point_cloud(dir / "c.pcd");
+    ASSERT_EQ(back.size(), 2u);
+    EXPECT_FLOAT_EQ(back.positions[1].z(), 6);
+    EXPECT_EQ(back.intensity, cloud.intensity);
+    ASSERT_NE(back.extra("label"), nullptr);
+    write_text(dir / "bad.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                                "WIDTH 100\nHEIGHT 1\nPOINTS 100\nDATA binary\nabc");
+    EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "bad.pcd"); }), ExitCode::InvalidInput);
+}

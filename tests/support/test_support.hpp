@@ -1,0 +1,45 @@
+// Shared helpers for the GoogleTest suite: where the real scans are, temporary folders,
+// and running the CLI binary.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace treelobes::test {
+
+// Folder of the real scans: $TREELOBES_REAL_DATA or ../shared/data beside the source tree.
+// Fails the calling test (ADD_FAILURE + returns empty path) when it does not exist.
+std::filesystem::path real_data_dir();
+// real_data_dir() / relative; fails the test when the file is missing.
+std::filesystem::path real_data(const std::string& relative);
+
+// The source tree (for committed fixtures under data/ and tests/).
+std::filesystem::path source_dir();
+
+// A fresh, empty folder unique to the running test; removed by the destructor.
+class TempDir {
+public:
+    TempDir();
+    ~TempDir();
+    TempDir(const TempDir&) = delete;
+    TempDir& operator=(const TempDir&) = delete;
+    const std::filesystem::path& path() const { return path_; }
+    std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+private:
+    std::filesystem::path path_;
+};
+
+struct CommandResult {
+    int exit_code = -1;
+    std::string out;  // stdout
+    std::string err;  // stderr
+};
+
+// Runs build/bin/treelobes with the given argument string (shell-quoted by the caller).
+CommandResult run_cli(const std::string& arguments);
+
+// Writes text to a file (test fixtures).
+void write_text(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace treelobes::test
