@@ -7,8 +7,10 @@
 #include "core/version.hpp"
 
 #include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
 
 #include <iostream>
+#include <memory>
 #include <new>
 
 using namespace treelobes;
@@ -32,6 +34,7 @@ int run(int argc, char** argv) {
 
     cli::Job job;
     cli::add_info_command(app, global, job);
+    cli::add_render_command(app, global, job);
 
     try {
         app.parse(argc, argv);
@@ -40,6 +43,11 @@ int run(int argc, char** argv) {
         return code == 0 ? 0 : static_cast<int>(ExitCode::Usage);
     }
     set_log_level(parse_log_level(global.log_level));
+    // --threads caps every TBB parallel loop of the stages for the whole run.
+    std::unique_ptr<tbb::global_control> thread_limit;
+    if (global.threads > 0)
+        thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                             static_cast<std::size_t>(global.threads));
     return job ? job() : static_cast<int>(ExitCode::Usage);
 }
 

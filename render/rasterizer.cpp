@@ -1,0 +1,147 @@
+#include "render/rasterizer.hpp"
+
+#include "core/error.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace treelobes::render {
+
+Rgba shade(Rgba colour, double light) {
+    light = std::clamp(light, 0.0, 1.0);
+    return {static_cast<std::uint8_t>(colour[0] * light), static_cast<std::uint8_t>(colour[1] * light),
+            static_cast<std::uint8_t>(colour[2] * light), colour[3]};
+}
+
+View View::side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azimuth_deg, double elevation_deg) {
+    const double az = azimuth_deg * M_PI / 180.0, el = elevation_deg * M_PI / 180.0;
+    View view;
+    view.forward = Eigen::Vector3d(std::sin(az) * std::cos(el), std::cos(az) * std::cos(el), -std::sin(el));
+    view.up = Eigen::Vector3d(0, 0, 1);
+    view.lo = lo;
+    view.hi = hi;
+    return view;
+}
+
+Rasterizer::Rasterizer(int width, int height, const View& view, Rgba background)
+    : image_(width, height, background),
+      depth_(static_cast<std::size_t>(width) * height, std::numeric_limits<double>::infinity()) {
+    if (!view.forward.allFinite() || view.forward.norm() == 0) throw Error::usage("render: view direction is zero");
+    forward_ = view.forward.normalized();
+    // Image axes: right = forward x up, up = right x forward (Gram-Schmidt against forward).
+    Eigen::Vector3d up = view.up - view.up.dot(forward_) * forward_;
+    if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY().dot(forward_) * forward_;
+    up_ = up.normalized();
+    right_ = forward_.cross(up_).normalized();
+    centre_ = 0.5 * (view.lo + view.hi);
+    // Extent of the box's corners on the image axes decides the scale.
+    double half_w = 1e-9, half_h = 1e-9;
+    for (int corner = 0; corner < 8; ++corner) {
+        const Eigen::Vector3d p((corner & 1) ? view.hi.x() : view.lo.x(), (corner & 2) ? view.hi.y() : view.lo.y(),
+                                (corner & 4) ? view.hi.z() : view.lo.z());
+        half_w = std::max(half_w, std::abs((p - centre_).dot(right_)));
+        half_h = std::max(half_h, std::abs((p - centre_).dot(up_)));
+    }
+    const double usable = 1.0 - 2.0 * view.margin;
+    scale_ = std::min(width * usable / (2 * half_w), height * usable / (2 * half_h));
+}
+
+Eigen::Vector3d Rasterizer::project(const Eigen::Vector3d& world) const {
+    const Eigen::Vector3d d = world - centre_;
+    return {image_.width / 2.0 + d.dot(right_) * scale_, image_.height / 2.0 - d.dot(up_) * scale_, d.dot(forward_)};
+}
+
+void Rasterizer::plot(int x, int y, double depth, Rgba colour) {
+    if (x < 0 || y < 0 || x >= image_.width || y >= image_.height) return;
+    double& z = depth_[static_cast<std::size_t>(y) * image_.width + x];
+    if (depth >= z) return;
+    z = depth;
+    image_.set(x, y, colour);
+}
+
+void Rasterizer::fill_triangle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c, Rgba colour) {
+    const double area = (b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x());
+    if (std::abs(area) < 1e-12) return;
+    const int x0 = std::max(0, static_cast<int>(std::floor(std::min({a.x(), b.x(), c.x()}))));
+    const int x1 = std::min(image_.width - 1, static_cast<int>(std::ceil(std::max({a.x(), b.x(), c.x()}))));
+    const int y0 = std::max(0, static_cast<int>(std::floor(std::min({a.y(), b.y(), c.y()}))));
+    const int y1 = std::min(image_.height - 1, static_cast<int>(std::ceil(std::max({a.y(), b.y(), c.y()}))));
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+            const double px = x + 0.5, py = y + 0.5;
+            // Barycentric weights; the sign of `area` handles both windings (two-sided).
+            const double w0 = ((b.x() - px) * (c.y() - py) - (b.y() - py) * (c.x() - px)) / area;
+            const double w1 = ((c.x() - px) * (a.y() - py) - (c.y() - py) * (a.x() - px)) / area;
+            const double w2 = 1.0 - w0 - w1;
+            if (w0 < 0 || w1 < 0 || w2 < 0) continue;
+            plot(x, y, w0 * a.z() + w1 * b.z() + w2 * c.z(), colour);
+        }
+}
+
+void Rasterizer::draw_mesh(const TriangleMesh& mesh, Rgba colour) {
+    // Headlight from the viewer plus a little from above, two-sided Lambert.
+    const Eigen::Vector3d light = (-forward_ + 0.5 * up_).normalized();
+    for (const auto& f : mesh.faces) {
+        Eigen::Vector3d world[3];
+        for (int k = 0; k < 3; ++k) world[k] = mesh.origin + mesh.vertices[f[k]].cast<double>();
+        const Eigen::Vector3d normal = (world[1] - world[0]).cross(world[2] - world[0]);
+        if (normal.norm() == 0 || !normal.allFinite()) continue;
+        const double lambert = std::abs(normal.normalized().dot(light));
+        fill_triangle(project(world[0]), project(world[1]), project(world[2]), shade(colour, 0.35 + 0.65 * lambert));
+    }
+}
+
+void Rasterizer::draw_points(const std::vector<Eigen::Vector3d>& points, const std::vector<Rgba>& colours, int size_px) {
+    const int half = std::max(0, size_px - 1) / 2;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const Eigen::Vector3d p = project(points[i]);
+        const Rgba colour = colours.size() == points.size() ? colours[i] : colours.front();
+        for (int dy = -half; dy <= half; ++dy)
+            for (int dx = -half; dx <= half; ++dx)
+                plot(static_cast<int>(std::floor(p.x())) + dx, static_cast<int>(std::floor(p.y())) + dy, p.z(), colour);
+    }
+}
+
+void Rasterizer::draw_points(const PointCloud& cloud, Rgba colour, int size_px) {
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) points.push_back(cloud.global(i));
+    // Shade by depth so that a dense scan still shows its shape.
+    double near = std::numeric_limits<double>::max(), far = -near;
+    for (const auto& p : points) {
+        near = std::min(near, (p - centre_).dot(forward_));
+        far = std::max(far, (p - centre_).dot(forward_));
+    }
+    std::vector<Rgba> colours;
+    colours.reserve(points.size());
+    for (const auto& p : points) {
+        const double t = far > near ? ((p - centre_).dot(forward_) - near) / (far - near) : 0.0;
+        colours.push_back(shade(colour, 1.0 - 0.6 * t));
+    }
+    if (!points.empty()) draw_points(points, colours, size_px);
+}
+
+void Rasterizer::draw_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b, Rgba colour) {
+    const Eigen::Vector3d pa = project(a), pb = project(b);
+    const int steps = std::max(1, static_cast<int>(std::ceil(std::max(std::abs(pb.x() - pa.x()), std::abs(pb.y() - pa.y())))));
+    for (int i = 0; i <= steps; ++i) {
+        const Eigen::Vector3d p = pa + (pb - pa) * (static_cast<double>(i) / steps);
+        plot(static_cast<int>(std::floor(p.x())), static_cast<int>(std::floor(p.y())), p.z() - 1e-6, colour);
+    }
+}
+
+void Rasterizer::draw_skeleton(const TreeGraph& tree, Rgba colour) {
+    for (std::size_t i = 1; i < tree.size(); ++i) {
+        const auto& node = tree.nodes[i];
+        draw_segment(tree.origin + tree.nodes[node.parent].position.cast<double>(), tree.origin + node.position.cast<double>(), colour);
+    }
+}
+
+std::size_t Rasterizer::covered_pixels() const {
+    return static_cast<std::size_t>(std::count_if(depth_.begin(), depth_.end(), [](double z) { return std::isfinite(z); }));
+}
+
+}  // namespace treelobes::render
