@@ -6,6 +6,7 @@
 #include "core/ply_format.hpp"
 #include "core/skeleton_io.hpp"
 
+#include <cmath>
 #include <limits>
 
 namespace fs = std::filesystem;
@@ -35,6 +36,17 @@ void set_bounds(FileInfo& info, const Points& points, const Eigen::Vector3d& ori
     info.bounds_max = hi;
 }
 
+// LAS coordinates are integers times the scale: report the bounds on that grid, as the header
+// does, rather than the float round-off of the local frame.
+void snap_to_las_grid(FileInfo& info) {
+    for (int k = 0; k < 3; ++k) {
+        const double scale = info.las_scale[k], offset = info.las_offset[k];
+        if (!(scale > 0)) continue;
+        info.bounds_min[k] = offset + std::round((info.bounds_min[k] - offset) / scale) * scale;
+        info.bounds_max[k] = offset + std::round((info.bounds_max[k] - offset) / scale) * scale;
+    }
+}
+
 FileInfo describe_cloud(const fs::path& path) {
     const PointCloud cloud = read_point_cloud(path);
     FileInfo info;
@@ -57,6 +69,7 @@ FileInfo describe_cloud(const fs::path& path) {
     if (!cloud.rgb.empty()) add("rgb", "uint16[3]");
     if (!cloud.gps_time.empty()) add("gps_time", "float64");
     for (const auto& extra : cloud.extras) add(extra.name, attribute_type_name(extra.type));
+    if (info.format == "las") snap_to_las_grid(info);
     info.crs = cloud.georef.crs_wkt;
     if (info.crs.empty() && !cloud.georef.las_vlrs.empty()) info.crs = "GeoTIFF keys (" + std::to_string(cloud.georef.las_vlrs.size()) + " VLRs)";
     return info;
