@@ -25,19 +25,12 @@ void check_destination(const fs::path& path) {
         throw Error::input(path.string(), "cannot write: folder " + parent.string() + " does not exist");
 }
 
-}  // namespace
-
-void write_atomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
-    check_destination(path);
-    const fs::path temporary = temporary_path_for(path);
+// Runs `produce` to create `temporary`, then renames it onto `path`; on any failure the
+// temporary is removed and the destination is left as it was.
+void replace_with(const fs::path& path, const fs::path& temporary, const std::function<void()>& produce) {
     try {
-        {
-            std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-            if (!out) throw Error::input(path.string(), "cannot write (permission denied or read-only folder)");
-            write(out);
-            out.flush();
-            if (!out) throw Error::input(path.string(), "write failed (disk full?)");
-        }
+        produce();
+        if (!fs::exists(temporary)) throw Error::input(path.string(), "cannot write (permission denied or read-only folder)");
         std::error_code ec;
         fs::rename(temporary, path, ec);
         if (ec) throw Error::input(path.string(), "cannot replace file: " + ec.message());
@@ -48,22 +41,26 @@ void write_atomically(const fs::path& path, const std::function<void(std::ostrea
     }
 }
 
+}  // namespace
+
+void write_atomically(const fs::path& path, const std::function<void(std::ostream&)>& write) {
+    check_destination(path);
+    const fs::path temporary = temporary_path_for(path);
+    replace_with(path, temporary, [&] {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        if (!out) throw Error::input(path.string(), "cannot write (permission denied or read-only folder)");
+        write(out);
+        out.flush();
+        if (!out) throw Error::input(path.string(), "write failed (disk full?)");
+    });
+}
+
 void write_atomically_via_path(const fs::path& path, const std::function<void(const fs::path&)>& write) {
     check_destination(path);
     // Keep the extension last: these libraries pick the format from it.
     const fs::path temporary = path.parent_path() / (path.stem().string() + ".tmp." + std::to_string(::getpid()) +
                                                      path.extension().string());
-    try {
-        write(temporary);
-        if (!fs::exists(temporary)) throw Error::input(path.string(), "cannot write (permission denied or read-only folder)");
-        std::error_code ec;
-        fs::rename(temporary, path, ec);
-        if (ec) throw Error::input(path.string(), "cannot replace file: " + ec.message());
-    } catch (...) {
-        std::error_code ignored;
-        fs::remove(temporary, ignored);
-        throw;
-    }
+    replace_with(path, temporary, [&] { write(temporary); });
 }
 
 void write_file_atomically(const fs::path& path, const std::string& contents) {

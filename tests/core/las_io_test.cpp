@@ -20,20 +20,11 @@
 
 using namespace treelobes;
 using treelobes::test::TempDir;
+using treelobes::test::error_code_of;
 
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
-
-template <typename F>
-ExitCode error_code_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return ExitCode::Ok;
-}
 
 Bytes load_file(const std::filesystem::path& path) {
     const std::string text = read_file(path);

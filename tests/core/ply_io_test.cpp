@@ -14,19 +14,10 @@
 
 using namespace treelobes;
 using treelobes::test::TempDir;
+using treelobes::test::error_code_of;
 using treelobes::test::write_text;
 
 namespace {
-
-template <typename F>
-ExitCode error_code_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.code();
-    }
-    return ExitCode::Ok;
-}
 
 PointCloud sample_cloud() {
     PointCloud cloud;

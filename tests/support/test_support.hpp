@@ -2,6 +2,8 @@
 // and running the CLI binary.
 #pragma once
 
+#include "core/error.hpp"
+
 #include <filesystem>
 #include <string>
 
@@ -38,6 +40,17 @@ struct CommandResult {
 
 // Runs build/bin/treelobes with the given argument string (shell-quoted by the caller).
 CommandResult run_cli(const std::string& arguments);
+
+// Exit code of the treelobes::Error that `action` throws; ExitCode::Ok when it throws none.
+template <typename Action>
+ExitCode error_code_of(Action&& action) {
+    try {
+        action();
+    } catch (const Error& e) {
+        return e.code();
+    }
+    return ExitCode::Ok;
+}
 
 // Writes text to a file (test fixtures).
 void write_text(const std::filesystem::path& path, const std::string& text);
