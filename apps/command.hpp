@@ -20,6 +20,7 @@ struct GlobalOptions {
 using Job = std::function<int()>;  // returns the process exit code
 
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_encode_commands(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job);
 
 }  // namespace treelobes::cli

@@ -34,6 +34,7 @@ int run(int argc, char** argv) {
 
     cli::Job job;
     cli::add_info_command(app, global, job);
+    cli::add_encode_commands(app, global, job);
     cli::add_render_command(app, global, job);
 
     try {

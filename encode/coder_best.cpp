@@ -1,0 +1,439 @@
+#include "encode/coder_best.hpp"
+
+#include "core/error.hpp"
+#include "encode/bitstream.hpp"
+#include "encode/range_coder.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <deque>
+#include <memory>
+
+namespace treelobes::encode {
+
+namespace {
+
+// ---- Shared plumbing: one modelling routine serves the encoder and the decoder ---------------
+
+// IO policies: `bit(model, b)` codes b (encoder) or returns the decoded bit (decoder, b ignored).
+struct Encoding {
+    static constexpr bool kEncoding = true;
+    RangeEncoder rc;
+    bool bit(BitModel& m, bool b) {
+        rc.encode(m, b);
+        return b;
+    }
+    std::uint64_t direct(std::uint64_t v, unsigned n) {
+        rc.encode_direct(v, n);
+        return v;
+    }
+    [[noreturn]] void fail(const std::string& what) { throw Error(ExitCode::Internal, what); }
+};
+
+struct Decoding {
+    static constexpr bool kEncoding = false;
+    RangeDecoder rc;
+    bool bit(BitModel& m, bool) { return rc.decode(m); }
+    std::uint64_t direct(std::uint64_t, unsigned n) { return rc.decode_direct(n); }
+    [[noreturn]] void fail(const std::string& what) { rc.fail(what); }
+};
+
+// Adaptive Exp-Golomb: the bit width k of v in unary (k = 0 is v = 0, so the first decision is
+// the "is zero" flag), then the bits below the leading one — as a bit tree for k <= 6, where
+// the distribution within a width still matters, and as plain bits above.
+struct UIntModel {
+    static constexpr unsigned kUnary = 24, kTreeWidth = 6;
+    std::array<BitModel, kUnary> unary;
+    std::array<BitModel, 62> tree;  // widths 2..6: offsets 2^(k-1) - 2
+};
+
+constexpr unsigned kMaxWidth = 62;
+
+template <class IO>
+std::uint64_t code_uint(IO& io, UIntModel& m, std::uint64_t v) {
+    const unsigned width = IO::kEncoding ? bit_width64(v) : 0;
+    if (IO::kEncoding && width > kMaxWidth) io.fail("value too large for the arithmetic coder");
+    unsigned k = 0;
+    while (io.bit(m.unary[std::min(k, UIntModel::kUnary - 1)], k < width)) {
+        if (++k > kMaxWidth) io.fail("corrupt integer code");
+    }
+    if (k <= 1) return k;
+    const unsigned low_bits = k - 1;
+    std::uint64_t value = 1;
+    if (k <= UIntModel::kTreeWidth) {
+        const unsigned offset = (1u << (k - 1)) - 2;
+        unsigned node = 1;
+        for (unsigned i = low_bits; i-- > 0;) {
+            const bool b = io.bit(m.tree[offset + node], (v >> i) & 1);
+            node = node * 2 + b;
+            value = value * 2 + b;
+        }
+        return value;
+    }
+    return (value << low_bits) | io.direct(v & ((std::uint64_t{1} << low_bits) - 1), low_bits);
+}
+
+void write_varint(std::vector<std::uint8_t>& out, std::uint64_t v) {
+    while (v >= 0x80) {
+        out.push_back(static_cast<std::uint8_t>(v | 0x80));
+        v >>= 7;
+    }
+    out.push_back(static_cast<std::uint8_t>(v));
+}
+
+std::uint64_t read_varint(std::span<const std::uint8_t> bytes, std::size_t& position, const std::string& context) {
+    std::uint64_t v = 0;
+    for (unsigned shift = 0; shift < 64; shift += 7) {
+        if (position >= bytes.size()) throw Error::input(context, "truncated stream header");
+        const std::uint8_t byte = bytes[position++];
+        v |= static_cast<std::uint64_t>(byte & 0x7F) << shift;
+        if (!(byte & 0x80)) return v;
+    }
+    throw Error::input(context, "invalid stream header");
+}
+
+bool is_terminator(char c) { return c == kFork || c == kTip || c == kEndOfInternode; }
+int sign_of(std::int64_t v) { return (v > 0) - (v < 0); }
+
+// ---- Symbols: the structured (canonical) model ----------------------------------------------
+
+constexpr int kParentBuckets = 7;  // parent component clamped to -3..3
+constexpr int kNormBuckets = 12;   // |moves| already coded on earlier axes, clamped
+
+struct SymbolModels {
+    std::array<UIntModel, 3 * kParentBuckets * kNormBuckets> start_axis;
+    std::array<BitModel, 3 * kParentBuckets> start_sign;
+    std::array<BitModel, 4 * 4 * 4> correction_nonzero;
+    std::array<UIntModel, 3 * 3 * 4> correction_axis;
+    std::array<BitModel, 3 * 3 * 3> correction_sign;
+    std::array<BitModel, 2 * 8 * 4 * 2> is_end_of_internode, is_fork;
+};
+
+// Replays the traversal queue of Pseudocode 1 on the coded internodes (identically in encoder and
+// decoder) and provides the contexts of the next internode.
+class ChainWalker {
+public:
+    bool start = true;                 // the next internode begins a branch: its vector is a full Δv
+    Voxel chain_direction = Voxel::Zero();  // Δv of the previous internode of the branch
+    Voxel parent_direction = Voxel::Zero(); // at a start: Δv of the internode that forked it off
+    int since_start = 0;
+    int order = 0;                     // branch order (0 trunk)
+    unsigned recent_corrections = 0;   // were the last two corrections non-zero (2 bits)
+    std::array<int, 3> last_sign{0, 0, 0};  // sign of the last non-zero correction per axis
+
+    // `vector` is what the symbols code: Δv at a start, else the correction.
+    void advance(const Voxel& vector, char terminator) {
+        const Voxel move = start ? vector : Voxel(chain_direction + vector);
+        if (!start) {
+            for (int a = 0; a < 3; ++a)
+                if (vector[a] != 0) last_sign[a] = sign_of(vector[a]);
+            recent_corrections = ((recent_corrections << 1) | (vector.isZero() ? 0u : 1u)) & 3u;
+        }
+        // Zero-length internodes at a branch start code further laterals of the same fork.
+        const bool sibling_marker = start && move.isZero();
+        if (terminator == kFork) queue_.push_back(sibling_marker ? Fork{parent_direction, order} : Fork{move, order + 1});
+        if (terminator == kTip) {
+            begin_branch();
+        } else if (!(sibling_marker && terminator == kFork)) {
+            start = false;
+            chain_direction = move;
+            ++since_start;
+        }
+    }
+
+private:
+    struct Fork {
+        Voxel direction;
+        int order;
+    };
+    void begin_branch() {
+        start = true;
+        since_start = 0;
+        recent_corrections = 0;
+        last_sign = {0, 0, 0};
+        chain_direction = Voxel::Zero();
+        parent_direction = Voxel::Zero();
+        order = 0;
+        if (queue_.empty()) return;  // only at the end of a valid code
+        parent_direction = queue_.front().direction;
+        order = queue_.front().order;
+        queue_.pop_front();
+    }
+    std::deque<Fork> queue_;
+};
+
+// Codes the vector of one internode; `budget` caps the moves a decoder may produce.
+template <class IO>
+Voxel code_vector(IO& io, SymbolModels& m, const ChainWalker& w, Voxel v, std::uint64_t budget) {
+    std::uint64_t used = 0;
+    auto spend = [&](std::uint64_t magnitude) {
+        used += magnitude;
+        if (used > budget) io.fail("internode moves exceed the code length");
+    };
+    if (w.start) {
+        for (int a = 0; a < 3; ++a) {
+            const int parent = static_cast<int>(std::clamp<std::int64_t>(w.parent_direction[a], -3, 3)) + 3;
+            const int norm = static_cast<int>(std::min<std::uint64_t>(used, kNormBuckets - 1));
+            const std::uint64_t magnitude =
+                code_uint(io, m.start_axis[(a * kParentBuckets + parent) * kNormBuckets + norm], static_cast<std::uint64_t>(std::abs(v[a])));
+            spend(magnitude);
+            const bool negative = magnitude != 0 && io.bit(m.start_sign[a * kParentBuckets + parent], v[a] < 0);
+            v[a] = negative ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
+        }
+        return v;
+    }
+    const int since = std::min(w.since_start, 3), order = std::min(w.order, 3);
+    if (!io.bit(m.correction_nonzero[(w.recent_corrections * 4 + since) * 4 + order], !v.isZero())) return Voxel::Zero();
+    int nonzero_axes = 0;
+    for (int a = 0; a < 3; ++a) {
+        const bool implied = a == 2 && nonzero_axes == 0;  // a non-zero correction needs one axis
+        const int direction = static_cast<int>(std::min<std::int64_t>(std::abs(w.chain_direction[a]), 3));
+        const std::uint64_t magnitude =
+            code_uint(io, m.correction_axis[(a * 3 + nonzero_axes) * 4 + direction],
+                      static_cast<std::uint64_t>(std::abs(v[a])) - (IO::kEncoding && implied ? 1 : 0)) + (implied ? 1 : 0);
+        spend(magnitude);
+        bool negative = false;
+        if (magnitude != 0) {
+            ++nonzero_axes;
+            negative = io.bit(m.correction_sign[(a * 3 + w.last_sign[a] + 1) * 3 + sign_of(w.chain_direction[a]) + 1], v[a] < 0);
+        }
+        v[a] = negative ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
+    }
+    return v;
+}
+
+template <class IO>
+char code_terminator(IO& io, SymbolModels& m, const ChainWalker& w, bool moved, char terminator) {
+    const int ctx = ((int(w.start) * 8 + std::min(w.since_start, 7)) * 4 + std::min(w.order, 3)) * 2 + int(moved);
+    if (io.bit(m.is_end_of_internode[ctx], terminator == kEndOfInternode)) return kEndOfInternode;
+    return io.bit(m.is_fork[ctx], terminator == kFork) ? kFork : kTip;
+}
+
+// Splits a code into internode vectors if every internode is canonical (ascending moves, never
+// both directions on one axis, i.e. exactly what append_moves writes) and ends with a terminator.
+bool canonical_internodes(const std::string& symbols, std::vector<std::pair<Voxel, char>>& out) {
+    std::size_t begin = 0;
+    std::string rewritten;
+    for (std::size_t i = 0; i < symbols.size(); ++i) {
+        if (!is_terminator(symbols[i])) continue;
+        Voxel v = Voxel::Zero();
+        for (std::size_t k = begin; k < i; ++k) v[(symbols[k] - '0') % 3] += symbols[k] < '3' ? 1 : -1;
+        rewritten.clear();
+        append_moves(v, rewritten);
+        if (rewritten.size() != i - begin || symbols.compare(begin, i - begin, rewritten) != 0) return false;
+        out.emplace_back(v, symbols[i]);
+        begin = i + 1;
+    }
+    return begin == symbols.size();
+}
+
+// ---- Symbols: the fallback order-2 model for non-canonical codes ------------------------------
+
+struct GenericModels {
+    std::array<BitModel, 81 * 16> tree;  // context: previous two symbols; 4-bit symbol tree
+};
+
+template <class IO>
+std::uint8_t code_generic_symbol(IO& io, GenericModels& m, unsigned context, std::uint8_t symbol) {
+    unsigned node = 1;
+    for (int i = 3; i >= 0; --i) node = node * 2 + io.bit(m.tree[context * 16 + node], (symbol >> i) & 1);
+    const unsigned value = node - 16;
+    if (value > 8) io.fail("corrupt symbol");
+    return static_cast<std::uint8_t>(value);
+}
+
+enum SymbolMode : std::uint8_t { kGeneric = 0, kCanonical = 1 };
+
+// ---- Radii ------------------------------------------------------------------------------------
+
+// The internode tree a code describes: parent internode (-1 for the first and for laterals whose
+// fork is missing), tips below, whether it starts a branch, and its terminator.
+struct Topology {
+    std::vector<int> parent;
+    std::vector<std::uint32_t> tips;
+    std::vector<std::uint8_t> start;
+    std::vector<char> terminator;
+};
+
+Topology parse_topology(const std::string& symbols) {
+    Topology t;
+    std::deque<int> forks;
+    bool start = true;
+    for (char c : symbols) {
+        if (!is_terminator(c)) continue;
+        const int index = static_cast<int>(t.parent.size());
+        int parent = index - 1;
+        if (start && index > 0) {
+            parent = forks.empty() ? -1 : forks.front();
+            if (!forks.empty()) forks.pop_front();
+        }
+        t.parent.push_back(index == 0 ? -1 : parent);
+        t.start.push_back(start);
+        t.terminator.push_back(c);
+        if (c == kFork) forks.push_back(index);
+        start = c == kTip;
+    }
+    t.tips.assign(t.parent.size(), 0);
+    for (std::size_t i = t.parent.size(); i-- > 0;) {  // parents precede their children
+        if (t.terminator[i] == kTip) ++t.tips[i];
+        if (t.parent[i] >= 0) t.tips[t.parent[i]] += t.tips[i];
+    }
+    return t;
+}
+
+enum RadiusPredictor : std::uint8_t { kParentRadius = 0, kPipeModel = 1 };
+
+std::uint64_t isqrt(std::uint64_t x) {
+    auto r = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(x)));
+    while (r > 0 && r * r > x) --r;  // exact floor whatever the libm rounding
+    while ((r + 1) * (r + 1) <= x) ++r;
+    return r;
+}
+
+// r_parent · sqrt(tips / tips_parent), rounded, in integers (deterministic on every platform).
+std::int64_t predict_radius(const Topology& t, std::span<const int> radii, std::size_t i, RadiusPredictor predictor) {
+    const int parent = t.parent[i];
+    if (parent < 0) return 0;
+    const std::int64_t reference = radii[parent];
+    if (predictor == kParentRadius || reference <= 0 || t.tips[parent] == 0 || t.tips[i] >= t.tips[parent]) return reference;
+    const auto square = static_cast<unsigned __int128>(reference) * static_cast<unsigned __int128>(reference) * 4u;
+    const auto x = static_cast<std::uint64_t>(square * t.tips[i] / t.tips[parent]);  // < 4 r^2 < 2^64
+    return static_cast<std::int64_t>((isqrt(x) + 1) / 2);
+}
+
+constexpr int kPredictedBuckets = 17;
+
+struct RadiusModels {
+    std::array<UIntModel, 2 * 3 * kPredictedBuckets * 3> residual;
+    std::array<BitModel, 2 * kPredictedBuckets * 3> sign;
+};
+
+int terminator_index(char c) { return c == kEndOfInternode ? 0 : c == kFork ? 1 : 2; }
+int residual_bucket(std::int64_t e) { return e == 0 ? 0 : (std::abs(e) <= 2 ? 1 : 2); }
+
+template <class IO>
+void code_radii(IO& io, const Topology& t, std::span<int> radii, RadiusPredictor predictor) {
+    auto models = std::make_unique<RadiusModels>();
+    std::vector<std::int64_t> residuals(radii.size(), 0);
+    for (std::size_t i = 0; i < radii.size(); ++i) {
+        const std::int64_t predicted = predict_radius(t, radii, i, predictor);
+        const int magnitude_bucket = static_cast<int>(std::min<unsigned>(bit_width64(static_cast<std::uint64_t>(std::abs(predicted))), kPredictedBuckets - 1));
+        const std::int64_t parent_residual = t.parent[i] >= 0 ? residuals[t.parent[i]] : 0;
+        const int ctx = ((int(t.start[i]) * 3 + terminator_index(t.terminator[i])) * kPredictedBuckets + magnitude_bucket) * 3 +
+                        residual_bucket(parent_residual);
+        const std::int64_t e = IO::kEncoding ? radii[i] - predicted : 0;
+        const std::uint64_t magnitude = code_uint(io, models->residual[ctx], static_cast<std::uint64_t>(std::abs(e)));
+        const int sign_ctx = (int(t.start[i]) * kPredictedBuckets + magnitude_bucket) * 3 + sign_of(parent_residual) + 1;
+        const bool negative = magnitude != 0 && io.bit(models->sign[sign_ctx], e < 0);
+        if (magnitude > (std::uint64_t{1} << 33)) io.fail("radius residual out of range");
+        residuals[i] = negative ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
+        const std::int64_t radius = predicted + residuals[i];
+        if (radius < INT32_MIN || radius > INT32_MAX) io.fail("decoded radius out of range");
+        radii[i] = static_cast<int>(radius);
+    }
+}
+
+std::vector<std::uint8_t> encode_radii_with(const Topology& t, std::span<const int> radii, RadiusPredictor predictor) {
+    Encoding io;
+    std::vector<int> copy(radii.begin(), radii.end());
+    code_radii(io, t, copy, predictor);
+    std::vector<std::uint8_t> out{predictor};
+    const std::vector<std::uint8_t> payload = io.rc.finish();
+    out.insert(out.end(), payload.begin(), payload.end());
+    return out;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> best_encode_symbols(const std::string& symbols) {
+    std::vector<std::uint8_t> out;
+    write_varint(out, symbols.size());
+    std::vector<std::pair<Voxel, char>> internodes;
+    Encoding io;
+    if (canonical_internodes(symbols, internodes)) {
+        out.push_back(kCanonical);
+        auto models = std::make_unique<SymbolModels>();
+        ChainWalker walker;
+        for (const auto& [vector, terminator] : internodes) {
+            code_vector(io, *models, walker, vector, symbols.size());
+            code_terminator(io, *models, walker, !vector.isZero(), terminator);
+            walker.advance(vector, terminator);
+        }
+    } else {
+        out.push_back(kGeneric);
+        auto models = std::make_unique<GenericModels>();
+        unsigned context = 8 * 9 + 8;
+        for (char c : symbols) {
+            const auto symbol = static_cast<std::uint8_t>(c - '0');
+            code_generic_symbol(io, *models, context, symbol);
+            context = (context % 9) * 9 + symbol;
+        }
+    }
+    const std::vector<std::uint8_t> payload = io.rc.finish();
+    out.insert(out.end(), payload.begin(), payload.end());
+    return out;
+}
+
+std::string best_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context) {
+    std::size_t position = 0;
+    const std::uint64_t n = read_varint(bytes, position, context);
+    if (n > kMaxCodeSymbols) throw Error::input(context, "code length " + std::to_string(n) + " exceeds the decoder limit");
+    if (position >= bytes.size()) throw Error::input(context, "truncated stream header");
+    const std::uint8_t mode = bytes[position++];
+    if (mode != kCanonical && mode != kGeneric) throw Error::input(context, "unknown symbol model " + std::to_string(mode));
+    Decoding io{RangeDecoder(bytes.subspan(position), context)};
+    std::string symbols;
+    symbols.reserve(n);
+    if (mode == kCanonical) {
+        auto models = std::make_unique<SymbolModels>();
+        ChainWalker walker;
+        while (symbols.size() < n) {
+            const Voxel vector = code_vector(io, *models, walker, Voxel::Zero(), n - symbols.size() - 1);
+            const char terminator = code_terminator(io, *models, walker, !vector.isZero(), kTip);
+            append_moves(vector, symbols);
+            symbols += terminator;
+            walker.advance(vector, terminator);
+        }
+    } else {
+        auto models = std::make_unique<GenericModels>();
+        unsigned ctx = 8 * 9 + 8;
+        while (symbols.size() < n) {
+            const std::uint8_t symbol = code_generic_symbol(io, *models, ctx, 0);
+            symbols += static_cast<char>('0' + symbol);
+            ctx = (ctx % 9) * 9 + symbol;
+        }
+    }
+    if (!io.rc.at_end()) throw Error::input(context, "trailing bytes after the symbol stream");
+    return symbols;
+}
+
+std::vector<std::uint8_t> best_encode_radii(const std::string& symbols, std::span<const int> radii) {
+    const Topology topology = parse_topology(symbols);
+    if (topology.parent.size() != radii.size())
+        throw Error(ExitCode::Internal, "best radii: radius count differs from the internode count");
+    if (radii.empty()) return {};
+    std::vector<std::uint8_t> best = encode_radii_with(topology, radii, kParentRadius);
+    std::vector<std::uint8_t> pipe = encode_radii_with(topology, radii, kPipeModel);
+    return pipe.size() < best.size() ? pipe : best;
+}
+
+std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
+                                   const std::string& context) {
+    const Topology topology = parse_topology(symbols);
+    std::vector<int> radii(topology.parent.size(), 0);
+    if (radii.empty()) {
+        if (!bytes.empty()) throw Error::input(context, "radii stream for a code without internodes");
+        return radii;
+    }
+    if (bytes.empty()) throw Error::input(context, "empty radii stream");
+    const std::uint8_t predictor = bytes[0];
+    if (predictor != kParentRadius && predictor != kPipeModel)
+        throw Error::input(context, "unknown radius predictor " + std::to_string(predictor));
+    Decoding io{RangeDecoder(bytes.subspan(1), context)};
+    code_radii(io, topology, radii, static_cast<RadiusPredictor>(predictor));
+    if (!io.rc.at_end()) throw Error::input(context, "trailing bytes after the radii stream");
+    return radii;
+}
+
+}  // namespace treelobes::encode

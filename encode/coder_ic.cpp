@@ -1,0 +1,134 @@
+#include "encode/coder_ic.hpp"
+
+#include "core/error.hpp"
+#include "encode/bitstream.hpp"
+#include "encode/bwt.hpp"
+#include "encode/interpolative.hpp"
+#include "encode/transforms.hpp"
+
+#include <algorithm>
+#include <climits>
+
+namespace treelobes::encode {
+
+namespace {
+
+constexpr unsigned kAlphabet = 9;                // symbols 0..8 (Table 1)
+constexpr std::uint64_t kMaxMtfPosition = kAlphabet - 1;
+// Radius d-gaps are differences of two ints, so the shifted gaps stay below 2^33.
+constexpr std::uint64_t kMaxShiftedGap = std::uint64_t{1} << 33;
+
+bool is_terminator(char c) { return c == kFork || c == kTip || c == kEndOfInternode; }
+
+// Internode index ranges [begin, end) of the branches: each ends at the internode closed by a 7;
+// internodes after the last 7 (only in codes that do not end with one) form a final sublist.
+std::vector<std::pair<std::size_t, std::size_t>> branch_sublists(const std::string& symbols) {
+    std::vector<std::pair<std::size_t, std::size_t>> lists;
+    std::size_t begin = 0, internode = 0;
+    for (char c : symbols) {
+        if (!is_terminator(c)) continue;
+        ++internode;
+        if (c == kTip) {
+            lists.emplace_back(begin, internode);
+            begin = internode;
+        }
+    }
+    if (begin < internode) lists.emplace_back(begin, internode);
+    return lists;
+}
+
+std::size_t internode_count(const std::string& symbols) {
+    return static_cast<std::size_t>(std::count_if(symbols.begin(), symbols.end(), is_terminator));
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> ic_encode_symbols(const std::string& symbols) {
+    BitWriter out;
+    write_count(out, symbols.size());
+    if (symbols.empty()) return out.take();
+    std::vector<std::uint8_t> text(symbols.size());
+    for (std::size_t i = 0; i < symbols.size(); ++i) text[i] = static_cast<std::uint8_t>(symbols[i] - '0');
+    const BwtResult bwt = bwt_forward(text, kAlphabet);
+    write_centred_minimal_binary(out, bwt.primary_index, symbols.size() + 1);
+    const std::vector<std::uint8_t> mtf = mtf_encode(bwt.last_column, kAlphabet);
+    const std::vector<std::uint64_t> values(mtf.begin(), mtf.end());
+    write_interpolative(out, cumulative_sum(values), {.max_gap = kMaxMtfPosition});
+    return out.take();
+}
+
+std::string ic_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context) {
+    BitReader in(bytes, context);
+    const std::uint64_t n = read_count(in);
+    if (n > kMaxCodeSymbols) in.fail("code length " + std::to_string(n) + " exceeds the decoder limit");
+    if (n == 0) return {};
+    const std::uint64_t primary = read_centred_minimal_binary(in, n + 1);
+    const std::vector<std::uint64_t> sums = read_interpolative(in, n, {.max_gap = kMaxMtfPosition});
+    const std::vector<std::uint64_t> values = differences(sums, kMaxMtfPosition, context);
+    const std::vector<std::uint8_t> mtf(values.begin(), values.end());
+    const std::vector<std::uint8_t> text = bwt_inverse(mtf_decode(mtf, kAlphabet, context), primary, kAlphabet, context);
+    std::string symbols(text.size(), '0');
+    for (std::size_t i = 0; i < text.size(); ++i) symbols[i] = static_cast<char>('0' + text[i]);
+    return symbols;
+}
+
+RadiiSequence radii_to_sequence(const std::string& symbols, std::span<const int> radii) {
+    std::vector<std::int64_t> gaps;
+    gaps.reserve(radii.size());
+    for (const auto& [begin, end] : branch_sublists(symbols)) {
+        std::int64_t previous = 0;  // the inverted sublist starts from 0
+        for (std::size_t i = end; i-- > begin;) {
+            gaps.push_back(static_cast<std::int64_t>(radii[i]) - previous);
+            previous = radii[i];
+        }
+    }
+    RadiiSequence sequence;
+    if (gaps.empty()) return sequence;
+    sequence.offset = *std::min_element(gaps.begin(), gaps.end());
+    std::vector<std::uint64_t> shifted(gaps.size());
+    for (std::size_t i = 0; i < gaps.size(); ++i) shifted[i] = static_cast<std::uint64_t>(gaps[i] - sequence.offset);
+    sequence.cumulative = cumulative_sum(shifted);
+    return sequence;
+}
+
+std::vector<std::uint8_t> ic_encode_radii(const std::string& symbols, std::span<const int> radii) {
+    if (radii.size() != internode_count(symbols))
+        throw Error(ExitCode::Internal, "ic radii: radius count differs from the internode count");
+    const RadiiSequence sequence = radii_to_sequence(symbols, radii);
+    BitWriter out;
+    if (radii.empty()) return out.take();
+    std::uint64_t max_gap = 0, previous = 0;
+    for (std::uint64_t q : sequence.cumulative) {
+        max_gap = std::max(max_gap, q - previous);
+        previous = q;
+    }
+    write_count(out, zigzag(sequence.offset));
+    write_count(out, max_gap);
+    write_interpolative(out, sequence.cumulative, {.max_gap = max_gap});
+    return out.take();
+}
+
+std::vector<int> ic_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
+                                 const std::string& context) {
+    const std::size_t n = internode_count(symbols);
+    std::vector<int> radii(n);
+    if (n == 0) return radii;
+    BitReader in(bytes, context);
+    const std::int64_t offset = unzigzag(read_count(in));
+    const std::uint64_t max_gap = read_count(in);
+    if (max_gap > kMaxShiftedGap || offset < -(std::int64_t{1} << 33) || offset > (std::int64_t{1} << 33))
+        in.fail("radius gap bounds out of range");
+    const std::vector<std::uint64_t> shifted = differences(read_interpolative(in, n, {.max_gap = max_gap}), max_gap, context);
+    std::size_t k = 0;
+    for (const auto& [begin, end] : branch_sublists(symbols)) {
+        std::int64_t value = 0;
+        for (std::size_t i = end; i-- > begin;) {
+            value += static_cast<std::int64_t>(shifted[k++]) + offset;
+            if (value < INT_MIN || value > INT_MAX) in.fail("decoded radius out of range");
+            radii[i] = static_cast<int>(value);
+        }
+    }
+    return radii;
+}
+
+}  // namespace treelobes::encode

@@ -1,0 +1,35 @@
+// Level of detail directly on the chain code (seed 000 §3.2, Pseudocode 2, Fig. 7).
+//
+// Every lateral branch whose first internode has a radius below the threshold T is removed
+// with everything that grows on it; the fork symbol of its surviving parent becomes 8. The
+// trunk and all main extensions are never shortened. Works on F6 and DBF6 alike: a removed
+// lateral's first internode is coded fully, and the internode after a fork turned into 8 keeps
+// its correction relative to the same predecessor.
+//
+// One deliberate difference from Pseudocode 2 as printed: a branch whose parent branch was
+// removed is removed too, even when its own radius reaches T (the printed loop would copy it
+// without the fork that attaches it, leaving an undecodable code).
+#pragma once
+
+#include "encode/chain_code.hpp"
+
+#include <string>
+#include <vector>
+
+namespace treelobes::encode {
+
+// C', R' of Pseudocode 2 for threshold T (in radius units). Throws Error(InvalidInput) naming
+// `context` for a corrupt code or a radius list of the wrong length.
+ChainCode reduce_lod(const ChainCode& code, double threshold, const std::string& context = "chain code");
+
+// Thresholds for `levels` LODs (LOD 0 = full detail) as in §4 Experiment 1: the values at
+// levels-1 uniformly spaced positions i*n/levels (i = 1..levels-1) of the n sorted unique radii.
+// Non-decreasing; fewer unique radii than levels repeat values. Throws Error(Usage) for levels < 1.
+std::vector<double> lod_thresholds(const std::vector<int>& radii, int levels);
+
+// LOD 0..thresholds.size(): the full code, then successive reductions (each from the previous
+// one, which equals reducing the full code by the larger threshold).
+std::vector<ChainCode> lod_chain(const ChainCode& code, const std::vector<double>& thresholds,
+                                 const std::string& context = "chain code");
+
+}  // namespace treelobes::encode

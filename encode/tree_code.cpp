@@ -1,0 +1,247 @@
+#include "encode/tree_code.hpp"
+
+#include "core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+namespace treelobes::encode {
+
+namespace {
+
+// Beyond 2^52 a double no longer holds every integer, so Eq. 1 would not round exactly.
+constexpr double kMaxVoxelsFromRoot = 4503599627370496.0;
+
+void check_positive(double value, const char* what) {
+    if (!(value > 0.0) || !std::isfinite(value))
+        throw Error::usage(std::string(what) + " must be a positive number (got " + std::to_string(value) + ")");
+}
+
+// Voxel coordinates of every vertex relative to the root (Eq. 1).
+std::vector<Voxel> voxelize_tree(const TreeGraph& tree, double voxel_size, const std::string& context) {
+    const Eigen::Vector3d root = tree.nodes[0].position.cast<double>();
+    std::vector<Voxel> voxels(tree.size());
+    for (std::size_t i = 0; i < tree.size(); ++i) {
+        const Eigen::Vector3d scaled = (tree.nodes[i].position.cast<double>() - root) / voxel_size;
+        if (scaled.cwiseAbs().maxCoeff() > kMaxVoxelsFromRoot)
+            throw Error::input(context, "node " + std::to_string(i) + " lies too far from the root for voxel size " +
+                                            std::to_string(voxel_size) + " m");
+        for (int axis = 0; axis < 3; ++axis) voxels[i][axis] = voxelize(scaled[axis]);
+    }
+    return voxels;
+}
+
+std::vector<int> quantize_radii(const TreeGraph& tree, double radius_unit, const std::string& context) {
+    std::vector<int> radii(tree.size());
+    for (std::size_t i = 0; i < tree.size(); ++i) {
+        const float radius = tree.nodes[i].radius;
+        if (radius < 0.0f) throw Error::input(context, "node " + std::to_string(i) + " has a negative radius");
+        if (radius / radius_unit > std::numeric_limits<int>::max() / 2)
+            throw Error::input(context, "node " + std::to_string(i) + " has a radius too large for radius unit " +
+                                            std::to_string(radius_unit) + " m");
+        radii[i] = quantize_radius(radius, radius_unit);
+    }
+    return radii;
+}
+
+// Direction change 1 - cos(angle) between two moves; a zero move counts as a right angle, as
+// in TreeGraph::order_children_by_subtree_length.
+double turn(const Voxel& incoming, const Voxel& move) {
+    const Eigen::Vector3d a = incoming.cast<double>(), b = move.cast<double>();
+    if (a.isZero() || b.isZero()) return 1.0;
+    return 1.0 - a.dot(b) / (a.norm() * b.norm());
+}
+
+// Children of every vertex in coding order: main child first, then laterals. Uses only what the
+// code stores (quantized radii, voxel moves) plus the node index, so a decoded tree, whose
+// indices follow the code order, sorts the same way.
+std::vector<std::vector<int>> coding_order(const TreeGraph& tree, const std::vector<Voxel>& voxels,
+                                           const std::vector<int>& radii) {
+    // Incoming direction of each vertex: the last non-zero move on the path from the root, so that
+    // zero-length internodes (contracted by the decoder) do not change it; +z above the root.
+    std::vector<Voxel> incoming(tree.size(), Voxel(0, 0, 1));
+    for (int node : tree.preorder())
+        for (int child : tree.nodes[node].children) {
+            const Voxel move = voxels[child] - voxels[node];
+            incoming[child] = move.isZero() ? incoming[node] : move;
+        }
+    std::vector<std::vector<int>> order(tree.size());
+    for (std::size_t node = 0; node < tree.size(); ++node) {
+        std::vector<int> children = tree.nodes[node].children;
+        auto key = [&](int child) {
+            return std::make_tuple(-radii[child], turn(incoming[node], Voxel(voxels[child] - voxels[node])), child);
+        };
+        std::sort(children.begin(), children.end(), [&](int a, int b) { return key(a) < key(b); });
+        order[node] = std::move(children);
+    }
+    return order;
+}
+
+// Pseudocode 1 with the multi-way fork rule: builds the internode stream of one tree.
+class StreamBuilder {
+public:
+    StreamBuilder(const TreeGraph& tree, const std::vector<Voxel>& voxels, const std::vector<int>& radii,
+                  std::vector<std::vector<int>> order)
+        : tree_(tree), voxels_(voxels), radii_(radii), order_(std::move(order)) {}
+
+    // Returns the stream; `sources` receives the tree node behind each internode (-1 for the
+    // zero-length internodes of forks).
+    std::vector<Internode> build(std::vector<int>& sources) {
+        const std::vector<int>& root_children = order_[0];
+        if (root_children.size() > 1) {
+            // The root forks at once: a zero-length root internode carries the fork.
+            emit(Voxel::Zero(), kFork, radii_[root_children[0]], -1);
+            queue_.push_back({0, std::vector<int>(root_children.begin() + 1, root_children.end())});
+        }
+        walk_branch(root_children[0]);
+        while (!queue_.empty()) {
+            const LateralGroup group = std::move(queue_.front());
+            queue_.pop_front();
+            start_lateral(group);
+        }
+        sources = std::move(sources_);
+        return std::move(stream_);
+    }
+
+private:
+    // Laterals of one fork vertex still to be coded, in coding order.
+    struct LateralGroup {
+        int fork = 0;
+        std::vector<int> laterals;
+    };
+
+    void emit(const Voxel& move, char terminator, int radius, int source) {
+        stream_.push_back({move, terminator, radius});
+        sources_.push_back(source);
+    }
+
+    // Follows main children from `node` (the first child vertex of a branch) to the branch tip.
+    void walk_branch(int node) {
+        for (;;) {
+            const std::vector<int>& children = order_[node];
+            const char terminator = children.empty() ? kTip : children.size() == 1 ? kEndOfInternode : kFork;
+            emit(voxels_[node] - voxels_[tree_.nodes[node].parent], terminator, radii_[node], node);
+            if (children.empty()) return;
+            if (children.size() > 1) queue_.push_back({node, std::vector<int>(children.begin() + 1, children.end())});
+            node = children[0];
+        }
+    }
+
+    // Dequeued lateral(s) of a fork: the siblings of a multi-way fork are announced by
+    // zero-length internodes ("7 6...6") and queued singly, then the first lateral is coded.
+    void start_lateral(const LateralGroup& group) {
+        const int first = group.laterals[0];
+        for (std::size_t k = 1; k < group.laterals.size(); ++k) {
+            emit(Voxel::Zero(), kFork, radii_[first], -1);
+            queue_.push_back({group.fork, {group.laterals[k]}});
+        }
+        walk_branch(first);
+    }
+
+    const TreeGraph& tree_;
+    const std::vector<Voxel>& voxels_;
+    const std::vector<int>& radii_;
+    const std::vector<std::vector<int>> order_;  // owned: callers pass a temporary
+    std::deque<LateralGroup> queue_;
+    std::vector<Internode> stream_;
+    std::vector<int> sources_;
+};
+
+// Tree node behind each decoded node: the root, then every internode that the decoder does not
+// contract, in code order.
+std::vector<int> decoded_sources(const std::vector<Internode>& stream, const std::vector<int>& sources) {
+    const std::vector<bool> contracted = contracted_internodes(stream);
+    std::vector<int> decoded{0};
+    for (std::size_t i = 0; i < stream.size(); ++i)
+        if (!contracted[i]) decoded.push_back(sources[i]);
+    return decoded;
+}
+
+}  // namespace
+
+std::int64_t voxelize(double coordinate_in_voxels) {
+    const double x = coordinate_in_voxels;
+    const double sign = x > 0.0 ? 1.0 : x < 0.0 ? -1.0 : 0.0;
+    return static_cast<std::int64_t>(std::trunc(x + 0.5 * sign));
+}
+
+int quantize_radius(float radius, double radius_unit) {
+    return static_cast<int>(std::round(static_cast<double>(radius) / radius_unit));
+}
+
+double median_internode_length(const TreeGraph& tree, const std::string& context) {
+    std::vector<float> lengths;
+    for (std::size_t i = 1; i < tree.size(); ++i)
+        if (const float length = tree.edge_length(static_cast<int>(i)); length > 0.0f) lengths.push_back(length);
+    if (lengths.empty()) throw Error::input(context, "no edge of positive length: cannot derive the internode length");
+    const auto middle = lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2);
+    std::nth_element(lengths.begin(), middle, lengths.end());
+    return *middle;
+}
+
+EncodedTree encode_tree(const TreeGraph& tree, const EncodeOptions& options, const std::string& context) {
+    check_positive(options.resolution, "resolution");
+    check_positive(options.radius_unit, "radius unit");
+    if (options.internode_length != 0.0) check_positive(options.internode_length, "internode length");
+    tree.validate(context);
+    if (tree.nodes[0].children.empty()) throw Error::input(context, "tree has no internodes (the root has no child)");
+
+    EncodedTree encoded;
+    encoded.resolution = options.resolution;
+    encoded.internode_length =
+        options.internode_length > 0.0 ? options.internode_length : median_internode_length(tree, context);
+    encoded.geometry.voxel_size = encoded.internode_length / options.resolution;  // Eq. 2
+    encoded.geometry.radius_unit = options.radius_unit;
+    encoded.geometry.root_position = tree.nodes[0].position;
+    encoded.geometry.origin = tree.origin;
+
+    const std::vector<Voxel> voxels = voxelize_tree(tree, encoded.geometry.voxel_size, context);
+    const std::vector<int> radii = quantize_radii(tree, options.radius_unit, context);
+    encoded.geometry.root_radius = radii[0];
+
+    std::vector<int> sources;
+    encoded.internodes = StreamBuilder(tree, voxels, radii, coding_order(tree, voxels, radii)).build(sources);
+    encoded.decoded_to_source = decoded_sources(encoded.internodes, sources);
+    encoded.code.kind = options.kind;
+    encoded.code.symbols = write_symbols(encoded.internodes, options.kind);
+    encoded.code.radii.reserve(encoded.internodes.size());
+    for (const Internode& internode : encoded.internodes) encoded.code.radii.push_back(internode.radius);
+    return encoded;
+}
+
+TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const std::string& context) {
+    check_positive(geometry.voxel_size, "voxel size");
+    check_positive(geometry.radius_unit, "radius unit");
+    if (geometry.root_radius < 0) throw Error::input(context, "root radius is negative");
+    const std::vector<Internode> stream = read_internodes(code, context);
+    const std::vector<bool> contracted = contracted_internodes(stream);
+
+    TreeGraph tree;
+    tree.origin = geometry.origin;
+    const Eigen::Vector3d root = geometry.root_position.cast<double>();
+    tree.add_node(geometry.root_position, static_cast<float>(geometry.root_radius * geometry.radius_unit), -1);
+    std::vector<Voxel> voxels{Voxel::Zero()};
+    std::deque<int> queued_forks;  // vertices whose next lateral is still to come
+    int attach = 0;                // vertex the next internode starts from
+    for (std::size_t i = 0; i < stream.size(); ++i) {
+        const Internode& internode = stream[i];
+        if (!contracted[i]) {
+            const Voxel voxel = voxels[attach] + internode.move;
+            if (voxel.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
+                throw Error::input(context, "internode " + std::to_string(i + 1) + " ends more than 2^40 voxels from the root (corrupt code)");
+            const Eigen::Vector3d position = root + voxel.cast<double>() * geometry.voxel_size;
+            attach = tree.add_node(position.cast<float>(), static_cast<float>(internode.radius * geometry.radius_unit), attach);
+            voxels.push_back(voxel);
+        }
+        if (internode.terminator == kFork) queued_forks.push_back(attach);
+        if (internode.terminator == kTip && !queued_forks.empty()) {
+            attach = queued_forks.front();
+            queued_forks.pop_front();
+        }
+    }
+    return tree;
+}
+
+}  // namespace treelobes::encode
