@@ -1,19 +1,28 @@
-// `treelobes encode`, `treelobes lod` and `treelobes decode-code`: F6/DBF6 chain codes of
-// skeletons (seed 000 §3.1-3.2) on the command line. Codes and radius lists travel as text
-// (the code on one line, the comma-separated radii on the next); files come with compression.
+// `treelobes encode`, `lod`, `decode` and `decode-code`: F6/DBF6 chain codes of skeletons
+// (seed 000 §3.1-3.2) on the command line. Without --out, codes and radius lists travel as text
+// (the code on one line, the comma-separated radii on the next); with --out they are compressed
+// into a .dbf6 file (one tree, LODs) or a .forest file (many trees), which `decode` reads back
+// (seed 000 §3.3, §4; docs/dbf6.md, docs/forest.md).
 #include "apps/command.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
+#include "core/atomic_file.hpp"
 #include "encode/chain_code.hpp"
+#include "encode/forest_file.hpp"
 #include "encode/lod.hpp"
 #include "encode/tree_code.hpp"
+#include "encode/tree_file.hpp"
+#include "lobes/tlobe_io.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -24,13 +33,29 @@ namespace {
 
 using namespace treelobes::encode;
 
+namespace fs = std::filesystem;
+
 struct EncodeCliOptions {
     std::string skeleton;
+    std::string forest;  // directory of skeletons or a list file
+    std::string out;     // .dbf6 (one tree) or .forest (--forest)
     double resolution = 5.0;
     std::string internode_length = "auto";
     double radius_unit = 0.001;
     bool f6 = false;
     bool print_code = false;
+    int lods = 1;
+    std::string coder = "best";
+    bool stats = false;
+};
+
+struct DecodeFileCliOptions {
+    std::string input;
+    int lod = 0;
+    int tree = -1;  // -1: every tree of a forest
+    std::string out;
+    bool ascii = false;
+    bool stats = false;
 };
 
 struct LodCliOptions {
@@ -87,13 +112,202 @@ double parse_internode_length(const std::string& text) {
     return value;
 }
 
-int run_encode(const EncodeCliOptions& options, const GlobalOptions& global) {
-    const TreeGraph tree = read_skeleton_ply(options.skeleton);
+EncodeOptions encode_options_of(const EncodeCliOptions& options) {
     EncodeOptions encode_options;
     encode_options.resolution = options.resolution;
     encode_options.internode_length = parse_internode_length(options.internode_length);
     encode_options.radius_unit = options.radius_unit;
     encode_options.kind = options.f6 ? CodeKind::F6 : CodeKind::DBF6;
+    return encode_options;
+}
+
+TreeFileOptions file_options_of(const EncodeCliOptions& options) {
+    TreeFileOptions file_options;
+    file_options.encode = encode_options_of(options);
+    file_options.lods = options.lods;
+    file_options.coder = parse_coder(options.coder);
+    return file_options;
+}
+
+bool has_extension(const fs::path& path, const std::string& extension) {
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return ext == extension;
+}
+
+// A skeleton PLY, or the main skeleton of a lobe-based tree (.tlobe).
+TreeGraph read_tree_input(const fs::path& path) {
+    if (has_extension(path, ".tlobe")) return lobes::read_tlobe(path).skeleton;
+    return read_skeleton_ply(path);
+}
+
+nlohmann::json lod_stats_json(const StoredTree& tree, const std::vector<StreamSizes>& sizes) {
+    nlohmann::json lods = nlohmann::json::array();
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+        nlohmann::json lod = {{"lod", k},
+                              {"threshold", k ? tree.thresholds[k - 1] : 0},
+                              {"symbol_bytes", sizes[k].symbols},
+                              {"radii_bytes", sizes[k].radii}};
+        if (!tree.lods[k].radii.empty() || sizes[k].internodes) {  // counts only for LODs that were decoded
+            lod["internodes"] = sizes[k].internodes;
+            lod["code_length"] = sizes[k].code_length;
+        }
+        lods.push_back(lod);
+    }
+    return lods;
+}
+
+void print_lod_stats(const StoredTree& tree, const std::vector<StreamSizes>& sizes) {
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+        std::cout << "  LOD " << k;
+        if (k) std::cout << " (threshold " << tree.thresholds[k - 1] << ")";
+        std::cout << ": ";
+        if (!tree.lods[k].radii.empty() || sizes[k].internodes)
+            std::cout << sizes[k].internodes << " internodes, " << sizes[k].code_length << " symbols -> ";
+        std::cout << sizes[k].symbols << " + " << sizes[k].radii << " bytes (symbols + radii)\n";
+    }
+}
+
+int run_encode_file(const EncodeCliOptions& options, const GlobalOptions& global) {
+    const TreeGraph tree = read_tree_input(options.skeleton);
+    const StoredTree stored = store_tree(tree, file_options_of(options), options.skeleton);
+    std::vector<StreamSizes> sizes;
+    const std::vector<std::uint8_t> bytes = write_tree_file_bytes(stored, &sizes);
+    write_file_atomically(options.out, std::string(bytes.begin(), bytes.end()));
+    const std::size_t internodes = stored.lods[0].radii.size();
+    const std::size_t raw = 16 * internodes;  // seed 000 Table 5: 16 bytes per internode
+    if (global.json) {
+        nlohmann::json j = {{"treelobes", kVersion},
+                            {"input", options.skeleton},
+                            {"out", options.out},
+                            {"kind", code_kind_name(stored.kind)},
+                            {"coder", coder_name(stored.coder)},
+                            {"resolution", stored.resolution},
+                            {"internode_length", stored.internode_length},
+                            {"radius_unit", stored.radius_unit},
+                            {"root_radius", stored.root_radius},
+                            {"internodes", internodes},
+                            {"file_bytes", bytes.size()},
+                            {"raw_bytes", raw}};
+        if (options.stats) j["lods"] = lod_stats_json(stored, sizes);
+        std::cout << j.dump(2) << "\n";
+        return 0;
+    }
+    std::cout << "wrote " << options.out << ": " << bytes.size() << " bytes for " << internodes << " internodes ("
+              << coder_name(stored.coder) << " coder, " << stored.lods.size() << " LOD" << (stored.lods.size() > 1 ? "s" : "")
+              << ", " << static_cast<double>(raw) / static_cast<double>(bytes.size()) << "x smaller than 16 bytes per internode)\n";
+    if (options.stats) print_lod_stats(stored, sizes);
+    return 0;
+}
+
+// Trees of a forest: every skeleton PLY / .tlobe in a directory (sorted by name), or a list file
+// with one tree per line: `PATH [X Y Z [AZIMUTH_DEGREES]]` (relative paths from the list's folder,
+// # comments). Without a position a tree stands where its skeleton's root is.
+std::vector<ForestTree> read_forest_input(const fs::path& input) {
+    struct Item {
+        fs::path path;
+        bool placed = false;
+        Eigen::Vector3d position{0, 0, 0};
+        double azimuth_degrees = 0.0;
+    };
+    std::vector<Item> items;
+    if (fs::is_directory(input)) {
+        for (const auto& entry : fs::directory_iterator(input))
+            if (entry.is_regular_file() && (has_extension(entry.path(), ".ply") || has_extension(entry.path(), ".tlobe")))
+                items.push_back({entry.path()});
+        std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.path < b.path; });
+        if (items.empty()) throw Error::input(input.string(), "no skeleton .ply or .tlobe files in the directory");
+    } else {
+        std::istringstream list(read_file(input));
+        std::string line;
+        for (int number = 1; std::getline(list, line); ++number) {
+            const auto hash = line.find('#');
+            if (hash != std::string::npos) line.erase(hash);
+            std::istringstream fields(line);
+            std::vector<std::string> tokens;
+            for (std::string token; fields >> token;) tokens.push_back(token);
+            if (tokens.empty()) continue;
+            const std::string where = "line " + std::to_string(number);
+            if (tokens.size() != 1 && tokens.size() != 4 && tokens.size() != 5)
+                throw Error::input(input.string(), where + ": expected PATH [X Y Z [AZIMUTH_DEGREES]]");
+            Item item{fs::path(tokens[0]).is_absolute() ? fs::path(tokens[0]) : input.parent_path() / tokens[0]};
+            std::vector<double> numbers;
+            for (std::size_t t = 1; t < tokens.size(); ++t) {
+                double value = 0.0;
+                const auto [end, error] = std::from_chars(tokens[t].data(), tokens[t].data() + tokens[t].size(), value);
+                if (error != std::errc() || end != tokens[t].data() + tokens[t].size() || !std::isfinite(value))
+                    throw Error::input(input.string(), where + ": '" + tokens[t] + "' is not a finite number");
+                numbers.push_back(value);
+            }
+            if (numbers.size() >= 3) {
+                item.placed = true;
+                item.position = {numbers[0], numbers[1], numbers[2]};
+            }
+            if (numbers.size() == 4) item.azimuth_degrees = numbers[3];
+            items.push_back(item);
+        }
+        if (items.empty()) throw Error::input(input.string(), "the tree list names no trees");
+    }
+    std::vector<ForestTree> trees;
+    for (const Item& item : items) {
+        ForestTree tree;
+        tree.skeleton = read_tree_input(item.path);
+        tree.skeleton.validate(item.path.string());
+        tree.name = item.path.stem().string();
+        // Store the tree in its own frame with the root at 0; its placement goes to the index.
+        const Eigen::Vector3d root = tree.skeleton.origin + tree.skeleton.nodes[0].position.cast<double>();
+        tree.skeleton.origin = -tree.skeleton.nodes[0].position.cast<double>();
+        tree.position = item.placed ? item.position : root;
+        tree.azimuth = static_cast<float>(item.azimuth_degrees * M_PI / 180.0);
+        trees.push_back(std::move(tree));
+    }
+    return trees;
+}
+
+int run_encode_forest(const EncodeCliOptions& options, const GlobalOptions& global) {
+    const std::vector<ForestTree> trees = read_forest_input(options.forest);
+    ForestStats stats;
+    const std::vector<std::uint8_t> bytes = write_forest_bytes(trees, file_options_of(options), &stats);
+    write_file_atomically(options.out, std::string(bytes.begin(), bytes.end()));
+    std::size_t internodes = 0;
+    for (const auto& tree : stats.trees) internodes += tree.empty() ? 0 : tree[0].internodes;
+    if (global.json) {
+        nlohmann::json j = {{"treelobes", kVersion},   {"input", options.forest},         {"out", options.out},
+                            {"trees", trees.size()},     {"internodes", internodes},        {"file_bytes", bytes.size()},
+                            {"raw_bytes", 16 * internodes}, {"index_bytes", stats.header_and_index},
+                            {"coder", options.coder},    {"lods", options.lods},            {"resolution", options.resolution}};
+        if (options.stats) {
+            j["tree_stats"] = nlohmann::json::array();
+            for (std::size_t i = 0; i < trees.size(); ++i) {
+                nlohmann::json lods = nlohmann::json::array();
+                for (std::size_t k = 0; k < stats.trees[i].size(); ++k)
+                    lods.push_back({{"lod", k},
+                                    {"internodes", stats.trees[i][k].internodes},
+                                    {"symbol_bytes", stats.trees[i][k].symbols},
+                                    {"radii_bytes", stats.trees[i][k].radii}});
+                j["tree_stats"].push_back({{"name", trees[i].name}, {"lods", lods}});
+            }
+        }
+        std::cout << j.dump(2) << "\n";
+        return 0;
+    }
+    std::cout << "wrote " << options.out << ": " << trees.size() << " trees, " << internodes << " internodes, "
+              << bytes.size() << " bytes (header and index " << stats.header_and_index << ")\n";
+    if (options.stats)
+        for (std::size_t i = 0; i < trees.size(); ++i) {
+            std::size_t total = 0;
+            for (const StreamSizes& s : stats.trees[i]) total += s.symbols + s.radii;
+            std::cout << "  " << i << " " << trees[i].name << ": " << stats.trees[i][0].internodes << " internodes, "
+                      << total << " bytes of streams\n";
+        }
+    return 0;
+}
+
+int run_encode(const EncodeCliOptions& options, const GlobalOptions& global) {
+    if (!options.forest.empty()) return run_encode_forest(options, global);
+    if (!options.out.empty()) return run_encode_file(options, global);
+    const TreeGraph tree = read_tree_input(options.skeleton);
+    const EncodeOptions encode_options = encode_options_of(options);
     const EncodedTree encoded = encode_tree(tree, encode_options, options.skeleton);
 
     const SymbolCounts counts = count_symbols(encoded.code.symbols);
@@ -216,22 +430,150 @@ int run_decode(const DecodeCliOptions& options, const GlobalOptions& global) {
     return 0;
 }
 
+bool is_forest_file(const fs::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    char magic[4] = {};
+    file.read(magic, 4);
+    return file.gcount() == 4 && std::string(magic, 4) == "DBFF";
+}
+
+void write_tree_output(const TreeGraph& tree, const fs::path& out, bool ascii) { write_skeleton_ply(tree, out, !ascii); }
+
+int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& global) {
+    ForestReader forest{fs::path(options.input)};
+    std::vector<std::size_t> selected;
+    if (options.tree >= 0) {
+        forest.entry(static_cast<std::size_t>(options.tree));  // usage error when out of range
+        selected.push_back(static_cast<std::size_t>(options.tree));
+    } else {
+        for (std::size_t i = 0; i < forest.size(); ++i) selected.push_back(i);
+    }
+    // Everything is decoded before anything is written: a damaged tree leaves no partial output.
+    std::vector<TreeGraph> trees;
+    nlohmann::json written = nlohmann::json::array();
+    std::size_t internodes = 0;
+    for (std::size_t i : selected) {
+        std::vector<StreamSizes> sizes;
+        const StoredTree stored = forest.read(i, options.lod, &sizes);
+        trees.push_back(place_tree(decode_stored_tree(stored, options.lod, options.input + ": tree " + std::to_string(i)),
+                                   forest.entry(i)));
+        internodes += sizes[static_cast<std::size_t>(options.lod)].internodes;
+        nlohmann::json item = {{"tree", i}, {"name", forest.entry(i).name}, {"nodes", trees.back().size()}};
+        if (options.stats) item["lods"] = lod_stats_json(stored, sizes);
+        written.push_back(item);
+    }
+    if (options.tree >= 0) {
+        write_tree_output(trees[0], options.out, options.ascii);
+        written[0]["out"] = options.out;
+    } else {
+        // One skeleton PLY per tree in the --out directory, named by index and tree name.
+        fs::create_directories(options.out);
+        for (std::size_t k = 0; k < selected.size(); ++k) {
+            char prefix[16];
+            std::snprintf(prefix, sizeof prefix, "%05zu", selected[k]);
+            const std::string name = forest.entry(selected[k]).name;
+            const fs::path out = fs::path(options.out) / (std::string(prefix) + (name.empty() ? "" : "_" + name) + ".ply");
+            write_tree_output(trees[k], out, options.ascii);
+            written[k]["out"] = out.string();
+        }
+    }
+    if (global.json) {
+        std::cout << nlohmann::json{{"treelobes", kVersion}, {"input", options.input}, {"trees_in_file", forest.size()},
+                                    {"lod", options.lod},    {"internodes", internodes},  {"decoded", written}}
+                         .dump(2)
+                  << "\n";
+        return 0;
+    }
+    std::cout << "decoded " << selected.size() << " of " << forest.size() << " trees (LOD " << options.lod << ", "
+              << internodes << " internodes) from " << options.input << " into " << options.out << "\n";
+    return 0;
+}
+
+int run_decode_file(const DecodeFileCliOptions& options, const GlobalOptions& global) {
+    if (options.lod < 0) throw Error::usage("--lod must be 0 or more");
+    if (is_forest_file(options.input)) return run_decode_forest(options, global);
+    if (options.tree >= 0) throw Error::usage("--tree applies to .forest files; " + options.input + " holds one tree");
+    std::vector<StreamSizes> sizes;
+    const StoredTree stored = read_tree_file(options.input, options.lod, &sizes);
+    const TreeGraph tree = decode_stored_tree(stored, options.lod, options.input);
+    write_tree_output(tree, options.out, options.ascii);
+    const StreamSizes& level = sizes[static_cast<std::size_t>(options.lod)];
+    if (global.json) {
+        nlohmann::json j = {{"treelobes", kVersion},
+                            {"input", options.input},
+                            {"kind", code_kind_name(stored.kind)},
+                            {"coder", coder_name(stored.coder)},
+                            {"lods_in_file", stored.lods.size()},
+                            {"lod", options.lod},
+                            {"internodes", level.internodes},
+                            {"nodes", tree.size()},
+                            {"tips", tree.tip_count()},
+                            {"out", options.out}};
+        if (options.stats) j["lods"] = lod_stats_json(stored, sizes);
+        std::cout << j.dump(2) << "\n";
+        return 0;
+    }
+    std::cout << "decoded LOD " << options.lod << " of " << stored.lods.size() << " (" << level.internodes << " internodes, "
+              << coder_name(stored.coder) << " coder): " << tree.size() << " nodes, " << tree.tip_count() << " tips; wrote "
+              << options.out << "\n";
+    if (options.stats) print_lod_stats(stored, sizes);
+    return 0;
+}
+
 void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<EncodeCliOptions>();
-    CLI::App* sub = app.add_subcommand("encode", "Encode a skeleton PLY as an F6/DBF6 chain code and radius list (seed 000)");
-    sub->add_option("skeleton", options->skeleton, "Skeleton PLY (vertex 0 is the root)")->required();
+    CLI::App* sub = app.add_subcommand(
+        "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (seed 000); with --out, compress it into "
+                  "a .dbf6 file, or many trees (--forest) into a .forest file");
+    auto* skeleton = sub->add_option("skeleton", options->skeleton, "Skeleton PLY (vertex 0 is the root) or .tlobe");
+    auto* forest = sub->add_option("--forest", options->forest,
+                                   "Directory of skeleton PLY/.tlobe files, or a list file with lines PATH [X Y Z [AZIMUTH_DEG]]");
+    skeleton->excludes(forest);
+    forest->excludes(skeleton);
+    auto* out = sub->add_option("--out", options->out, "Output .dbf6 file (one tree) or .forest file (--forest)");
     sub->add_option("--resolution", options->resolution, "Voxels per internode length (r of Eq. 2)")
         ->required()
         ->check(CLI::PositiveNumber);
     sub->add_option("--internode-length", options->internode_length,
-                    "Internode length l in metres, or 'auto' for the median edge length")
+                    "Internode length l in metres, or 'auto' for the median edge length (per tree)")
         ->capture_default_str();
     sub->add_option("--radius-unit", options->radius_unit, "Metres per radius step of the radius list")
         ->capture_default_str()
         ->check(CLI::PositiveNumber);
     sub->add_flag("--f6", options->f6, "Plain F6 code instead of the differential DBF6");
-    sub->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_encode(*options, global); }; });
+    auto* print = sub->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
+    auto* lods = sub->add_option("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
+                     ->capture_default_str()
+                     ->check(CLI::Range(1, kMaxLods));
+    auto* coder = sub->add_option("--coder", options->coder, "Compression: ic (seed 000 §3.3) or best")
+                      ->capture_default_str()
+                      ->check(CLI::IsMember({"ic", "best"}));
+    sub->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");
+    print->excludes(out);
+    sub->callback([options, skeleton, forest, out, lods, coder, &global, &job] {
+        if (skeleton->count() == 0 && forest->count() == 0) throw CLI::RequiredError("skeleton or --forest");
+        if (forest->count() && out->count() == 0) throw CLI::RequiredError("--out (with --forest)");
+        if (out->count() == 0 && (lods->count() || coder->count()))
+            throw CLI::ValidationError("--lods/--coder", "apply to files: give --out");
+        job = [options, &global] { return run_encode(*options, global); };
+    });
+}
+
+void add_decode(CLI::App& app, const GlobalOptions& global, Job& job) {
+    auto options = std::make_shared<DecodeFileCliOptions>();
+    CLI::App* sub = app.add_subcommand("decode", "Decode a .dbf6 tree or .forest trees into skeleton PLY files");
+    sub->add_option("input", options->input, "A .dbf6 or .forest file")->required();
+    sub->add_option("--lod", options->lod, "Level of detail to decode (0 = full detail)")
+        ->capture_default_str()
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--tree", options->tree, "Forest files: decode only tree I (0-based) into the --out PLY")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--out", options->out,
+                    "Output skeleton PLY; for a whole forest (no --tree) a directory receiving one PLY per tree")
+        ->required();
+    sub->add_flag("--ascii", options->ascii, "Write ASCII PLY instead of binary");
+    sub->add_flag("--stats", options->stats, "Report the size of every stream");
+    sub->callback([options, &global, &job] { job = [options, &global] { return run_decode_file(*options, global); }; });
 }
 
 void add_lod(CLI::App& app, const GlobalOptions& global, Job& job) {
@@ -278,6 +620,7 @@ void add_decode_code(CLI::App& app, const GlobalOptions& global, Job& job) {
 
 void add_encode_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     add_encode(app, global, job);
+    add_decode(app, global, job);
     add_lod(app, global, job);
     add_decode_code(app, global, job);
 }

@@ -20,7 +20,13 @@ struct GlobalOptions {
 using Job = std::function<int()>;  // returns the process exit code
 
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_reconstruct_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_encode_commands(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job);
 
 }  // namespace treelobes::cli

@@ -34,8 +34,14 @@ int run(int argc, char** argv) {
 
     cli::Job job;
     cli::add_info_command(app, global, job);
+    cli::add_multires_command(app, global, job);
+    cli::add_reconstruct_command(app, global, job);
+    cli::add_eval_command(app, global, job);
     cli::add_encode_commands(app, global, job);
     cli::add_render_command(app, global, job);
+    cli::add_synth_command(app, global, job);
+    cli::add_classify_command(app, global, job);
+    cli::add_lobes_commands(app, global, job);
 
     try {
         app.parse(argc, argv);

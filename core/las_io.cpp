@@ -24,6 +24,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -897,9 +898,21 @@ PointStats point_stats(const PointCloud& cloud, const WritePlan& plan) {
     return stats;
 }
 
+// The header's creation date is today's, unless SOURCE_DATE_EPOCH (the reproducible-builds
+// convention: seconds since 1970 UTC) pins it, so that regenerated files are byte-identical.
+std::chrono::sys_days creation_date() {
+    using namespace std::chrono;
+    if (const char* epoch = std::getenv("SOURCE_DATE_EPOCH")) {
+        char* end = nullptr;
+        const long long seconds = std::strtoll(epoch, &end, 10);
+        if (end != epoch && *end == '\0' && seconds >= 0) return floor<days>(sys_seconds{std::chrono::seconds{seconds}});
+    }
+    return floor<days>(system_clock::now());
+}
+
 std::pair<std::uint16_t, std::uint16_t> creation_day_and_year() {
     using namespace std::chrono;
-    const sys_days today = floor<days>(system_clock::now());
+    const sys_days today = creation_date();
     const year_month_day date{today};
     const sys_days january_first{date.year() / January / 1};
     return {static_cast<std::uint16_t>((today - january_first).count() + 1), static_cast<std::uint16_t>(int(date.year()))};

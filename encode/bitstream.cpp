@@ -42,8 +42,6 @@ std::uint64_t BitReader::read(unsigned count) {
     return value;
 }
 
-unsigned bit_width64(std::uint64_t v) { return static_cast<unsigned>(std::bit_width(v)); }
-
 void write_elias_gamma(BitWriter& out, std::uint64_t v) {
     if (v == 0) throw Error(ExitCode::Internal, "Elias gamma code of 0");
     const unsigned width = bit_width64(v);

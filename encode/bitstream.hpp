@@ -7,6 +7,7 @@
 // coding uses for a value in a known range.
 #pragma once
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -51,7 +52,7 @@ private:
 };
 
 // Number of bits of the binary representation of v (0 for v = 0).
-unsigned bit_width64(std::uint64_t v);
+inline unsigned bit_width64(std::uint64_t v) { return static_cast<unsigned>(std::bit_width(v)); }  // inline: hot in the coders
 
 // Elias gamma code of v >= 1: floor(log2 v) zeros, then v in binary.
 void write_elias_gamma(BitWriter& out, std::uint64_t v);

@@ -31,22 +31,22 @@ void check_code_for_coding(const ChainCode& code, const std::string& context) {
                                         std::to_string(internodes) + " internodes");
 }
 
-CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::string& context) {
+CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::string& context, const BestPrior* prior) {
     check_code_for_coding(code, context);
     if (coder == Coder::Interpolative) return {ic_encode_symbols(code.symbols), ic_encode_radii(code.symbols, code.radii)};
-    return {best_encode_symbols(code.symbols), best_encode_radii(code.symbols, code.radii)};
+    return {best_encode_symbols(code.symbols, prior), best_encode_radii(code.symbols, code.radii, prior)};
 }
 
 ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
-                         CodeKind kind, const std::string& context) {
+                         CodeKind kind, const std::string& context, const BestPrior* prior) {
     ChainCode code;
     code.kind = kind;
     if (coder == Coder::Interpolative) {
         code.symbols = ic_decode_symbols(symbols, context + " (symbols)");
         code.radii = ic_decode_radii(radii, code.symbols, context + " (radii)");
     } else if (coder == Coder::Best) {
-        code.symbols = best_decode_symbols(symbols, context + " (symbols)");
-        code.radii = best_decode_radii(radii, code.symbols, context + " (radii)");
+        code = best_decode_code(symbols, radii, context + " (symbols)", context + " (radii)", prior);
+        code.kind = kind;
     } else {
         throw Error::input(context, "unknown coder " + std::to_string(static_cast<int>(coder)));
     }

@@ -16,7 +16,7 @@ namespace treelobes::encode {
 
 enum class Coder : std::uint8_t {
     Interpolative = 1,  // `ic`: BWT, MTF, cumulative sum, binary interpolative coding (§3.3)
-    Best = 2,           // `best`: context-modelled binary arithmetic coding (docs/compression.md)
+    Best = 2,           // `best`: context-modelled binary arithmetic coding (docs/dbf6.md)
 };
 const char* coder_name(Coder coder);
 // "ic" or "best"; throws Error(Usage) otherwise.
@@ -35,10 +35,14 @@ inline constexpr std::size_t kMaxCodeSymbols = std::size_t{1} << 28;
 // differs from the number of internodes (6, 7 and 8).
 void check_code_for_coding(const ChainCode& code, const std::string& context);
 
-CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::string& context = "chain code");
+class BestPrior;  // coder_best.hpp: initial model state shared by the trees of a forest
+
+// `prior` (Best only; nullptr = uniform start) must be the same for encoding and decoding.
+CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::string& context = "chain code",
+                            const BestPrior* prior = nullptr);
 // Inverse of encode_streams; `kind` is carried by the container. Throws Error(InvalidInput)
 // naming `context` for any corrupt or truncated stream.
 ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
-                         CodeKind kind, const std::string& context = "chain code");
+                         CodeKind kind, const std::string& context = "chain code", const BestPrior* prior = nullptr);
 
 }  // namespace treelobes::encode

@@ -2,7 +2,10 @@
 
 #include "core/error.hpp"
 #include "encode/bitstream.hpp"
+#include "encode/coder_ic.hpp"
 #include "encode/range_coder.hpp"
+
+#include <zlib.h>
 
 #include <algorithm>
 #include <array>
@@ -104,10 +107,10 @@ constexpr int kNormBuckets = 12;   // |moves| already coded on earlier axes, cla
 struct SymbolModels {
     std::array<UIntModel, 3 * kParentBuckets * kNormBuckets> start_axis;
     std::array<BitModel, 3 * kParentBuckets> start_sign;
-    std::array<BitModel, 4 * 4 * 4> correction_nonzero;
-    std::array<UIntModel, 3 * 3 * 4> correction_axis;
-    std::array<BitModel, 3 * 3 * 3> correction_sign;
-    std::array<BitModel, 2 * 8 * 4 * 2> is_end_of_internode, is_fork;
+    std::array<BitModel, 2 * 4 * 4 * 4> correction_nonzero;
+    std::array<UIntModel, 2 * 3 * 3 * 4> correction_axis;
+    std::array<BitModel, 2 * 3 * 3 * 3> correction_sign;
+    std::array<BitModel, 2 * 4 * 8 * 4 * 2> is_end_of_internode, is_fork;
 };
 
 // Replays the traversal queue of Pseudocode 1 on the coded internodes (identically in encoder and
@@ -118,6 +121,7 @@ public:
     Voxel chain_direction = Voxel::Zero();  // Δv of the previous internode of the branch
     Voxel parent_direction = Voxel::Zero(); // at a start: Δv of the internode that forked it off
     int since_start = 0;
+    int since_fork = 0;                // internodes since the branch's last fork (or its start)
     int order = 0;                     // branch order (0 trunk)
     unsigned recent_corrections = 0;   // were the last two corrections non-zero (2 bits)
     std::array<int, 3> last_sign{0, 0, 0};  // sign of the last non-zero correction per axis
@@ -139,6 +143,7 @@ public:
             start = false;
             chain_direction = move;
             ++since_start;
+            since_fork = terminator == kFork ? 0 : since_fork + 1;
         }
     }
 
@@ -150,6 +155,7 @@ private:
     void begin_branch() {
         start = true;
         since_start = 0;
+        since_fork = 0;
         recent_corrections = 0;
         last_sign = {0, 0, 0};
         chain_direction = Voxel::Zero();
@@ -184,19 +190,23 @@ Voxel code_vector(IO& io, SymbolModels& m, const ChainWalker& w, Voxel v, std::u
         return v;
     }
     const int since = std::min(w.since_start, 3), order = std::min(w.order, 3);
-    if (!io.bit(m.correction_nonzero[(w.recent_corrections * 4 + since) * 4 + order], !v.isZero())) return Voxel::Zero();
+    // A branch bends where it forks: a correction right after a fork is more likely and larger.
+    const int after_fork = w.since_fork == 0 ? 1 : 0;
+    if (!io.bit(m.correction_nonzero[((after_fork * 4 + w.recent_corrections) * 4 + since) * 4 + order], !v.isZero()))
+        return Voxel::Zero();
     int nonzero_axes = 0;
     for (int a = 0; a < 3; ++a) {
         const bool implied = a == 2 && nonzero_axes == 0;  // a non-zero correction needs one axis
         const int direction = static_cast<int>(std::min<std::int64_t>(std::abs(w.chain_direction[a]), 3));
         const std::uint64_t magnitude =
-            code_uint(io, m.correction_axis[(a * 3 + nonzero_axes) * 4 + direction],
+            code_uint(io, m.correction_axis[((after_fork * 3 + a) * 3 + nonzero_axes) * 4 + direction],
                       static_cast<std::uint64_t>(std::abs(v[a])) - (IO::kEncoding && implied ? 1 : 0)) + (implied ? 1 : 0);
         spend(magnitude);
         bool negative = false;
         if (magnitude != 0) {
             ++nonzero_axes;
-            negative = io.bit(m.correction_sign[(a * 3 + w.last_sign[a] + 1) * 3 + sign_of(w.chain_direction[a]) + 1], v[a] < 0);
+            negative = io.bit(m.correction_sign[((after_fork * 3 + a) * 3 + w.last_sign[a] + 1) * 3 + sign_of(w.chain_direction[a]) + 1],
+                              v[a] < 0);
         }
         v[a] = negative ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
     }
@@ -205,7 +215,9 @@ Voxel code_vector(IO& io, SymbolModels& m, const ChainWalker& w, Voxel v, std::u
 
 template <class IO>
 char code_terminator(IO& io, SymbolModels& m, const ChainWalker& w, bool moved, char terminator) {
-    const int ctx = ((int(w.start) * 8 + std::min(w.since_start, 7)) * 4 + std::min(w.order, 3)) * 2 + int(moved);
+    // Forks come at fairly regular spacings along a branch: the distance to the last one matters.
+    const int ctx = (((int(w.start) * 4 + std::min(w.since_start, 3)) * 8 + std::min(w.since_fork, 7)) * 4 + std::min(w.order, 3)) * 2 +
+                    int(moved);
     if (io.bit(m.is_end_of_internode[ctx], terminator == kEndOfInternode)) return kEndOfInternode;
     return io.bit(m.is_fork[ctx], terminator == kFork) ? kFork : kTip;
 }
@@ -243,7 +255,8 @@ std::uint8_t code_generic_symbol(IO& io, GenericModels& m, unsigned context, std
     return static_cast<std::uint8_t>(value);
 }
 
-enum SymbolMode : std::uint8_t { kGeneric = 0, kCanonical = 1 };
+// kInterpolative: the `ic` stream, kept when it is smaller (short or irregular codes).
+enum SymbolMode : std::uint8_t { kGeneric = 0, kCanonical = 1, kInterpolativeSymbols = 2 };
 
 // ---- Radii ------------------------------------------------------------------------------------
 
@@ -256,21 +269,22 @@ struct Topology {
     std::vector<char> terminator;
 };
 
-Topology parse_topology(const std::string& symbols) {
+// The topology from the terminators of the internodes in code order.
+Topology topology_of(std::span<const char> terminators) {
     Topology t;
-    std::deque<int> forks;
+    t.parent.reserve(terminators.size());
+    t.start.reserve(terminators.size());
+    t.terminator.assign(terminators.begin(), terminators.end());
+    std::vector<int> forks;  // a FIFO queue: forks[next_fork..] are still waiting for their lateral
+    std::size_t next_fork = 0;
     bool start = true;
-    for (char c : symbols) {
-        if (!is_terminator(c)) continue;
-        const int index = static_cast<int>(t.parent.size());
+    for (std::size_t i = 0; i < terminators.size(); ++i) {
+        const char c = terminators[i];
+        const int index = static_cast<int>(i);
         int parent = index - 1;
-        if (start && index > 0) {
-            parent = forks.empty() ? -1 : forks.front();
-            if (!forks.empty()) forks.pop_front();
-        }
+        if (start && index > 0) parent = next_fork < forks.size() ? forks[next_fork++] : -1;
         t.parent.push_back(index == 0 ? -1 : parent);
         t.start.push_back(start);
-        t.terminator.push_back(c);
         if (c == kFork) forks.push_back(index);
         start = c == kTip;
     }
@@ -282,7 +296,18 @@ Topology parse_topology(const std::string& symbols) {
     return t;
 }
 
-enum RadiusPredictor : std::uint8_t { kParentRadius = 0, kPipeModel = 1 };
+std::vector<char> terminators_of(const std::string& symbols) {
+    std::vector<char> terminators;
+    for (char c : symbols)
+        if (is_terminator(c)) terminators.push_back(c);
+    return terminators;
+}
+
+Topology parse_topology(const std::string& symbols) { return topology_of(terminators_of(symbols)); }
+
+// kInterpolativeRadii: the `ic` radii stream, kept when it is smaller (very smooth radii, e.g.
+// allometric radii of reconstructions, where interpolative coding codes runs of equal gaps in 0 bits).
+enum RadiusPredictor : std::uint8_t { kParentRadius = 0, kPipeModel = 1, kInterpolativeRadii = 2 };
 
 std::uint64_t isqrt(std::uint64_t x) {
     auto r = static_cast<std::uint64_t>(std::sqrt(static_cast<double>(x)));
@@ -313,8 +338,7 @@ int terminator_index(char c) { return c == kEndOfInternode ? 0 : c == kFork ? 1 
 int residual_bucket(std::int64_t e) { return e == 0 ? 0 : (std::abs(e) <= 2 ? 1 : 2); }
 
 template <class IO>
-void code_radii(IO& io, const Topology& t, std::span<int> radii, RadiusPredictor predictor) {
-    auto models = std::make_unique<RadiusModels>();
+void code_radii(IO& io, const Topology& t, std::span<int> radii, RadiusPredictor predictor, RadiusModels* models) {
     std::vector<std::int64_t> residuals(radii.size(), 0);
     for (std::size_t i = 0; i < radii.size(); ++i) {
         const std::int64_t predicted = predict_radius(t, radii, i, predictor);
@@ -334,32 +358,124 @@ void code_radii(IO& io, const Topology& t, std::span<int> radii, RadiusPredictor
     }
 }
 
-std::vector<std::uint8_t> encode_radii_with(const Topology& t, std::span<const int> radii, RadiusPredictor predictor) {
+std::vector<std::uint8_t> encode_radii_with(const Topology& t, std::span<const int> radii, RadiusPredictor predictor,
+                                            const RadiusModels& initial) {
     Encoding io;
     std::vector<int> copy(radii.begin(), radii.end());
-    code_radii(io, t, copy, predictor);
+    auto models = std::make_unique<RadiusModels>(initial);
+    code_radii(io, t, copy, predictor, models.get());
     std::vector<std::uint8_t> out{predictor};
     const std::vector<std::uint8_t> payload = io.rc.finish();
     out.insert(out.end(), payload.begin(), payload.end());
     return out;
 }
 
+// Codes the internodes of a canonical code with `models` (encoder side; also trains priors).
+void encode_canonical(Encoding& io, SymbolModels& models, const std::vector<std::pair<Voxel, char>>& internodes,
+                      std::size_t symbol_count) {
+    ChainWalker walker;
+    for (const auto& [vector, terminator] : internodes) {
+        code_vector(io, models, walker, vector, symbol_count);
+        code_terminator(io, models, walker, !vector.isZero(), terminator);
+        walker.advance(vector, terminator);
+    }
+}
+
+// Prior confidence: a trained model counts as this many observations, so each tree still moves
+// it at rate ~1/(kPriorConfidence + 1.5) at first.
+constexpr std::uint8_t kPriorConfidence = 16;
+
 }  // namespace
 
-std::vector<std::uint8_t> best_encode_symbols(const std::string& symbols) {
+struct BestPrior::State {
+    SymbolModels symbols;
+    RadiusModels radii;
+};
+
+namespace {
+
+// The state is a plain array of BitModels (every model struct is arrays of them).
+static_assert(sizeof(BitModel) == 4 && sizeof(BestPrior::State) % sizeof(BitModel) == 0);
+static_assert(std::is_trivially_copyable_v<BestPrior::State>);
+constexpr std::size_t kPriorModels = sizeof(BestPrior::State) / sizeof(BitModel);
+
+BitModel* models_of(BestPrior::State& state) { return reinterpret_cast<BitModel*>(&state); }
+
+std::unique_ptr<SymbolModels> symbol_models(const BestPrior* prior) {
+    return prior ? std::make_unique<SymbolModels>(prior->state().symbols) : std::make_unique<SymbolModels>();
+}
+
+}  // namespace
+
+BestPrior::BestPrior() : state_(std::make_unique<State>()) {}
+BestPrior::~BestPrior() = default;
+BestPrior::BestPrior(BestPrior&&) noexcept = default;
+BestPrior& BestPrior::operator=(BestPrior&&) noexcept = default;
+
+BestPrior BestPrior::train(const std::vector<const ChainCode*>& codes) {
+    BestPrior prior;
+    for (const ChainCode* code : codes) {
+        std::vector<std::pair<Voxel, char>> internodes;
+        if (!canonical_internodes(code->symbols, internodes)) continue;
+        Encoding symbols_io;
+        encode_canonical(symbols_io, prior.state_->symbols, internodes, code->symbols.size());
+        const Topology topology = parse_topology(code->symbols);
+        if (topology.parent.size() != code->radii.size() || code->radii.empty()) continue;
+        Encoding radii_io;
+        std::vector<int> copy = code->radii;
+        code_radii(radii_io, topology, copy, kParentRadius, &prior.state_->radii);
+    }
+    BitModel* m = models_of(*prior.state_);
+    for (std::size_t i = 0; i < kPriorModels; ++i) m[i].seen = std::min(m[i].seen, kPriorConfidence);
+    const std::vector<std::uint8_t> bytes = prior.serialize();
+    return deserialize(bytes, "trained prior");
+}
+
+// Layout: model count (u32 LE), then zlib of the high byte of every p0 followed by every `seen`.
+std::vector<std::uint8_t> BestPrior::serialize() const {
+    const BitModel* m = models_of(*state_);
+    std::vector<std::uint8_t> raw(2 * kPriorModels);
+    for (std::size_t i = 0; i < kPriorModels; ++i) {
+        raw[i] = static_cast<std::uint8_t>(m[i].p0 >> 8);
+        raw[kPriorModels + i] = m[i].seen;
+    }
+    uLongf size = compressBound(static_cast<uLong>(raw.size()));
+    std::vector<std::uint8_t> out(4 + size);
+    for (int b = 0; b < 4; ++b) out[static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(kPriorModels >> (8 * b));
+    if (compress2(out.data() + 4, &size, raw.data(), static_cast<uLong>(raw.size()), 9) != Z_OK)
+        throw Error(ExitCode::Internal, "prior: zlib compression failed");
+    out.resize(4 + size);
+    return out;
+}
+
+BestPrior BestPrior::deserialize(std::span<const std::uint8_t> bytes, const std::string& context) {
+    if (bytes.size() < 4) throw Error::input(context, "truncated model prior");
+    std::uint32_t count = 0;
+    for (int b = 0; b < 4; ++b) count |= static_cast<std::uint32_t>(bytes[static_cast<std::size_t>(b)]) << (8 * b);
+    if (count != kPriorModels) throw Error::input(context, "model prior of " + std::to_string(count) + " models (this build has " +
+                                                               std::to_string(kPriorModels) + ")");
+    std::vector<std::uint8_t> raw(2 * kPriorModels);
+    uLongf size = static_cast<uLongf>(raw.size());
+    if (uncompress(raw.data(), &size, bytes.data() + 4, static_cast<uLong>(bytes.size() - 4)) != Z_OK || size != raw.size())
+        throw Error::input(context, "corrupt model prior");
+    BestPrior prior;
+    BitModel* m = models_of(*prior.state_);
+    for (std::size_t i = 0; i < kPriorModels; ++i) {
+        // Centre of the quantization step, kept inside the range update() maintains.
+        m[i].p0 = static_cast<std::uint16_t>(std::clamp((raw[i] << 8) + 128, 64, 65535 - 64));
+        m[i].seen = std::min<std::uint8_t>(raw[kPriorModels + i], BitModel::kLimit);
+    }
+    return prior;
+}
+
+std::vector<std::uint8_t> best_encode_symbols(const std::string& symbols, const BestPrior* prior) {
     std::vector<std::uint8_t> out;
     write_varint(out, symbols.size());
     std::vector<std::pair<Voxel, char>> internodes;
     Encoding io;
     if (canonical_internodes(symbols, internodes)) {
         out.push_back(kCanonical);
-        auto models = std::make_unique<SymbolModels>();
-        ChainWalker walker;
-        for (const auto& [vector, terminator] : internodes) {
-            code_vector(io, *models, walker, vector, symbols.size());
-            code_terminator(io, *models, walker, !vector.isZero(), terminator);
-            walker.advance(vector, terminator);
-        }
+        encode_canonical(io, *symbol_models(prior), internodes, symbols.size());
     } else {
         out.push_back(kGeneric);
         auto models = std::make_unique<GenericModels>();
@@ -372,27 +488,44 @@ std::vector<std::uint8_t> best_encode_symbols(const std::string& symbols) {
     }
     const std::vector<std::uint8_t> payload = io.rc.finish();
     out.insert(out.end(), payload.begin(), payload.end());
-    return out;
+    std::vector<std::uint8_t> interpolative;
+    write_varint(interpolative, symbols.size());
+    interpolative.push_back(kInterpolativeSymbols);
+    const std::vector<std::uint8_t> ic = ic_encode_symbols(symbols);
+    interpolative.insert(interpolative.end(), ic.begin(), ic.end());
+    return interpolative.size() < out.size() ? interpolative : out;
 }
 
-std::string best_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context) {
+namespace {
+
+// best_decode_symbols, also returning the terminators of the internodes (the radii decoder's
+// topology) without a second scan of the symbol string.
+std::string decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context, const BestPrior* prior,
+                           std::vector<char>& terminators) {
     std::size_t position = 0;
     const std::uint64_t n = read_varint(bytes, position, context);
     if (n > kMaxCodeSymbols) throw Error::input(context, "code length " + std::to_string(n) + " exceeds the decoder limit");
     if (position >= bytes.size()) throw Error::input(context, "truncated stream header");
     const std::uint8_t mode = bytes[position++];
+    if (mode == kInterpolativeSymbols) {
+        std::string symbols = ic_decode_symbols(bytes.subspan(position), context);
+        if (symbols.size() != n) throw Error::input(context, "symbol count disagrees with the stream header");
+        terminators = terminators_of(symbols);
+        return symbols;
+    }
     if (mode != kCanonical && mode != kGeneric) throw Error::input(context, "unknown symbol model " + std::to_string(mode));
     Decoding io{RangeDecoder(bytes.subspan(position), context)};
     std::string symbols;
     symbols.reserve(n);
     if (mode == kCanonical) {
-        auto models = std::make_unique<SymbolModels>();
+        const auto models = symbol_models(prior);
         ChainWalker walker;
         while (symbols.size() < n) {
             const Voxel vector = code_vector(io, *models, walker, Voxel::Zero(), n - symbols.size() - 1);
             const char terminator = code_terminator(io, *models, walker, !vector.isZero(), kTip);
             append_moves(vector, symbols);
             symbols += terminator;
+            terminators.push_back(terminator);
             walker.advance(vector, terminator);
         }
     } else {
@@ -403,24 +536,39 @@ std::string best_decode_symbols(std::span<const std::uint8_t> bytes, const std::
             symbols += static_cast<char>('0' + symbol);
             ctx = (ctx % 9) * 9 + symbol;
         }
+        terminators = terminators_of(symbols);
     }
     if (!io.rc.at_end()) throw Error::input(context, "trailing bytes after the symbol stream");
     return symbols;
 }
 
-std::vector<std::uint8_t> best_encode_radii(const std::string& symbols, std::span<const int> radii) {
+}  // namespace
+
+std::string best_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context, const BestPrior* prior) {
+    std::vector<char> terminators;
+    return decode_symbols(bytes, context, prior, terminators);
+}
+
+std::vector<std::uint8_t> best_encode_radii(const std::string& symbols, std::span<const int> radii, const BestPrior* prior) {
     const Topology topology = parse_topology(symbols);
     if (topology.parent.size() != radii.size())
         throw Error(ExitCode::Internal, "best radii: radius count differs from the internode count");
     if (radii.empty()) return {};
-    std::vector<std::uint8_t> best = encode_radii_with(topology, radii, kParentRadius);
-    std::vector<std::uint8_t> pipe = encode_radii_with(topology, radii, kPipeModel);
-    return pipe.size() < best.size() ? pipe : best;
+    const auto uniform = std::make_unique<RadiusModels>();
+    const RadiusModels& initial = prior ? prior->state().radii : *uniform;
+    std::vector<std::uint8_t> best = encode_radii_with(topology, radii, kParentRadius, initial);
+    std::vector<std::uint8_t> pipe = encode_radii_with(topology, radii, kPipeModel, initial);
+    if (pipe.size() < best.size()) best = std::move(pipe);
+    std::vector<std::uint8_t> interpolative{kInterpolativeRadii};
+    const std::vector<std::uint8_t> ic = ic_encode_radii(symbols, radii);
+    interpolative.insert(interpolative.end(), ic.begin(), ic.end());
+    return interpolative.size() < best.size() ? interpolative : best;
 }
 
-std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
-                                   const std::string& context) {
-    const Topology topology = parse_topology(symbols);
+namespace {
+
+std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols, const Topology& topology,
+                              const std::string& context, const BestPrior* prior) {
     std::vector<int> radii(topology.parent.size(), 0);
     if (radii.empty()) {
         if (!bytes.empty()) throw Error::input(context, "radii stream for a code without internodes");
@@ -428,12 +576,30 @@ std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const st
     }
     if (bytes.empty()) throw Error::input(context, "empty radii stream");
     const std::uint8_t predictor = bytes[0];
+    if (predictor == kInterpolativeRadii) return ic_decode_radii(bytes.subspan(1), symbols, context);
     if (predictor != kParentRadius && predictor != kPipeModel)
         throw Error::input(context, "unknown radius predictor " + std::to_string(predictor));
     Decoding io{RangeDecoder(bytes.subspan(1), context)};
-    code_radii(io, topology, radii, static_cast<RadiusPredictor>(predictor));
+    auto models = prior ? std::make_unique<RadiusModels>(prior->state().radii) : std::make_unique<RadiusModels>();
+    code_radii(io, topology, radii, static_cast<RadiusPredictor>(predictor), models.get());
     if (!io.rc.at_end()) throw Error::input(context, "trailing bytes after the radii stream");
     return radii;
+}
+
+}  // namespace
+
+std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
+                                   const std::string& context, const BestPrior* prior) {
+    return decode_radii(bytes, symbols, parse_topology(symbols), context, prior);
+}
+
+ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
+                           const std::string& symbols_context, const std::string& radii_context, const BestPrior* prior) {
+    ChainCode code;
+    std::vector<char> terminators;
+    code.symbols = decode_symbols(symbol_bytes, symbols_context, prior, terminators);
+    code.radii = decode_radii(radii_bytes, code.symbols, topology_of(terminators), radii_context, prior);
+    return code;
 }
 
 }  // namespace treelobes::encode

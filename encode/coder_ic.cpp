@@ -15,8 +15,8 @@ namespace {
 
 constexpr unsigned kAlphabet = 9;                // symbols 0..8 (Table 1)
 constexpr std::uint64_t kMaxMtfPosition = kAlphabet - 1;
-// Radius d-gaps are differences of two ints, so the shifted gaps stay below 2^33.
-constexpr std::uint64_t kMaxShiftedGap = std::uint64_t{1} << 33;
+// Radius d-gaps are differences of two ints, so shifted or zig-zagged gaps stay below 2^34.
+constexpr std::uint64_t kMaxShiftedGap = std::uint64_t{1} << 34;
 
 bool is_terminator(char c) { return c == kFork || c == kTip || c == kEndOfInternode; }
 
@@ -72,60 +72,91 @@ std::string ic_decode_symbols(std::span<const std::uint8_t> bytes, const std::st
     return symbols;
 }
 
-RadiiSequence radii_to_sequence(const std::string& symbols, std::span<const int> radii) {
+std::vector<std::int64_t> radius_gaps(const std::string& symbols, std::span<const int> radii, std::int64_t offset) {
     std::vector<std::int64_t> gaps;
     gaps.reserve(radii.size());
     for (const auto& [begin, end] : branch_sublists(symbols)) {
         std::int64_t previous = 0;  // the inverted sublist starts from 0
         for (std::size_t i = end; i-- > begin;) {
-            gaps.push_back(static_cast<std::int64_t>(radii[i]) - previous);
-            previous = radii[i];
+            const std::int64_t aligned = static_cast<std::int64_t>(radii[i]) - offset;
+            gaps.push_back(aligned - previous);
+            previous = aligned;
         }
     }
+    return gaps;
+}
+
+RadiiSequence radii_to_sequence(const std::string& symbols, std::span<const int> radii, GapMap map) {
     RadiiSequence sequence;
-    if (gaps.empty()) return sequence;
-    sequence.offset = *std::min_element(gaps.begin(), gaps.end());
-    std::vector<std::uint64_t> shifted(gaps.size());
-    for (std::size_t i = 0; i < gaps.size(); ++i) shifted[i] = static_cast<std::uint64_t>(gaps[i] - sequence.offset);
-    sequence.cumulative = cumulative_sum(shifted);
+    sequence.map = map;
+    if (radii.empty()) return sequence;
+    sequence.offset = *std::min_element(radii.begin(), radii.end());
+    const std::vector<std::int64_t> gaps = radius_gaps(symbols, radii, sequence.offset);
+    const std::int64_t lowest = *std::min_element(gaps.begin(), gaps.end());
+    sequence.shift = lowest < 0 ? static_cast<std::uint64_t>(-lowest) : 0;
+    std::vector<std::uint64_t> mapped(gaps.size());
+    for (std::size_t i = 0; i < gaps.size(); ++i)
+        mapped[i] = map == GapMap::ZigZag ? zigzag(gaps[i]) : static_cast<std::uint64_t>(gaps[i]) + sequence.shift;
+    sequence.cumulative = cumulative_sum(mapped);
     return sequence;
 }
 
-std::vector<std::uint8_t> ic_encode_radii(const std::string& symbols, std::span<const int> radii) {
-    if (radii.size() != internode_count(symbols))
-        throw Error(ExitCode::Internal, "ic radii: radius count differs from the internode count");
-    const RadiiSequence sequence = radii_to_sequence(symbols, radii);
-    BitWriter out;
-    if (radii.empty()) return out.take();
+namespace {
+
+std::vector<std::uint8_t> write_radii(const RadiiSequence& sequence) {
     std::uint64_t max_gap = 0, previous = 0;
     for (std::uint64_t q : sequence.cumulative) {
         max_gap = std::max(max_gap, q - previous);
         previous = q;
     }
+    BitWriter out;
     write_count(out, zigzag(sequence.offset));
+    out.write_bit(sequence.map == GapMap::ZigZag);
+    if (sequence.map == GapMap::Shift) write_count(out, sequence.shift);
     write_count(out, max_gap);
     write_interpolative(out, sequence.cumulative, {.max_gap = max_gap});
     return out.take();
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> ic_encode_radii(const std::string& symbols, std::span<const int> radii) {
+    if (radii.size() != internode_count(symbols))
+        throw Error(ExitCode::Internal, "ic radii: radius count differs from the internode count");
+    if (radii.empty()) return {};
+    const RadiiSequence shifted = radii_to_sequence(symbols, radii, GapMap::Shift);
+    std::vector<std::uint8_t> bytes = write_radii(shifted);
+    if (shifted.shift == 0) return bytes;  // monotone: the printed scheme, nothing to choose
+    std::vector<std::uint8_t> zigzagged = write_radii(radii_to_sequence(symbols, radii, GapMap::ZigZag));
+    return zigzagged.size() < bytes.size() ? zigzagged : bytes;
 }
 
 std::vector<int> ic_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
                                  const std::string& context) {
     const std::size_t n = internode_count(symbols);
     std::vector<int> radii(n);
-    if (n == 0) return radii;
+    if (n == 0) {
+        if (!bytes.empty()) throw Error::input(context, "radii stream for a code without internodes");
+        return radii;
+    }
     BitReader in(bytes, context);
     const std::int64_t offset = unzigzag(read_count(in));
+    const bool zigzagged = in.read_bit();
+    const std::uint64_t shift = zigzagged ? 0 : read_count(in);
     const std::uint64_t max_gap = read_count(in);
-    if (max_gap > kMaxShiftedGap || offset < -(std::int64_t{1} << 33) || offset > (std::int64_t{1} << 33))
+    constexpr std::int64_t kLimit = std::int64_t{1} << 33;  // radii are ints: offsets and gaps stay below
+    if (max_gap > kMaxShiftedGap || shift > kMaxShiftedGap || offset < -kLimit || offset > kLimit)
         in.fail("radius gap bounds out of range");
-    const std::vector<std::uint64_t> shifted = differences(read_interpolative(in, n, {.max_gap = max_gap}), max_gap, context);
+    const std::vector<std::uint64_t> mapped = differences(read_interpolative(in, n, {.max_gap = max_gap}), max_gap, context);
     std::size_t k = 0;
     for (const auto& [begin, end] : branch_sublists(symbols)) {
         std::int64_t value = 0;
         for (std::size_t i = end; i-- > begin;) {
-            value += static_cast<std::int64_t>(shifted[k++]) + offset;
-            if (value < INT_MIN || value > INT_MAX) in.fail("decoded radius out of range");
-            radii[i] = static_cast<int>(value);
+            const std::uint64_t m = mapped[k++];
+            value += zigzagged ? unzigzag(m) : static_cast<std::int64_t>(m) - static_cast<std::int64_t>(shift);
+            const std::int64_t radius = value + offset;
+            if (radius < INT_MIN || radius > INT_MAX) in.fail("decoded radius out of range");
+            radii[i] = static_cast<int>(radius);
         }
     }
     return radii;

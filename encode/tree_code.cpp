@@ -215,31 +215,58 @@ TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const
     check_positive(geometry.voxel_size, "voxel size");
     check_positive(geometry.radius_unit, "radius unit");
     if (geometry.root_radius < 0) throw Error::input(context, "root radius is negative");
-    const std::vector<Internode> stream = read_internodes(code, context);
-    const std::vector<bool> contracted = contracted_internodes(stream);
+    const std::size_t count = check_symbols(code.symbols, context);
+    if (code.radii.size() != count)  // read_internodes's checks and messages, inlined below
+        throw Error::input(context, "radius list has " + std::to_string(code.radii.size()) + " values but the " +
+                                        code_kind_name(code.kind) + " code has " + std::to_string(count) +
+                                        " internodes (one radius per 6, 7 or 8)");
 
     TreeGraph tree;
     tree.origin = geometry.origin;
     const Eigen::Vector3d root = geometry.root_position.cast<double>();
+    tree.nodes.reserve(count + 1);
     tree.add_node(geometry.root_position, static_cast<float>(geometry.root_radius * geometry.radius_unit), -1);
+    // One pass over the symbols, without an intermediate internode stream (read_internodes and
+    // contracted_internodes do the same in two more passes): decoding is on the forest's hot path.
     std::vector<Voxel> voxels{Voxel::Zero()};
-    std::deque<int> queued_forks;  // vertices whose next lateral is still to come
+    voxels.reserve(count + 1);
+    std::vector<int> queued_forks;  // FIFO: vertices whose next lateral is still to come
+    std::size_t next_fork = 0;
     int attach = 0;                // vertex the next internode starts from
-    for (std::size_t i = 0; i < stream.size(); ++i) {
-        const Internode& internode = stream[i];
-        if (!contracted[i]) {
-            const Voxel voxel = voxels[attach] + internode.move;
+    Voxel delta = Voxel::Zero(), previous = Voxel::Zero();
+    bool differential_base = false;  // DBF6: the internode codes a correction of `previous`
+    bool branch_start = true;        // no vertex of the current branch decoded yet
+    std::size_t index = 0;
+    for (std::size_t s = 0; s < code.symbols.size(); ++s) {
+        const char symbol = code.symbols[s];
+        if (symbol < kFork) {  // a move 0..5 (check_symbols admits nothing else below 6)
+            delta[(symbol - '0') % 3] += symbol < '3' ? 1 : -1;
+            continue;
+        }
+        const Voxel move = differential_base ? Voxel(previous + delta) : delta;
+        const int radius = code.radii[index];
+        if (radius < 0)
+            throw Error::input(context, "radius " + std::to_string(index + 1) + " is negative (" + std::to_string(radius) + ")");
+        if (move.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
+            throw Error::input(context, "internode ending at character " + std::to_string(s + 1) +
+                                            " moves more than 2^40 voxels (corrupt code)");
+        // contracted_internodes: a leading zero move of a branch that does not end it.
+        const bool contracted = branch_start && move.isZero() && symbol != kTip;
+        if (!contracted) {
+            const Voxel voxel = voxels[attach] + move;
             if (voxel.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
-                throw Error::input(context, "internode " + std::to_string(i + 1) + " ends more than 2^40 voxels from the root (corrupt code)");
+                throw Error::input(context, "internode " + std::to_string(index + 1) + " ends more than 2^40 voxels from the root (corrupt code)");
             const Eigen::Vector3d position = root + voxel.cast<double>() * geometry.voxel_size;
-            attach = tree.add_node(position.cast<float>(), static_cast<float>(internode.radius * geometry.radius_unit), attach);
+            attach = tree.add_node(position.cast<float>(), static_cast<float>(radius * geometry.radius_unit), attach);
             voxels.push_back(voxel);
+            branch_start = symbol == kTip;
         }
-        if (internode.terminator == kFork) queued_forks.push_back(attach);
-        if (internode.terminator == kTip && !queued_forks.empty()) {
-            attach = queued_forks.front();
-            queued_forks.pop_front();
-        }
+        if (symbol == kFork) queued_forks.push_back(attach);
+        if (symbol == kTip && next_fork < queued_forks.size()) attach = queued_forks[next_fork++];
+        previous = move;
+        differential_base = code.kind == CodeKind::DBF6 && symbol != kTip;
+        delta.setZero();
+        ++index;
     }
     return tree;
 }

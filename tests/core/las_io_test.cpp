@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -195,6 +196,19 @@ TEST(LasWrite, EmptyCloudRoundTrips) {
     const PointCloud back = write_then_read(cloud, dir);
     EXPECT_EQ(back.size(), 0u);
     EXPECT_EQ(back.source.las_point_format, 0);
+}
+
+TEST(LasWrite, SourceDateEpochPinsTheCreationDate) {
+    TempDir dir;
+    const PointCloud cloud = cloud_of_format(1, 3);
+    ::setenv("SOURCE_DATE_EPOCH", "1740787200", 1);  // 2025-03-01 00:00 UTC: day 60 of 2025
+    write_las(cloud, dir / "first.las");
+    write_las(cloud, dir / "second.las");
+    ::unsetenv("SOURCE_DATE_EPOCH");
+    const Bytes first = load_file(dir / "first.las");
+    EXPECT_EQ(peek<std::uint16_t>(first, 90), 60);
+    EXPECT_EQ(peek<std::uint16_t>(first, 92), 2025);
+    EXPECT_EQ(first, load_file(dir / "second.las"));
 }
 
 // ------------------------------------------------------------------------------------------------

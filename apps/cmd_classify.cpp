@@ -1,0 +1,425 @@
+// `treelobes classify features|train|predict|evaluate`: species classification (seed 001 §6.1).
+//   features  INPUT... --out features.csv      200+ shape features per tree (docs/features.md)
+//   train     features.csv --labels labels.csv --out model.jb      JointBoost model file
+//   predict   model.jb INPUT...|features.csv [--positions P.csv] [--vote]    species per tree
+//   evaluate  DATASET_DIR... --splits 100 --out report/   the paper's protocol, voting, XGBoost
+#include "apps/command.hpp"
+#include "classify/batch.hpp"
+#include "classify/evaluation.hpp"
+#include "classify/feature_table.hpp"
+#include "classify/features.hpp"
+#include "classify/jointboost.hpp"
+#include "classify/voting.hpp"
+#include "classify/xgboost_baseline.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/version.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <set>
+
+namespace treelobes::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace treelobes::classify;
+
+std::string format(const char* pattern, double value) {
+    char text[64];
+    std::snprintf(text, sizeof text, pattern, value);
+    return text;
+}
+
+void print(const json& summary, const GlobalOptions& global, const std::string& human) {
+    if (global.json) std::cout << summary.dump(2) << "\n";
+    else std::cout << human;
+}
+
+// failures.jsonl beside `out` (DESIGN.md: one JSON object per failure with the reason).
+void write_failures(const std::vector<BatchFailure>& failures, const fs::path& out) {
+    std::string lines;
+    for (const auto& f : failures) lines += json{{"item", f.id}, {"reason", f.reason}}.dump() + "\n";
+    write_file_atomically(out.parent_path() / "failures.jsonl", lines);
+}
+
+struct FeatureFlags {
+    std::string tree_attribute;
+    std::string relative_to;
+    bool no_skeleton = false;
+    FeatureOptions options() const {
+        FeatureOptions o;
+        o.skeleton = !no_skeleton;
+        return o;
+    }
+};
+
+void add_feature_flags(CLI::App* sub, FeatureFlags& f) {
+    sub->add_option("--tree-attribute", f.tree_attribute, "Split each input into trees by this per-point attribute (e.g. treeID)");
+    sub->add_option("--relative-to", f.relative_to, "Row ids are input paths relative to this folder (as in a dataset's labels.csv)");
+    sub->add_flag("--no-skeleton", f.no_skeleton, "Skip the skeleton features (zeros; faster)");
+}
+
+std::vector<BatchInput> batch_inputs(const std::vector<std::string>& files, const FeatureFlags& f) {
+    std::vector<BatchInput> inputs;
+    for (const auto& file : files) {
+        std::string id = file;
+        if (!f.relative_to.empty()) id = fs::path(file).lexically_relative(f.relative_to).generic_string();
+        inputs.push_back({file, id, f.tree_attribute});
+    }
+    return inputs;
+}
+
+// ---------------------------------------------------------------- features
+struct FeaturesCommand {
+    std::vector<std::string> inputs;
+    std::string out;
+    bool list = false;
+    FeatureFlags flags;
+};
+
+int run_features(const FeaturesCommand& c, const GlobalOptions& global) {
+    if (c.list) {
+        std::cout << features_markdown();
+        return 0;
+    }
+    if (c.inputs.empty() || c.out.empty()) throw Error::usage("classify features: give INPUT... and --out features.csv (or --list)");
+    const FeatureBatch batch = compute_feature_batch(batch_inputs(c.inputs, c.flags), c.flags.options());
+    if (batch.table.rows() == 0) throw Error::input(c.inputs.front(), "no tree gave features (" + batch.failures.front().reason + ")");
+    write_feature_csv(batch.table, c.out);
+    if (!batch.failures.empty()) write_failures(batch.failures, fs::absolute(c.out));
+    const json summary = {{"command", "classify features"}, {"treelobes", kVersion},   {"trees", batch.table.rows()},
+                          {"features", batch.table.cols()},  {"failed", batch.failures.size()}, {"points", batch.points},
+                          {"seconds", batch.seconds},        {"feature_seconds_per_tree", batch.feature_seconds / batch.table.rows()},
+                          {"out", c.out}};
+    print(summary, global,
+          std::to_string(batch.table.rows()) + " trees x " + std::to_string(batch.table.cols()) + " features -> " + c.out +
+              (batch.failures.empty() ? "" : " (" + std::to_string(batch.failures.size()) + " failed, see failures.jsonl)") +
+              format(" (%.1f s)\n", batch.seconds));
+    return batch.failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
+}
+
+// ---------------------------------------------------------------- train
+struct TrainCommand {
+    std::string features;
+    std::string labels;
+    std::string out;
+    JointBoostOptions options;
+};
+
+int run_train(const TrainCommand& c, const GlobalOptions& global) {
+    const FeatureTable table = read_feature_csv(c.features);
+    const LabelledSet set = make_labelled_set(table, read_labels_csv(c.labels), c.labels);
+    const auto start = std::chrono::steady_clock::now();
+    JointBoostReport report;
+    const JointBoostModel model = train_jointboost(set.features, set.labels, set.classes, c.options, &report);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    save_jointboost(model, c.out);
+    int correct = 0;
+    for (std::size_t r = 0; r < table.rows(); ++r) {
+        const auto p = model.probabilities(set.features.row(r));
+        correct += std::max_element(p.begin(), p.end()) - p.begin() == set.labels[r];
+    }
+    const double accuracy = static_cast<double>(correct) / static_cast<double>(table.rows());
+    const json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"trees", table.rows()},
+                          {"features", table.cols()},    {"classes", set.classes}, {"rounds", report.rounds},
+                          {"rounds_tried", report.rounds_tried}, {"training_accuracy", accuracy}, {"seconds", seconds},
+                          {"out", c.out}};
+    print(summary, global,
+          "JointBoost: " + std::to_string(table.rows()) + " trees, " + std::to_string(set.classes.size()) + " species, " +
+              std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " stumps (early stop after " +
+              std::to_string(report.rounds_tried) + "), training accuracy " + format("%.1f %%", 100 * accuracy) + " -> " + c.out +
+              format(" (%.2f s)\n", seconds));
+    return 0;
+}
+
+// ---------------------------------------------------------------- predict
+struct PredictCommand {
+    std::string model;
+    std::vector<std::string> inputs;
+    std::string positions;
+    std::string out;
+    bool vote = false;
+    VotingOptions voting;
+    FeatureFlags flags;
+};
+
+bool is_feature_table(const std::vector<std::string>& inputs) {
+    return inputs.size() == 1 && fs::path(inputs.front()).extension() == ".csv" && read_file(inputs.front()).rfind("id,", 0) == 0;
+}
+
+int run_predict(const PredictCommand& c, const GlobalOptions& global) {
+    const JointBoostModel model = load_jointboost(c.model);
+    FeatureTable table;
+    std::vector<Eigen::Vector2d> positions;
+    std::vector<BatchFailure> failures;
+    if (is_feature_table(c.inputs)) {
+        table = read_feature_csv(c.inputs.front());
+    } else {
+        FeatureBatch batch = compute_feature_batch(batch_inputs(c.inputs, c.flags), c.flags.options());
+        table = std::move(batch.table);
+        positions = std::move(batch.positions);
+        failures = std::move(batch.failures);
+    }
+    if (table.rows() == 0) throw Error::input(c.inputs.front(), "no tree to classify");
+    table = table.select_columns(model.feature_names, c.inputs.front());
+    if (!c.positions.empty()) {
+        std::map<std::string, Eigen::Vector2d> by_id;
+        for (const auto& p : read_positions_csv(c.positions)) by_id[p.id] = {p.x, p.y};
+        positions.clear();
+        for (const auto& id : table.ids) {
+            const auto it = by_id.find(id);
+            if (it == by_id.end()) throw Error::input(c.positions, "no position for tree '" + id + "'");
+            positions.push_back(it->second);
+        }
+    }
+    if (c.vote && positions.empty())
+        throw Error::usage("--vote needs positions: give --positions positions.csv (id,x,y) when predicting from a feature table");
+    std::vector<std::vector<double>> p;
+    for (std::size_t r = 0; r < table.rows(); ++r) p.push_back(model.probabilities(table.row(r)));
+    VotingResult vote;
+    if (c.vote) vote = spatial_vote(p, positions, c.voting);
+
+    std::string csv = "id,species,probability,confident";
+    if (c.vote) csv += ",voted_species";
+    for (const auto& name : model.classes) csv += ",p_" + name;
+    csv += "\n";
+    json trees = json::array();
+    std::map<std::string, int> counts;
+    int confident = 0, changed = 0;
+    for (std::size_t r = 0; r < table.rows(); ++r) {
+        const int best = static_cast<int>(std::max_element(p[r].begin(), p[r].end()) - p[r].begin());
+        const bool sure = is_confident(p[r], c.voting.confidence_factor);
+        const std::string final_species = model.classes[c.vote ? vote.species[r] : best];
+        confident += sure;
+        changed += c.vote && vote.changed[r];
+        ++counts[final_species];
+        csv += table.ids[r] + "," + model.classes[best] + "," + format("%.4f", p[r][best]) + "," + (sure ? "1" : "0");
+        if (c.vote) csv += "," + final_species;
+        for (double v : p[r]) csv += "," + format("%.4f", v);
+        csv += "\n";
+        trees.push_back({{"id", table.ids[r]}, {"species", final_species}, {"probability", p[r][best]}, {"confident", sure}});
+    }
+    if (!c.out.empty()) write_file_atomically(c.out, csv);
+    if (!failures.empty()) write_failures(failures, fs::absolute(c.out.empty() ? std::string("predictions.csv") : c.out));
+    const json summary = {{"command", "classify predict"}, {"treelobes", kVersion}, {"trees", trees}, {"confident", confident},
+                          {"changed_by_vote", changed},    {"failed", failures.size()}, {"out", c.out}};
+    std::string human;
+    if (c.out.empty()) human = csv;
+    else {
+        human = std::to_string(table.rows()) + " trees classified (" + std::to_string(confident) + " confident";
+        if (c.vote) human += ", " + std::to_string(changed) + " changed by spatial voting";
+        human += ") -> " + c.out + "\n";
+        for (const auto& [species, n] : counts) human += "  " + species + ": " + std::to_string(n) + "\n";
+    }
+    print(summary, global, human);
+    return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
+}
+
+// ---------------------------------------------------------------- evaluate
+struct EvaluateCommand {
+    std::vector<std::string> datasets;
+    std::string out;
+    std::string features;       // reuse a feature table instead of computing it
+    bool no_xgboost = false;
+    bool no_site_split = false;
+    std::string layout;         // "", "grouped" or "mixed": planting positions for voting
+    double spacing = 8.0;
+    EvaluationOptions options;
+    JointBoostOptions jointboost;
+    XGBoostOptions xgboost;
+    FeatureFlags flags;
+};
+
+// Trees and labels of one dataset folder: a `treelobes synth dataset` (labels.csv naming one
+// cloud per tree) or folders of `treelobes synth tile` outputs (tile.las split by treeID,
+// truth.csv with species and positions; the folder is the site group).
+void discover(const fs::path& dir, const std::string& prefix, std::vector<BatchInput>& inputs, std::vector<TreeLabel>& labels) {
+    if (fs::exists(dir / "labels.csv")) {
+        for (auto label : read_labels_csv(dir / "labels.csv")) {
+            inputs.push_back({dir / label.id, prefix + label.id, ""});
+            label.id = prefix + label.id;
+            labels.push_back(std::move(label));
+        }
+        return;
+    }
+    std::vector<fs::path> tiles;
+    if (fs::exists(dir / "truth.csv")) tiles.push_back(dir);
+    if (fs::is_directory(dir))
+        for (const auto& entry : fs::directory_iterator(dir))
+            if (entry.is_directory() && fs::exists(entry.path() / "truth.csv")) tiles.push_back(entry.path());
+    std::sort(tiles.begin(), tiles.end());
+    if (tiles.empty())
+        throw Error::input(dir.string(), "neither a dataset (labels.csv) nor tiles (folders with truth.csv and tile.las)");
+    for (const auto& tile : tiles) {
+        const fs::path cloud = fs::exists(tile / "tile.las") ? tile / "tile.las" : tile / "tile.ply";
+        const std::string group = prefix + (tile == dir ? dir.filename().string() : tile.filename().string());
+        inputs.push_back({cloud, group, "treeID"});
+        for (auto label : read_labels_csv(tile / "truth.csv")) {
+            label.id = group + "/" + label.id;
+            label.group = group;
+            labels.push_back(std::move(label));
+        }
+    }
+}
+
+NamedClassifier jointboost_classifier(const JointBoostOptions& base) {
+    return {"JointBoost", [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test,
+                                 std::uint64_t seed) {
+                JointBoostOptions o = base;
+                o.seed = seed;
+                std::vector<std::string> names;
+                for (int c = 0; c < classes; ++c) names.push_back(std::to_string(c));
+                ClassifierRun run;
+                const auto start = std::chrono::steady_clock::now();
+                JointBoostReport report;
+                const JointBoostModel model = train_jointboost(train, y, names, o, &report);
+                const auto trained = std::chrono::steady_clock::now();
+                for (std::size_t r = 0; r < test.rows(); ++r) run.probabilities.push_back(model.probabilities(test.row(r)));
+                run.train_seconds = std::chrono::duration<double>(trained - start).count();
+                run.predict_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - trained).count();
+                run.rounds = report.rounds;
+                return run;
+            }};
+}
+
+NamedClassifier xgboost_classifier(const XGBoostOptions& base) {
+    return {"XGBoost", [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test,
+                              std::uint64_t seed) {
+                XGBoostOptions o = base;
+                o.seed = seed;
+                XGBoostRun x = xgboost_train_predict(train, y, classes, test, o);
+                ClassifierRun run;
+                run.probabilities = std::move(x.probabilities);
+                run.train_seconds = x.train_seconds, run.predict_seconds = x.predict_seconds, run.rounds = x.rounds;
+                return run;
+            }};
+}
+
+int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
+    std::vector<BatchInput> inputs;
+    std::vector<TreeLabel> labels;
+    for (const auto& d : c.datasets)
+        discover(d, c.datasets.size() > 1 ? fs::path(d).lexically_normal().filename().string() + "/" : "", inputs, labels);
+    // Dataset folders that are not tiles have no site groups of their own.
+    FeatureTable table;
+    std::vector<BatchFailure> failures;
+    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion}, {"datasets", c.datasets}, {"baseline", xgboost_version()}};
+    if (!c.features.empty()) {
+        table = read_feature_csv(c.features);
+        extra["features_file"] = c.features;
+    } else {
+        FeatureBatch batch = compute_feature_batch(inputs, c.flags.options());
+        if (batch.table.rows() == 0) throw Error::input(c.datasets.front(), "no tree gave features");
+        table = std::move(batch.table);
+        failures = std::move(batch.failures);
+        fs::create_directories(c.out);
+        write_feature_csv(table, fs::path(c.out) / "features.csv");
+        extra["feature_seconds_per_tree"] = batch.feature_seconds / static_cast<double>(table.rows());
+        extra["feature_seconds_total"] = batch.seconds;
+        extra["points"] = batch.points;
+    }
+    // Only labelled trees that gave features take part.
+    std::set<std::string> have(table.ids.begin(), table.ids.end());
+    std::vector<TreeLabel> used;
+    for (const auto& l : labels)
+        if (have.count(l.id)) used.push_back(l);
+    std::vector<std::size_t> rows;
+    std::set<std::string> labelled;
+    for (const auto& l : used) labelled.insert(l.id);
+    for (std::size_t r = 0; r < table.rows(); ++r)
+        if (labelled.count(table.ids[r])) rows.push_back(r);
+    table = table.select_rows(rows);
+    LabelledSet set = make_labelled_set(table, used, c.datasets.front());
+    if (!c.layout.empty()) {
+        set.positions = planting_layout(set.labels, static_cast<int>(set.classes.size()), c.layout == "grouped", c.spacing, c.options.seed);
+        extra["layout"] = {{"planting", c.layout}, {"spacing_m", c.spacing}};
+    }
+
+    std::vector<NamedClassifier> classifiers = {jointboost_classifier(c.jointboost)};
+    if (!c.no_xgboost) classifiers.push_back(xgboost_classifier(c.xgboost));
+    EvaluationOptions options = c.options;
+    options.site_split = !c.no_site_split;
+    const EvaluationReport report = evaluate(set, classifiers, options);
+    extra["trees"] = set.labels.size();
+    extra["failed"] = failures.size();
+    write_report(report, options, c.out, extra.dump());
+    if (!failures.empty()) write_failures(failures, fs::path(c.out) / "features.csv");
+    json summary = json::parse(read_file(fs::path(c.out) / "summary.json"));
+    print(summary, global, report_summary(report) + "\nreport -> " + c.out + "\n");
+    return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
+}
+
+}  // namespace
+
+void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) {
+    CLI::App* classify = app.add_subcommand("classify", "Species classification: features, JointBoost, evaluation (seed 001 §6.1)");
+    classify->require_subcommand(1);
+
+    auto features = std::make_shared<FeaturesCommand>();
+    CLI::App* f = classify->add_subcommand("features", "Shape features of tree point clouds -> features.csv");
+    f->add_option("inputs", features->inputs, "Point clouds, one tree each (or many with --tree-attribute)");
+    f->add_option("--out,-o", features->out, "Output CSV");
+    f->add_flag("--list", features->list, "Print the feature catalogue (docs/features.md) and exit");
+    add_feature_flags(f, features->flags);
+    f->callback([features, &global, &job] { job = [features, &global] { return run_features(*features, global); }; });
+
+    auto train = std::make_shared<TrainCommand>();
+    CLI::App* t = classify->add_subcommand("train", "Train a JointBoost model from features.csv and labels.csv");
+    t->add_option("features", train->features, "Feature table from `classify features`")->required();
+    t->add_option("--labels", train->labels, "CSV with id and species columns")->required();
+    t->add_option("--out,-o", train->out, "Model file")->required();
+    t->add_option("--max-rounds", train->options.max_rounds, "Maximum boosting rounds")->check(CLI::Range(1, 100000))->capture_default_str();
+    t->add_option("--validation", train->options.validation_fraction, "Held-out fraction for early stopping (0 = off)")
+        ->check(CLI::Range(0.0, 0.9))->capture_default_str();
+    t->add_option("--patience", train->options.patience, "Rounds without improvement before stopping")->check(CLI::NonNegativeNumber)->capture_default_str();
+    t->add_option("--seed", train->options.seed, "Seed of the validation split")->capture_default_str();
+    t->callback([train, &global, &job] { job = [train, &global] { return run_train(*train, global); }; });
+
+    auto predict = std::make_shared<PredictCommand>();
+    CLI::App* p = classify->add_subcommand("predict", "Species of trees (point clouds or a feature table), optional spatial voting");
+    p->add_option("model", predict->model, "Model file from `classify train`")->required();
+    p->add_option("inputs", predict->inputs, "Point clouds or one features.csv")->required();
+    p->add_option("--positions", predict->positions, "CSV with id, x, y (default for clouds: the mean of their points)");
+    p->add_flag("--vote", predict->vote, "Spatial voting among the trees given");
+    p->add_option("--confidence", predict->voting.confidence_factor, "Confident when h1 > factor * h2")
+        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
+    p->add_option("--radius", predict->voting.radius_m, "Voting neighbourhood, m")->check(CLI::NonNegativeNumber)->capture_default_str();
+    p->add_option("--out,-o", predict->out, "predictions.csv (default: print the table)");
+    add_feature_flags(p, predict->flags);
+    p->callback([predict, &global, &job] { job = [predict, &global] { return run_predict(*predict, global); }; });
+
+    auto evaluate = std::make_shared<EvaluateCommand>();
+    CLI::App* e = classify->add_subcommand("evaluate", "The paper's protocol (50/50 splits), site split, voting, XGBoost baseline");
+    e->add_option("datasets", evaluate->datasets, "`synth dataset` folders (labels.csv) or folders of `synth tile` outputs")->required();
+    e->add_option("--out,-o", evaluate->out, "Report folder")->required();
+    e->add_option("--splits", evaluate->options.splits, "Random 50/50 splits")->check(CLI::Range(1, 100000))->capture_default_str();
+    e->add_option("--seed", evaluate->options.seed, "Seed of the splits")->capture_default_str();
+    e->add_option("--features", evaluate->features, "Reuse a feature table (e.g. report/features.csv of an earlier run)");
+    e->add_option("--confidence", evaluate->options.voting.confidence_factor, "Confident when h1 > factor * h2")
+        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
+    e->add_option("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(CLI::NonNegativeNumber)->capture_default_str();
+    e->add_option("--max-rounds", evaluate->jointboost.max_rounds, "JointBoost maximum rounds")->check(CLI::Range(1, 100000))->capture_default_str();
+    e->add_option("--layout", evaluate->layout,
+                  "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
+                  "replaces the dataset's positions")
+        ->check(CLI::IsMember({"grouped", "mixed"}));
+    e->add_option("--spacing", evaluate->spacing, "Distance between planted trees, m (with --layout)")
+        ->check(CLI::PositiveNumber)->capture_default_str();
+    e->add_flag("--no-xgboost", evaluate->no_xgboost, "Skip the XGBoost baseline");
+    e->add_flag("--no-site-split", evaluate->no_site_split, "Skip the leave-one-site-out split");
+    add_feature_flags(e, evaluate->flags);
+    e->callback([evaluate, &global, &job] { job = [evaluate, &global] { return run_evaluate(*evaluate, global); }; });
+}
+
+}  // namespace treelobes::cli

@@ -1,0 +1,285 @@
+// `treelobes reconstruct INPUT... --out DIR`: one skeleton, branch mesh, labelled points and
+// summary per single-tree scan (issue 4, seed 001 §4.1). Trees are independent: a failing
+// input is listed in DIR/failures.jsonl and the others go on (exit 3). Finished trees are
+// skipped on a re-run unless --overwrite.
+#include "apps/command.hpp"
+#include "config/species_library.hpp"
+#include "core/atomic_file.hpp"
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/mesh_io.hpp"
+#include "core/skeleton_io.hpp"
+#include "core/version.hpp"
+#include "reconstruct/branch_mesh.hpp"
+#include "reconstruct/reconstruct_tree.hpp"
+
+#include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
+
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <set>
+
+namespace fs = std::filesystem;
+
+namespace treelobes::cli {
+
+namespace {
+
+struct ReconstructCliOptions {
+    std::vector<std::string> inputs;
+    std::string out;
+    std::string species;
+    std::optional<double> beta, gamma, fs;
+    std::string ground = "auto";
+    std::string mesh_format = "ply";
+    bool overwrite = false;
+    bool reject_non_trees = false;
+    ReconstructOptions stage;
+    BranchMeshOptions mesh;
+};
+
+struct TreeOutputs {
+    fs::path skeleton, branches, points, summary;
+};
+
+TreeOutputs outputs_for(const ReconstructCliOptions& o, const fs::path& input) {
+    const fs::path dir(o.out);
+    const std::string stem = input.stem().string();
+    return {dir / (stem + "_skeleton.ply"), dir / (stem + "_branches." + o.mesh_format), dir / (stem + "_points.ply"),
+            dir / (stem + "_summary.json")};
+}
+
+double peak_memory_mb() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
+}
+
+// Rounded for readable JSON (floats would print as 0.30000001192092896).
+double rounded(double value, int digits = 4) {
+    const double scale = std::pow(10.0, digits);
+    return std::round(value * scale) / scale;
+}
+
+// Species parameters first, explicit --beta/--gamma/--fs on top.
+void resolve_species(ReconstructCliOptions& o) {
+    if (!o.species.empty()) {
+        const SpeciesEntry entry = find_species(load_species_entries(default_species_file()), o.species);
+        o.species = entry.name;
+        o.stage.skeleton.beta = entry.reconstruction.beta;
+        o.stage.allometry.gamma = entry.reconstruction.gamma;
+        o.stage.allometry.fs = entry.reconstruction.fs;
+    }
+    if (o.beta) o.stage.skeleton.beta = *o.beta;
+    if (o.gamma) o.stage.allometry.gamma = *o.gamma;
+    if (o.fs) o.stage.allometry.fs = *o.fs;
+    o.stage.preprocess.ground = parse_ground_mode(o.ground);
+}
+
+nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s) {
+    const auto& k = o.stage.skeleton;
+    return {{"species", o.species.empty() ? nlohmann::json() : nlohmann::json(o.species)},
+            {"beta", k.beta},
+            {"gamma", o.stage.allometry.gamma},
+            {"fs", o.stage.allometry.fs},
+            {"neighbours", k.neighbours},
+            {"bin_width", rounded(s.bin_width)},
+            {"internode_length", rounded(s.internode_length)},
+            {"min_twig_length", k.min_twig_length},
+            {"smoothing_iterations", k.smoothing_iterations},
+            {"root_diameter", o.stage.root_diameter},
+            {"voxel_size", o.stage.preprocess.voxel_size},
+            {"outlier_neighbours", o.stage.preprocess.outlier_neighbours},
+            {"outlier_sigma", o.stage.preprocess.outlier_sigma},
+            {"ground", o.ground},
+            {"mesh_sides", o.mesh.sides},
+            {"mesh_subdivisions", o.mesh.subdivisions}};
+}
+
+nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& input, const TreeOutputs& out,
+                            const TreeReconstruction& r) {
+    const TreeSummary& s = r.summary;
+    nlohmann::json seconds = nlohmann::json::object();
+    double total = 0;
+    for (const auto& [stage, t] : s.seconds) {
+        seconds[stage] = rounded(t);
+        total += t;
+    }
+    seconds["total"] = rounded(total);
+    return {{"treelobes", kVersion},
+            {"input", input.string()},
+            {"options", options_json(o, s)},
+            {"points", {{"input", s.input_points}, {"used", s.used_points}, {"duplicates", s.duplicates},
+                        {"outliers", s.outliers}, {"ground", s.ground_points}}},
+            {"tree", {{"height", rounded(s.height, 3)},
+                      {"dbh", s.dbh_fitted ? nlohmann::json(rounded(s.dbh, 3)) : nlohmann::json()},
+                      {"root_diameter", rounded(s.root_diameter, 3)},
+                      {"root_diameter_source", s.root_diameter_source},
+                      {"crown_width", rounded(s.crown_width, 3)},
+                      {"total_branch_length", rounded(s.total_length, 3)},
+                      {"branches", s.branches},
+                      {"internodes", s.internodes},
+                      {"tips", s.tips},
+                      {"max_branch_order", s.max_branch_order},
+                      {"stem_visible", s.stem_visible},
+                      {"ground_removed", s.ground_removed}}},
+            {"graph", {{"spacing", rounded(s.spacing)}, {"components", s.graph_components}, {"bridges", s.bridges},
+                       {"longest_bridge", rounded(s.longest_bridge)}}},
+            {"quality", {{"not_a_tree", s.quality.not_a_tree}, {"planar_fraction", rounded(s.quality.planar_fraction, 3)},
+                         {"flags", s.quality.flags}}},
+            {"outputs", {{"skeleton", out.skeleton.string()}, {"branches", out.branches.string()},
+                         {"points", out.points.string()}}},
+            {"seconds", seconds},
+            {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
+}
+
+void write_points(const PointCloud& cloud, const TreeReconstruction& r, const fs::path& path) {
+    PointCloud labelled = cloud;
+    auto& internode = labelled.add_extra("internode", AttributeType::Int32);
+    internode.values.assign(r.point_internode.begin(), r.point_internode.end());
+    auto& geodesic = labelled.add_extra("geodesic", AttributeType::Float32);
+    geodesic.values.assign(r.point_geodesic.begin(), r.point_geodesic.end());
+    write_point_cloud(labelled, path);
+}
+
+void print_human(const fs::path& input, const TreeSummary& s, double seconds) {
+    std::printf("%s: %zu points -> %zu internodes, %zu branches, %.1f m of branches; height %.2f m, ", input.string().c_str(),
+                s.input_points, s.internodes, s.branches, s.total_length, s.height);
+    if (s.dbh_fitted) std::printf("DBH %.3f m", s.dbh);
+    else std::printf("DBH n/a");
+    std::printf(", crown %.2f m, %.2f s\n", s.crown_width, seconds);
+    if (!s.quality.flags.empty()) {
+        std::printf("  flags:");
+        for (const auto& f : s.quality.flags) std::printf(" %s", f.c_str());
+        std::printf("%s\n", s.quality.not_a_tree ? "  (this does not look like a tree)" : "");
+    }
+}
+
+// Runs one input; returns its summary. Throws treelobes::Error for bad input.
+nlohmann::json run_one(const ReconstructCliOptions& o, const fs::path& input, const TreeOutputs& out, const GlobalOptions& global) {
+    const auto start = std::chrono::steady_clock::now();
+    const PointCloud cloud = read_point_cloud(input);
+    TreeReconstruction r = reconstruct_tree(cloud, o.stage, input.string());
+    if (o.reject_non_trees && r.summary.quality.not_a_tree)
+        throw Error::input(input.string(), "not a tree: " + std::to_string(r.summary.quality.planar_fraction) +
+                                               " of the points lie on wide planes (drop --reject-non-trees to keep it)");
+    auto mark = std::chrono::steady_clock::now();
+    const TriangleMesh mesh = build_branch_mesh(r.skeleton, o.mesh);
+    r.summary.seconds.emplace_back("mesh", std::chrono::duration<double>(std::chrono::steady_clock::now() - mark).count());
+    mark = std::chrono::steady_clock::now();
+    write_skeleton_ply(r.skeleton, out.skeleton);
+    write_mesh(mesh, out.branches);
+    write_points(cloud, r, out.points);
+    r.summary.seconds.emplace_back("write", std::chrono::duration<double>(std::chrono::steady_clock::now() - mark).count());
+    nlohmann::json summary = summary_json(o, input, out, r);
+    write_file_atomically(out.summary, summary.dump(2) + "\n");  // last: its presence marks a finished tree
+    if (!global.json) print_human(input, r.summary, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    return summary;
+}
+
+int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
+    std::unique_ptr<tbb::global_control> threads;
+    if (global.threads > 0)
+        threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(global.threads));
+    resolve_species(o);
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
+
+    nlohmann::json trees = nlohmann::json::array(), failures = nlohmann::json::array(), skipped = nlohmann::json::array();
+    std::set<std::string> stems;
+    int last_code = 0;
+    for (const auto& name : o.inputs) {
+        const fs::path input(name);
+        const TreeOutputs out = outputs_for(o, input);
+        try {
+            if (!stems.insert(input.stem().string()).second)
+                throw Error::input(name, "another input has the same name stem; its outputs would be overwritten");
+            if (!o.overwrite && fs::exists(out.summary) && fs::exists(out.skeleton) && fs::exists(out.branches) && fs::exists(out.points)) {
+                log_info(name + ": already reconstructed in " + o.out + " (use --overwrite to redo)");
+                skipped.push_back(name);
+                continue;
+            }
+            trees.push_back(run_one(o, input, out, global));
+        } catch (const Error& e) {
+            if (e.code() == ExitCode::Usage) throw;  // a bad option fails every tree alike
+            std::cerr << "treelobes: error: " << e.what() << "\n";
+            failures.push_back({{"input", name}, {"reason", e.what()}, {"exit_code", static_cast<int>(e.code())}});
+            last_code = static_cast<int>(e.code());
+        } catch (const std::exception& e) {
+            std::cerr << "treelobes: internal error on " << name << ": " << e.what() << "\n";
+            failures.push_back({{"input", name}, {"reason", std::string("internal error: ") + e.what()},
+                                {"exit_code", static_cast<int>(ExitCode::Internal)}});
+            last_code = static_cast<int>(ExitCode::Internal);
+        }
+    }
+    if (!failures.empty()) {
+        std::string lines;
+        for (const auto& f : failures) lines += f.dump() + "\n";
+        write_file_atomically(fs::path(o.out) / "failures.jsonl", lines);
+    }
+    if (global.json)
+        std::cout << nlohmann::json{{"treelobes", kVersion}, {"command", "reconstruct"}, {"out", o.out}, {"trees", trees},
+                                    {"skipped", skipped}, {"failures", failures}}.dump(2) << "\n";
+    else
+        std::printf("reconstructed %zu of %zu input(s) into %s (%zu failed, %zu skipped)\n", trees.size(), o.inputs.size(),
+                    o.out.c_str(), failures.size(), skipped.size());
+    if (failures.empty()) return 0;
+    return o.inputs.size() == 1 ? last_code : static_cast<int>(ExitCode::PartialFailure);
+}
+
+void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
+    sub->add_option("inputs", o.inputs, "Point clouds of single trees (LAS, PLY, PCD, XYZ/CSV)")->required();
+    sub->add_option("--out", o.out, "Output folder")->required();
+    sub->add_option("--species", o.species, "Species from config/species.yaml: sets beta, gamma and f_s");
+    sub->add_option("--beta", o.beta, "Edge weight exponent ||u-v||^beta (default 1.5, or the species')")->check(CLI::PositiveNumber);
+    sub->add_option("--gamma", o.gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(CLI::PositiveNumber);
+    sub->add_option("--fs", o.fs, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')")->check(CLI::Range(0.01, 1.0));
+    auto& k = o.stage.skeleton;
+    sub->add_option("--neighbours", k.neighbours, "k of the neighbour graph")->check(CLI::Range(2, 64))->capture_default_str();
+    sub->add_option("--bin-width", k.bin_width, "Geodesic bin width in metres (0 = from point spacing)")->check(CLI::NonNegativeNumber);
+    sub->add_option("--internode-length", k.internode_length, "Skeleton internode length in metres (0 = from point spacing)")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--min-twig-length", k.min_twig_length, "Prune leaf branches shorter than this, metres (0 = two bins)")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--smoothing", k.smoothing_iterations, "Smoothing passes over the skeleton")->check(CLI::Range(0, 100))->capture_default_str();
+    sub->add_option("--geodesic-smoothing", k.geodesic_smoothing, "Neighbour-averaging passes over the geodesic field before binning")
+        ->check(CLI::Range(0, 50))->capture_default_str();
+    sub->add_option("--max-gap", k.max_gap, "Leave parts joined only across a longer gap (metres) out of the skeleton (0 = keep all)")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--fit-axes", k.fit_axes, "Centre wide branch slices on fitted circles (true/false)")->capture_default_str();
+    sub->add_option("--root-diameter", o.stage.root_diameter, "Stem diameter at the base in metres (0 = from the stem fit)")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--voxel-size", o.stage.preprocess.voxel_size, "Keep one point per voxel of this size in metres (0 = off)")
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--outlier-neighbours", o.stage.preprocess.outlier_neighbours, "k of the outlier filter (0 = off)")
+        ->check(CLI::Range(0, 64))->capture_default_str();
+    sub->add_option("--ground", o.ground, "Ground points: auto (remove a detected ground plane), remove, keep")
+        ->check(CLI::IsMember({"auto", "remove", "keep"}))->capture_default_str();
+    sub->add_option("--mesh-sides", o.mesh.sides, "Vertices per ring of the branch mesh")->check(CLI::Range(3, 64))->capture_default_str();
+    sub->add_option("--mesh-subdivisions", o.mesh.subdivisions, "Rings per internode of the branch mesh")->check(CLI::Range(1, 16))
+        ->capture_default_str();
+    sub->add_option("--mesh-format", o.mesh_format, "Branch mesh format")->check(CLI::IsMember({"ply", "obj", "off"}))->capture_default_str();
+    sub->add_flag("--overwrite", o.overwrite, "Redo trees whose outputs exist");
+    sub->add_flag("--reject-non-trees", o.reject_non_trees, "Fail inputs flagged as not a tree instead of only flagging them");
+}
+
+}  // namespace
+
+void add_reconstruct_command(CLI::App& app, const GlobalOptions& global, Job& job) {
+    auto options = std::make_shared<ReconstructCliOptions>();
+    CLI::App* sub = app.add_subcommand("reconstruct", "Skeleton, radii, branch mesh and summary of single-tree scans");
+    add_flags(sub, *options);
+    sub->callback([options, &global, &job] { job = [options, &global] { return run_reconstruct(*options, global); }; });
+}
+
+}  // namespace treelobes::cli

@@ -1,0 +1,240 @@
+#include "classify/evaluation.hpp"
+
+#include "classify/splits.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "synth/random.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace treelobes::classify {
+
+LabelledSet make_labelled_set(const FeatureTable& features, const std::vector<TreeLabel>& labels, const std::string& labels_file) {
+    const auto rows = labels_for_rows(features, labels, labels_file);
+    LabelledSet set;
+    set.features = features;
+    std::set<std::string> names;
+    for (const auto& l : rows) names.insert(l.species);
+    set.classes.assign(names.begin(), names.end());
+    bool positions = true, groups = false;
+    for (const auto& l : rows) {
+        set.labels.push_back(static_cast<int>(std::lower_bound(set.classes.begin(), set.classes.end(), l.species) - set.classes.begin()));
+        positions = positions && l.x && l.y;
+        groups = groups || !l.group.empty();
+    }
+    if (positions)
+        for (const auto& l : rows) set.positions.emplace_back(*l.x, *l.y);
+    if (groups)
+        for (const auto& l : rows) set.groups.push_back(l.group);
+    return set;
+}
+
+std::vector<Eigen::Vector2d> planting_layout(const std::vector<int>& labels, int classes, bool grouped, double spacing_m,
+                                             std::uint64_t seed) {
+    if (!(spacing_m > 0)) throw Error::usage("planting layout: the spacing must be positive");
+    std::vector<Eigen::Vector2d> out(labels.size());
+    if (grouped) {
+        std::vector<int> planted(classes, 0);
+        for (std::size_t i = 0; i < labels.size(); ++i) out[i] = {250.0 * labels[i], spacing_m * planted[labels[i]]++};
+        return out;
+    }
+    std::vector<std::size_t> order(labels.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    synth::Rng rng(synth::stream_seed(seed, 0x1a7047));
+    for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
+    const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(labels.size()))));
+    for (std::size_t k = 0; k < order.size(); ++k)
+        out[order[k]] = {spacing_m * static_cast<double>(k % side), spacing_m * static_cast<double>(k / side)};
+    return out;
+}
+
+namespace {
+
+int argmax(const std::vector<double>& p) { return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin()); }
+
+// Accumulates the scores of one classifier over experiments.
+class ScoreAccumulator {
+public:
+    explicit ScoreAccumulator(int classes)
+        : classes_(classes), rate_sum_(classes, 0), rate_count_(classes, 0), voted_sum_(classes, 0),
+          confusion_(classes, std::vector<double>(classes, 0)) {}
+
+    void add(const std::vector<int>& truth, const std::vector<int>& predicted, const std::vector<bool>& confident,
+             const std::vector<int>* voted, const ClassifierRun& run) {
+        std::vector<int> total(classes_, 0), correct(classes_, 0), voted_correct(classes_, 0);
+        for (std::size_t i = 0; i < truth.size(); ++i) {
+            ++total[truth[i]];
+            const bool ok = predicted[i] == truth[i];
+            correct[truth[i]] += ok;
+            confusion_[truth[i]][predicted[i]] += 1;
+            tree_correct_ += ok, ++tree_total_;
+            if (confident[i]) confident_correct_ += ok, ++confident_total_;
+            else unconfident_correct_ += ok;
+            if (voted) {
+                const bool v = (*voted)[i] == truth[i];
+                voted_correct[truth[i]] += v;
+                voted_tree_correct_ += v;
+            }
+        }
+        for (int c = 0; c < classes_; ++c) {
+            if (total[c] == 0) continue;
+            rate_sum_[c] += static_cast<double>(correct[c]) / total[c];
+            voted_sum_[c] += static_cast<double>(voted_correct[c]) / total[c];
+            ++rate_count_[c];
+        }
+        voted_ = voted != nullptr;
+        train_seconds_ += run.train_seconds, predict_seconds_ += run.predict_seconds, rounds_ += run.rounds;
+        ++experiments_;
+    }
+
+    Scores scores(const std::vector<int>& labels, const std::vector<int>& train_counts) const {
+        Scores s;
+        s.experiments = experiments_;
+        s.confusion = confusion_;
+        s.species_trees.assign(classes_, 0);
+        for (int y : labels) ++s.species_trees[y];
+        s.species_train = train_counts;
+        s.species_rate.assign(classes_, 0);
+        s.voted_species_rate.assign(classes_, 0);
+        int rated = 0;
+        for (int c = 0; c < classes_; ++c) {
+            if (rate_count_[c] == 0) continue;
+            s.species_rate[c] = rate_sum_[c] / rate_count_[c];
+            s.voted_species_rate[c] = voted_sum_[c] / rate_count_[c];
+            s.average_rate += s.species_rate[c];
+            s.voted_average_rate += s.voted_species_rate[c];
+            ++rated;
+        }
+        if (rated > 0) s.average_rate /= rated, s.voted_average_rate /= rated;
+        const auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
+        s.tree_accuracy = ratio(tree_correct_, tree_total_);
+        s.confident_fraction = ratio(confident_total_, tree_total_);
+        s.confident_accuracy = ratio(confident_correct_, confident_total_);
+        s.unconfident_accuracy = ratio(unconfident_correct_, tree_total_ - confident_total_);
+        s.voted = voted_;
+        if (!voted_) s.voted_average_rate = 0, s.voted_species_rate.assign(classes_, 0);
+        s.voted_tree_accuracy = voted_ ? ratio(voted_tree_correct_, tree_total_) : 0.0;
+        s.train_seconds = train_seconds_, s.predict_seconds = predict_seconds_;
+        s.mean_rounds = ratio(rounds_, experiments_);
+        return s;
+    }
+
+private:
+    int classes_;
+    std::vector<double> rate_sum_;
+    std::vector<int> rate_count_;
+    std::vector<double> voted_sum_;
+    std::vector<std::vector<double>> confusion_;
+    double tree_correct_ = 0, tree_total_ = 0, confident_correct_ = 0, confident_total_ = 0, unconfident_correct_ = 0;
+    double voted_tree_correct_ = 0, train_seconds_ = 0, predict_seconds_ = 0, rounds_ = 0;
+    int experiments_ = 0;
+    bool voted_ = false;
+};
+
+// Trains on `train` rows and predicts `test` rows. Classes absent from the training rows (a site
+// split can leave a species out) are dropped for training and get probability 0.
+ClassifierRun run_experiment(const LabelledSet& set, const Classifier& classifier, const std::vector<std::size_t>& train,
+                             const std::vector<std::size_t>& test, std::uint64_t seed) {
+    const int classes = static_cast<int>(set.classes.size());
+    std::vector<int> compact(classes, -1), original;
+    for (auto r : train)
+        if (compact[set.labels[r]] < 0) compact[set.labels[r]] = 0;
+    for (int c = 0; c < classes; ++c)
+        if (compact[c] == 0) compact[c] = static_cast<int>(original.size()), original.push_back(c);
+    std::vector<int> y;
+    for (auto r : train) y.push_back(compact[set.labels[r]]);
+    ClassifierRun run = classifier(set.features.select_rows(train), y, static_cast<int>(original.size()), set.features.select_rows(test), seed);
+    for (auto& p : run.probabilities) {
+        std::vector<double> full(classes, 0.0);
+        for (std::size_t k = 0; k < original.size(); ++k) full[original[k]] = p[k];
+        p = std::move(full);
+    }
+    return run;
+}
+
+void score_experiment(const LabelledSet& set, const std::vector<std::size_t>& test, const ClassifierRun& run,
+                      const EvaluationOptions& options, ScoreAccumulator& acc) {
+    std::vector<int> truth, predicted;
+    std::vector<bool> confident;
+    std::vector<Eigen::Vector2d> positions;
+    for (std::size_t i = 0; i < test.size(); ++i) {
+        truth.push_back(set.labels[test[i]]);
+        predicted.push_back(argmax(run.probabilities[i]));
+        confident.push_back(is_confident(run.probabilities[i], options.voting.confidence_factor));
+        if (!set.positions.empty()) positions.push_back(set.positions[test[i]]);
+    }
+    if (set.positions.empty()) {
+        acc.add(truth, predicted, confident, nullptr, run);
+        return;
+    }
+    const VotingResult vote = spatial_vote(run.probabilities, positions, options.voting);
+    acc.add(truth, predicted, confident, &vote.species, run);
+}
+
+}  // namespace
+
+EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassifier>& classifiers, const EvaluationOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    if (options.splits < 1) throw Error::usage("--splits must be at least 1");
+    if (!(options.train_fraction > 0 && options.train_fraction < 1)) throw Error::usage("the training fraction must be in (0, 1)");
+    const int classes = static_cast<int>(set.classes.size());
+    if (classes < 2) throw Error::input("", "evaluation needs at least two species, got " + std::to_string(classes));
+    std::vector<int> count(classes, 0);
+    for (int y : set.labels) ++count[y];
+    for (int c = 0; c < classes; ++c)
+        if (count[c] < 2)
+            throw Error::input("", "species '" + set.classes[c] + "' has " + std::to_string(count[c]) +
+                                       " tree(s); every species needs 2 or more to be trained and tested");
+
+    EvaluationReport report;
+    report.classes = set.classes;
+    std::vector<ScoreAccumulator> random_acc(classifiers.size(), ScoreAccumulator(classes));
+    std::vector<int> train_counts(classes, 0);
+    Progress progress("classify evaluate: random splits", static_cast<std::size_t>(options.splits));
+    for (int s = 0; s < options.splits; ++s) {
+        const std::uint64_t seed = synth::stream_seed(options.seed, static_cast<std::uint64_t>(s));
+        std::vector<std::size_t> train, test;
+        stratified_split(set.labels, classes, options.train_fraction, seed, true, train, test);
+        if (s == 0)
+            for (auto r : train) ++train_counts[set.labels[r]];
+        for (std::size_t k = 0; k < classifiers.size(); ++k)
+            score_experiment(set, test, run_experiment(set, classifiers[k].run, train, test, seed), options, random_acc[k]);
+        progress.advance();
+    }
+    progress.finish();
+
+    std::vector<std::string> groups;
+    if (options.site_split && !set.groups.empty()) {
+        std::set<std::string> distinct(set.groups.begin(), set.groups.end());
+        groups.assign(distinct.begin(), distinct.end());
+    }
+    std::vector<ScoreAccumulator> site_acc(classifiers.size(), ScoreAccumulator(classes));
+    if (groups.size() >= 2) {
+        report.site_groups = groups;
+        Progress site_progress("classify evaluate: site split", groups.size());
+        for (std::size_t g = 0; g < groups.size(); ++g) {
+            std::vector<std::size_t> train, test;
+            for (std::size_t r = 0; r < set.labels.size(); ++r) (set.groups[r] == groups[g] ? test : train).push_back(r);
+            const std::uint64_t seed = synth::stream_seed(options.seed, 1000000 + g);
+            for (std::size_t k = 0; k < classifiers.size(); ++k)
+                score_experiment(set, test, run_experiment(set, classifiers[k].run, train, test, seed), options, site_acc[k]);
+            site_progress.advance();
+        }
+        site_progress.finish();
+    }
+    for (std::size_t k = 0; k < classifiers.size(); ++k) {
+        ClassifierReport r;
+        r.name = classifiers[k].name;
+        r.random_splits = random_acc[k].scores(set.labels, train_counts);
+        if (groups.size() >= 2) r.site_split = site_acc[k].scores(set.labels, {});
+        report.classifiers.push_back(std::move(r));
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+}  // namespace treelobes::classify

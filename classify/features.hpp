@@ -1,0 +1,55 @@
+// Shape features of one tree for species classification (seed 001 §6.1): more than 200 numbers
+// from the points and from a first skeleton reconstruction. docs/features.md lists every feature
+// with its unit and how it is computed; `feature_catalogue()` is the same list in code, and the
+// extractor checks each value it emits against it.
+//
+// Invariance: every feature is computed in the tree's own frame (origin at the stem foot, z up,
+// horizontal directions relative to the crown's principal axes), so it does not change when the
+// tree is moved or turned about the vertical. Density: the points are first reduced to one per
+// voxel of a size proportional to the tree height, and features are distributions (fractions,
+// quantiles, moments, angles) of those voxel points, so a thinned scan gives nearly the same
+// vector. Only the trunk diameter and the point-count variation read the raw points.
+#pragma once
+
+#include "core/point_cloud.hpp"
+
+#include <string>
+#include <vector>
+
+namespace treelobes::classify {
+
+struct FeatureOptions {
+    // Voxel size = height x voxel_fraction, clamped to [min_voxel, max_voxel] metres.
+    double voxel_fraction = 0.01;
+    double min_voxel = 0.03;
+    double max_voxel = 0.25;
+    int normal_neighbours = 12;      // k of the local PCA (normals, curvature, eigen-features)
+    bool skeleton = true;            // false: the skeleton group is filled with zeros (faster)
+    std::size_t max_raw_points = 400000;  // raw points read for the trunk and count features (evenly thinned above)
+};
+
+struct FeatureInfo {
+    std::string name;
+    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton
+    std::string unit;         // "m", "deg", "1" (dimensionless), "count", "1/m"
+    std::string description;  // how it is computed
+};
+
+// Every feature, in the order of the vectors below.
+const std::vector<FeatureInfo>& feature_catalogue();
+std::vector<std::string> feature_names();
+
+// Time spent per group (seconds) for the benchmark.
+struct FeatureTimings {
+    double prepare = 0, points = 0, normals = 0, hull = 0, skeleton = 0;
+};
+
+// The features of one tree's points (z up, metres). Throws Error::input naming `name` when the
+// cloud has too few points or is too flat to be a tree.
+std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptions& options = {},
+                                     const std::string& name = {}, FeatureTimings* timings = nullptr);
+
+// docs/features.md as generated from the catalogue (a test keeps the committed file in sync).
+std::string features_markdown();
+
+}  // namespace treelobes::classify

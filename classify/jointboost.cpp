@@ -1,0 +1,528 @@
+#include "classify/jointboost.hpp"
+
+#include "classify/splits.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+
+#include <nlohmann/json.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+namespace treelobes::classify {
+
+void Stump::finalise(int classes) {
+    above.assign(k.begin(), k.end());
+    below.assign(k.begin(), k.end());
+    for (int c : sharing) {
+        above[c] = a;
+        below[c] = b;
+    }
+    (void)classes;
+}
+
+std::vector<double> probabilities_from_scores(const std::vector<double>& scores) {
+    std::vector<double> p(scores.size());
+    double sum = 0;
+    for (std::size_t c = 0; c < scores.size(); ++c) sum += p[c] = 1.0 / (1.0 + std::exp(-2.0 * scores[c]));
+    for (double& v : p) v /= sum;
+    return p;
+}
+
+std::vector<double> JointBoostModel::scores(const double* features) const {
+    std::vector<double> h(classes.size(), 0.0);
+    for (const auto& s : stumps) {
+        const auto& values = features[s.feature] > s.threshold ? s.above : s.below;
+        for (std::size_t c = 0; c < h.size(); ++c) h[c] += values[c];
+    }
+    return h;
+}
+
+std::vector<double> JointBoostModel::probabilities(const double* features) const {
+    return probabilities_from_scores(scores(features));
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr int kMaxStackClasses = 64;
+
+// Contribution z^2/w of one side of a stump to the gain (the error is sum(w) - gain).
+inline double term(double z, double w) { return w > 0 ? z * z / w : 0.0; }
+
+void validate_training_input(const FeatureTable& table, const std::vector<int>& labels,
+                             const std::vector<std::string>& classes) {
+    if (labels.size() != table.rows())
+        throw Error(ExitCode::Internal, "JointBoost: " + std::to_string(labels.size()) + " labels for " +
+                                            std::to_string(table.rows()) + " rows");
+    if (classes.size() < 2) throw Error::input("", "JointBoost needs at least two classes, got " + std::to_string(classes.size()));
+    if (table.cols() == 0) throw Error::input("", "JointBoost: the feature table has no features");
+    std::vector<int> count(classes.size(), 0);
+    for (int y : labels) {
+        if (y < 0 || y >= static_cast<int>(classes.size())) throw Error(ExitCode::Internal, "JointBoost: label out of range");
+        ++count[y];
+    }
+    for (std::size_t c = 0; c < classes.size(); ++c)
+        if (count[c] == 0) throw Error::input("", "JointBoost: class '" + classes[c] + "' has no training trees");
+    for (std::size_t r = 0; r < table.rows(); ++r)
+        for (std::size_t f = 0; f < table.cols(); ++f)
+            if (!std::isfinite(table.at(r, f)))
+                throw Error::input("", "tree '" + table.ids[r] + "': feature '" + table.feature_names[f] + "' is not finite");
+}
+
+// The best stump of one feature: its gain (error reduction relative to sum(w)), threshold
+// position and sharing set.
+struct Candidate {
+    double gain = -kInf;
+    int feature = -1;
+    int position = -1;          // split between sorted positions position and position + 1
+    std::vector<int> sharing;   // ascending
+};
+
+// One boosting run over a fixed training set.
+class RoundFitter {
+public:
+    RoundFitter(const FeatureTable& table, const std::vector<int>& labels, int classes)
+        : table_(table), labels_(labels), n_(table.rows()), f_(table.cols()), c_(classes),
+          weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0), order_(table.cols()) {
+        presort();
+    }
+
+    // Fits the stump of the next round; false when no feature has two distinct values.
+    //
+    // Exact branch and bound: for each threshold, separate stumps per class bound the gain of
+    // any shared stump (Cauchy-Schwarz: (sum z)^2 / sum w <= sum z^2 / w). Phase 1 computes the
+    // bounds of all thresholds; phase 2 runs the greedy sharing search only where the bound can
+    // still beat the best gain found so far, features with the highest bound first. A threshold
+    // is skipped only when it cannot win or tie, so the result equals the exhaustive search.
+    bool fit(Stump& stump) {
+        compute_class_totals();
+        std::vector<std::vector<std::pair<double, int>>> bounds(f_);  // per feature: (bound, position), best first
+        tbb::parallel_for(std::size_t(0), f_, [&](std::size_t f) { bounds[f] = threshold_bounds(f); });
+        std::vector<std::size_t> visit;
+        for (std::size_t f = 0; f < f_; ++f)
+            if (!bounds[f].empty()) visit.push_back(f);
+        if (visit.empty()) return false;
+        std::stable_sort(visit.begin(), visit.end(),
+                         [&](std::size_t a, std::size_t b) { return bounds[a].front().first > bounds[b].front().first; });
+        std::vector<Candidate> per_feature(f_);
+        SharedBest shared;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, visit.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t v = r.begin(); v != r.end(); ++v)
+                per_feature[visit[v]] = best_for_feature(visit[v], bounds[visit[v]], shared);
+        });
+        // Serial reduction in feature order: the lower feature index wins a tie.
+        const Candidate* best = nullptr;
+        for (const auto& candidate : per_feature)
+            if (candidate.feature >= 0 && (!best || candidate.gain > best->gain)) best = &candidate;
+        stump = make_stump(*best);
+        return true;
+    }
+
+    // w <- w exp(-z h), renormalised to a mean of 1. Returns the training loss, the mean of
+    // exp(-z H) over trees and classes (the weights before renormalisation tell it).
+    double update(const Stump& stump) {
+        for (std::size_t i = 0; i < n_; ++i) {
+            const auto& h = table_.at(i, stump.feature) > stump.threshold ? stump.above : stump.below;
+            for (int c = 0; c < c_; ++c) weight(i, c) *= std::exp(-(labels_[i] == c ? 1.0 : -1.0) * h[c]);
+        }
+        const double mean = std::accumulate(weights_.begin(), weights_.end(), 0.0) / static_cast<double>(weights_.size());
+        for (double& w : weights_) w /= mean;
+        loss_ *= mean;
+        return loss_;
+    }
+
+private:
+    double& weight(std::size_t i, int c) { return weights_[i * static_cast<std::size_t>(c_) + c]; }
+    double weight(std::size_t i, int c) const { return weights_[i * static_cast<std::size_t>(c_) + c]; }
+    double value(std::size_t i, std::size_t f) const { return table_.at(i, f); }
+
+    // Sample indices sorted by each feature (stable: equal values keep row order). Constant
+    // features get an empty order and are never split.
+    void presort() {
+        tbb::parallel_for(std::size_t(0), f_, [&](std::size_t f) {
+            std::vector<int> order(n_);
+            std::iota(order.begin(), order.end(), 0);
+            std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return value(i, f) < value(j, f); });
+            if (n_ > 1 && value(order.front(), f) < value(order.back(), f)) order_[f] = std::move(order);
+        });
+    }
+
+    // Per class: total weight W_c, signed total Z_c and the gain K_c = Z_c^2 / W_c of the
+    // constant k_c = Z_c / W_c used for classes outside the sharing set.
+    void compute_class_totals() {
+        total_w_.assign(c_, 0.0);
+        total_z_.assign(c_, 0.0);
+        k_gain_.assign(c_, 0.0);
+        signed_weights_.resize(weights_.size());
+        for (std::size_t i = 0; i < n_; ++i)
+            for (int c = 0; c < c_; ++c) {
+                const double w = weight(i, c);
+                signed_weights_[i * c_ + c] = labels_[i] == c ? w : -w;
+                total_w_[c] += w;
+                total_z_[c] += signed_weights_[i * c_ + c];
+            }
+        for (int c = 0; c < c_; ++c) k_gain_[c] = term(total_z_[c], total_w_[c]);
+        k_gain_sum_ = std::accumulate(k_gain_.begin(), k_gain_.end(), 0.0);
+    }
+
+    // Greedy forward selection of the sharing set for one threshold, given per-class sums below
+    // (wl, zl) and above (wg, zg). Returns the best gain on the path and writes its set.
+    // The path is cut when no extension can reach `floor` (a gain already found): a superset T of
+    // S gains at most pooled(S) + sum over c outside S of max(ind_c, K_c) (Cauchy-Schwarz again),
+    // so the cut never changes the round's winner.
+    double greedy_sharing(const double* wl, const double* zl, const double* wg, const double* zg, double floor,
+                          std::vector<int>& path, int& best_size) const {
+        double sum_wl = 0, sum_zl = 0, sum_wg = 0, sum_zg = 0, outside = k_gain_sum_;
+        double individual[kMaxStackClasses], rest = 0;
+        std::vector<double> heap_individual;
+        double* ind = individual;
+        if (c_ > kMaxStackClasses) heap_individual.resize(c_), ind = heap_individual.data();
+        for (int c = 0; c < c_; ++c) rest += ind[c] = std::max(term(zg[c], wg[c]) + term(zl[c], wl[c]), k_gain_[c]);
+        const double cut = floor - 1e-9 * std::abs(floor);
+        std::uint64_t in_small = 0;
+        std::vector<char> in_large(c_ > 64 ? c_ : 0, 0);
+        auto is_in = [&](int c) { return c < 64 ? ((in_small >> c) & 1u) != 0 : in_large[c] != 0; };
+        double best = -kInf;
+        best_size = 0;
+        for (int step = 0; step < c_; ++step) {
+            int chosen = -1;
+            double chosen_gain = -kInf;
+            for (int c = 0; c < c_; ++c) {
+                if (is_in(c)) continue;
+                const double g = term(sum_zg + zg[c], sum_wg + wg[c]) + term(sum_zl + zl[c], sum_wl + wl[c]) +
+                                 (outside - k_gain_[c]);
+                if (g > chosen_gain) chosen_gain = g, chosen = c;  // lowest class index wins a tie
+            }
+            if (chosen < 64) in_small |= std::uint64_t(1) << chosen;
+            else in_large[chosen] = 1;
+            path[step] = chosen;
+            sum_wl += wl[chosen], sum_zl += zl[chosen], sum_wg += wg[chosen], sum_zg += zg[chosen];
+            outside -= k_gain_[chosen];
+            rest -= ind[chosen];
+            if (chosen_gain > best) best = chosen_gain, best_size = step + 1;  // smaller set wins a tie
+            if (term(sum_zg, sum_wg) + term(sum_zl, sum_wl) + rest < cut) break;
+        }
+        return best;
+    }
+
+    // The highest gain found so far by any feature (only ever raised; read for pruning).
+    struct SharedBest {
+        std::atomic<double> gain{-kInf};
+        void raise(double g) {
+            double current = gain.load();
+            while (g > current && !gain.compare_exchange_weak(current, g)) {}
+        }
+        // True when a bound cannot reach the best gain; the margin covers rounding differences
+        // between a bound and the gain it bounds.
+        bool beats(double bound) const {
+            const double best = gain.load();
+            return bound < best - 1e-9 * std::abs(best);
+        }
+    };
+
+    // Per-class sums below (prefix, positions < t) and above (suffix, positions >= t) in the
+    // sorted order of feature f; row t of each has c_ entries. The suffix is summed, not obtained
+    // by subtraction, so a light upper side keeps its precision.
+    void side_sums(std::size_t f, std::vector<double>& pw, std::vector<double>& pz, std::vector<double>& sw,
+                   std::vector<double>& sz) const {
+        const auto& order = order_[f];
+        const std::size_t cc = static_cast<std::size_t>(c_);
+        // Only the empty ends need zeros; every other row is written below (no refill per call).
+        for (auto* v : {&pw, &pz, &sw, &sz}) v->resize((n_ + 1) * cc);
+        std::fill_n(pw.begin(), cc, 0.0), std::fill_n(pz.begin(), cc, 0.0);
+        std::fill_n(sw.begin() + n_ * cc, cc, 0.0), std::fill_n(sz.begin() + n_ * cc, cc, 0.0);
+        for (std::size_t t = 0; t < n_; ++t) {
+            const double* w = &weights_[order[t] * cc];
+            const double* z = &signed_weights_[order[t] * cc];
+            for (std::size_t c = 0; c < cc; ++c) {
+                pw[(t + 1) * cc + c] = pw[t * cc + c] + w[c];
+                pz[(t + 1) * cc + c] = pz[t * cc + c] + z[c];
+            }
+        }
+        for (std::size_t t = n_; t-- > 0;) {
+            const double* w = &weights_[order[t] * cc];
+            const double* z = &signed_weights_[order[t] * cc];
+            for (std::size_t c = 0; c < cc; ++c) {
+                sw[t * cc + c] = sw[(t + 1) * cc + c] + w[c];
+                sz[t * cc + c] = sz[(t + 1) * cc + c] + z[c];
+            }
+        }
+    }
+
+    // Gain bound of every threshold of feature f (split after sorted position t), best first;
+    // empty for a constant feature.
+    std::vector<std::pair<double, int>> threshold_bounds(std::size_t f) const {
+        std::vector<std::pair<double, int>> bounds;
+        const auto& order = order_[f];
+        if (order.empty()) return bounds;
+        thread_local std::vector<double> pw, pz, sw, sz;  // scratch reused across calls
+        side_sums(f, pw, pz, sw, sz);
+        const std::size_t cc = static_cast<std::size_t>(c_);
+        for (std::size_t t = 0; t + 1 < n_; ++t) {
+            if (!(value(order[t + 1], f) > value(order[t], f))) continue;  // not between distinct values
+            const std::size_t row = (t + 1) * cc;
+            double bound = 0;
+            for (int c = 0; c < c_; ++c)
+                bound += std::max(term(sz[row + c], sw[row + c]) + term(pz[row + c], pw[row + c]), k_gain_[c]);
+            bounds.emplace_back(bound, static_cast<int>(t));
+        }
+        // Best bound first; the rest is sorted only if the feature is visited in phase 2.
+        std::iter_swap(bounds.begin(), std::max_element(bounds.begin(), bounds.end(),
+                                                        [](const auto& a, const auto& b) { return a.first < b.first; }));
+        return bounds;
+    }
+
+    // The best stump of feature f: thresholds in decreasing order of their bound until the bound
+    // cannot beat the best gain of any feature so far.
+    Candidate best_for_feature(std::size_t f, std::vector<std::pair<double, int>>& bounds, SharedBest& shared) const {
+        Candidate best;
+        if (shared.beats(bounds.front().first)) return best;
+        thread_local std::vector<double> pw, pz, sw, sz;  // scratch reused across calls
+        side_sums(f, pw, pz, sw, sz);
+        const std::size_t cc = static_cast<std::size_t>(c_);
+        std::vector<int> path(cc);
+        // A heap hands out thresholds by decreasing bound (ties: lower position first) and stops
+        // as soon as the rest cannot win, without sorting them all.
+        const auto lower = [](const auto& a, const auto& b) { return a.first < b.first || (a.first == b.first && a.second > b.second); };
+        std::make_heap(bounds.begin(), bounds.end(), lower);
+        for (auto end = bounds.end(); end != bounds.begin(); --end) {
+            std::pop_heap(bounds.begin(), end, lower);
+            const auto [bound, t] = *(end - 1);
+            if (shared.beats(bound) || bound < best.gain - 1e-9 * std::abs(best.gain)) break;
+            const std::size_t row = (static_cast<std::size_t>(t) + 1) * cc;
+            int size = 0;
+            const double floor = std::max(shared.gain.load(), best.gain);
+            const double gain = greedy_sharing(&pw[row], &pz[row], &sw[row], &sz[row], floor, path, size);
+            if (gain > best.gain || (gain == best.gain && t < best.position)) {  // the lower threshold wins a tie
+                best.gain = gain;
+                best.feature = static_cast<int>(f);
+                best.position = t;
+                best.sharing.assign(path.begin(), path.begin() + size);
+                shared.raise(gain);
+            }
+        }
+        std::sort(best.sharing.begin(), best.sharing.end());
+        return best;
+    }
+
+    // The stump of a candidate: midpoint threshold and the weighted means a_S, b_S, k_c.
+    Stump make_stump(const Candidate& candidate) const {
+        Stump s;
+        s.feature = candidate.feature;
+        const auto& order = order_[candidate.feature];
+        const double lo = value(order[candidate.position], candidate.feature);
+        const double hi = value(order[candidate.position + 1], candidate.feature);
+        s.threshold = lo + (hi - lo) / 2;
+        if (!(s.threshold < hi)) s.threshold = lo;  // adjacent doubles: "v > lo" is the same split
+        s.sharing = candidate.sharing;
+        double wa = 0, za = 0, wb = 0, zb = 0;
+        for (int c : s.sharing)
+            for (std::size_t i = 0; i < n_; ++i) {
+                const double w = weight(i, c), signed_w = labels_[i] == c ? w : -w;
+                if (value(i, s.feature) > s.threshold) wa += w, za += signed_w;
+                else wb += w, zb += signed_w;
+            }
+        s.a = wa > 0 ? za / wa : 0.0;
+        s.b = wb > 0 ? zb / wb : 0.0;
+        s.k.resize(c_);
+        for (int c = 0; c < c_; ++c) s.k[c] = total_w_[c] > 0 ? total_z_[c] / total_w_[c] : 0.0;
+        s.finalise(c_);
+        return s;
+    }
+
+    const FeatureTable& table_;
+    const std::vector<int>& labels_;
+    std::size_t n_, f_;
+    int c_;
+    std::vector<double> weights_;            // sample-major: weights_[i * classes + c]
+    std::vector<double> signed_weights_;     // z_i^c w_i^c, same layout
+    std::vector<std::vector<int>> order_;
+    std::vector<double> total_w_, total_z_, k_gain_;
+    double k_gain_sum_ = 0;
+    double loss_ = 1.0;  // mean exp(-z H), H = 0 at the start
+};
+
+// Validation score after each round: (errors, mean log-loss), compared lexicographically.
+struct ValidationTracker {
+    const FeatureTable& table;
+    const std::vector<int>& labels;
+    std::vector<std::vector<double>> scores;
+
+    ValidationTracker(const FeatureTable& t, const std::vector<int>& y, int classes)
+        : table(t), labels(y), scores(t.rows(), std::vector<double>(classes, 0.0)) {}
+
+    std::pair<int, double> add(const Stump& s) {
+        int errors = 0;
+        double logloss = 0;
+        for (std::size_t i = 0; i < table.rows(); ++i) {
+            const auto& values = table.at(i, s.feature) > s.threshold ? s.above : s.below;
+            for (std::size_t c = 0; c < values.size(); ++c) scores[i][c] += values[c];
+            const auto p = probabilities_from_scores(scores[i]);
+            const auto top = std::max_element(p.begin(), p.end()) - p.begin();
+            errors += top != labels[i];
+            logloss -= std::log(std::max(p[labels[i]], 1e-15));
+        }
+        return {errors, logloss / static_cast<double>(table.rows())};
+    }
+};
+
+std::vector<int> subset_labels(const std::vector<int>& labels, const std::vector<std::size_t>& rows) {
+    std::vector<int> out;
+    out.reserve(rows.size());
+    for (auto r : rows) out.push_back(labels[r]);
+    return out;
+}
+
+}  // namespace
+
+JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels,
+                                      const std::vector<std::string>& classes, int rounds,
+                                      std::vector<double>* training_loss) {
+    validate_training_input(table, labels, classes);
+    JointBoostModel model;
+    model.classes = classes;
+    model.feature_names = table.feature_names;
+    RoundFitter fitter(table, labels, static_cast<int>(classes.size()));
+    for (int m = 0; m < rounds; ++m) {
+        Stump stump;
+        if (!fitter.fit(stump)) break;
+        const double loss = fitter.update(stump);
+        if (training_loss) training_loss->push_back(loss);
+        model.stumps.push_back(std::move(stump));
+    }
+    return model;
+}
+
+JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels,
+                                 const std::vector<std::string>& classes, const JointBoostOptions& options,
+                                 JointBoostReport* report) {
+    validate_training_input(table, labels, classes);
+    if (options.max_rounds < 1) throw Error::usage("JointBoost: max_rounds must be at least 1");
+    if (options.validation_fraction < 0 || options.validation_fraction >= 1)
+        throw Error::usage("JointBoost: validation fraction must be in [0, 1)");
+    JointBoostReport local;
+    JointBoostReport& r = report ? *report : local;
+    r = {};
+
+    std::vector<std::size_t> fit_rows, validation_rows;
+    if (options.validation_fraction > 0)
+        stratified_split(labels, static_cast<int>(classes.size()), options.validation_fraction, options.seed, false,
+                         validation_rows, fit_rows);
+    if (validation_rows.empty()) {  // nothing to stop on: plain boosting for max_rounds
+        auto model = fit_jointboost_rounds(table, labels, classes, options.max_rounds, &r.training_loss);
+        r.rounds = r.rounds_tried = static_cast<int>(model.stumps.size());
+        return model;
+    }
+
+    const FeatureTable fit_table = table.select_rows(fit_rows);
+    const std::vector<int> fit_labels = subset_labels(labels, fit_rows);
+    const FeatureTable validation_table = table.select_rows(validation_rows);
+    const std::vector<int> validation_labels = subset_labels(labels, validation_rows);
+
+    JointBoostModel model;
+    model.classes = classes;
+    model.feature_names = table.feature_names;
+    RoundFitter fitter(fit_table, fit_labels, static_cast<int>(classes.size()));
+    ValidationTracker tracker(validation_table, validation_labels, static_cast<int>(classes.size()));
+    std::pair<int, double> best{std::numeric_limits<int>::max(), kInf};
+    int best_rounds = 0;
+    for (int m = 0; m < options.max_rounds; ++m) {
+        Stump stump;
+        if (!fitter.fit(stump)) break;
+        r.training_loss.push_back(fitter.update(stump));
+        const auto score = tracker.add(stump);
+        r.validation_error.push_back(static_cast<double>(score.first) / static_cast<double>(validation_rows.size()));
+        r.validation_logloss.push_back(score.second);
+        model.stumps.push_back(std::move(stump));
+        if (score < best) best = score, best_rounds = m + 1;
+        if (options.patience > 0 && m + 1 - best_rounds >= options.patience) break;
+    }
+    r.rounds_tried = static_cast<int>(model.stumps.size());
+    best_rounds = std::max(best_rounds, 1);
+    if (options.refit) {
+        model = fit_jointboost_rounds(table, labels, classes, best_rounds);
+    } else {
+        model.stumps.resize(std::min<std::size_t>(model.stumps.size(), best_rounds));
+    }
+    r.rounds = static_cast<int>(model.stumps.size());
+    return model;
+}
+
+void save_jointboost(const JointBoostModel& model, const std::filesystem::path& path) {
+    nlohmann::json stumps = nlohmann::json::array();
+    for (const auto& s : model.stumps)
+        stumps.push_back({{"feature", s.feature}, {"threshold", s.threshold}, {"a", s.a}, {"b", s.b},
+                          {"sharing", s.sharing}, {"k", s.k}});
+    const nlohmann::json doc = {
+        {"format", "treelobes-jointboost"},
+        {"version", kJointBoostModelVersion},
+        {"probability", "p_c = sigma(2 H_c) / sum_c' sigma(2 H_c'), sigma(t) = 1/(1+exp(-t))"},
+        {"classes", model.classes},
+        {"features", model.feature_names},
+        {"stumps", stumps},
+    };
+    write_file_atomically(path, doc.dump(1) + "\n");
+}
+
+namespace {
+
+Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const std::string& file, std::size_t index) {
+    const std::string where = "stump " + std::to_string(index) + ": ";
+    Stump s;
+    s.feature = j.at("feature").get<int>();
+    s.threshold = j.at("threshold").get<double>();
+    s.a = j.at("a").get<double>();
+    s.b = j.at("b").get<double>();
+    s.sharing = j.at("sharing").get<std::vector<int>>();
+    s.k = j.at("k").get<std::vector<double>>();
+    if (s.feature < 0 || s.feature >= static_cast<int>(model.feature_names.size()))
+        throw Error::input(file, where + "feature index out of range");
+    if (static_cast<int>(s.k.size()) != model.class_count()) throw Error::input(file, where + "k has the wrong length");
+    if (s.sharing.empty()) throw Error::input(file, where + "empty sharing set");
+    for (int c : s.sharing)
+        if (c < 0 || c >= model.class_count()) throw Error::input(file, where + "class index out of range");
+    if (!std::isfinite(s.threshold) || !std::isfinite(s.a) || !std::isfinite(s.b))
+        throw Error::input(file, where + "non-finite value");
+    s.finalise(model.class_count());
+    return s;
+}
+
+}  // namespace
+
+JointBoostModel load_jointboost(const std::filesystem::path& path) {
+    const std::string file = path.string();
+    const std::string text = read_file(path);
+    nlohmann::json doc;
+    try {
+        doc = nlohmann::json::parse(text);
+    } catch (const nlohmann::json::exception& e) {
+        throw Error::input(file, std::string("not a JointBoost model (JSON: ") + e.what() + ")");
+    }
+    if (!doc.is_object() || !doc.contains("format") || doc["format"] != "treelobes-jointboost")
+        throw Error::input(file, "not a JointBoost model (expected \"format\": \"treelobes-jointboost\")");
+    if (!doc.contains("version") || !doc["version"].is_number_integer())
+        throw Error::input(file, "the model has no integer \"version\"");
+    const int version = doc["version"].get<int>();
+    if (version != kJointBoostModelVersion)
+        throw Error::input(file, "model version " + std::to_string(version) + " is not supported (this build reads version " +
+                                     std::to_string(kJointBoostModelVersion) + ")");
+    JointBoostModel model;
+    try {
+        model.classes = doc.at("classes").get<std::vector<std::string>>();
+        model.feature_names = doc.at("features").get<std::vector<std::string>>();
+        if (model.classes.size() < 2) throw Error::input(file, "fewer than two classes");
+        const auto& stumps = doc.at("stumps");
+        for (std::size_t m = 0; m < stumps.size(); ++m) model.stumps.push_back(parse_stump(stumps[m], model, file, m));
+    } catch (const nlohmann::json::exception& e) {
+        throw Error::input(file, std::string("malformed JointBoost model: ") + e.what());
+    }
+    return model;
+}
+
+}  // namespace treelobes::classify

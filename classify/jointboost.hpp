@@ -1,0 +1,101 @@
+// JointBoost (Torralba, Murphy & Freeman, "Sharing visual features for multiclass and
+// multiview object detection", PAMI 2007): multiclass boosting whose weak learners are
+// regression stumps shared by a subset S of the classes.
+//
+// Round m fits, by weighted least squares on the one-vs-all targets z_i^c in {+1,-1},
+//     h_m(v, c) = a_S  if c in S and v_f > theta
+//                 b_S  if c in S and v_f <= theta
+//                 k_c  if c not in S
+// with a_S, b_S the weighted means of z over the classes of S on each side of the threshold and
+// k_c the weighted mean of z^c (so classes outside S do not bias the sharing choice). For every
+// feature f and every threshold theta (midpoints of consecutive sorted distinct values, sums by
+// prefix/suffix accumulation) the sharing set is chosen by greedy forward selection over all
+// classes: start empty, add the class that lowers the error most, until all classes are in; the
+// best set on that path (the all-classes set included) is the candidate of (f, theta). The round
+// keeps the candidate of least error; ties go to the lower feature index, then the lower
+// threshold, then the smaller set. Weights are updated w_i^c <- w_i^c exp(-z_i^c h_m(v_i, c)) and
+// renormalised. Training is deterministic and independent of the number of threads.
+//
+// Classifier output: H(v, c) = sum_m h_m(v, c) estimates half the log-odds of class c against the
+// rest (GentleBoost), so the class probabilities are the normalised logistic of 2H:
+//     p_c = sigma(2 H(v,c)) / sum_c' sigma(2 H(v,c')),   sigma(t) = 1 / (1 + e^-t).
+// The spatial-voting confidence rule h1 > 1.5 h2 is applied to these p_c.
+#pragma once
+
+#include "classify/feature_table.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace treelobes::classify {
+
+struct JointBoostOptions {
+    int max_rounds = 400;              // upper bound on the number of stumps
+    // Early stopping: a stratified, seeded fraction of the training trees is held out; training
+    // stops `patience` rounds after the best validation score (fewest errors, then lowest mean
+    // log-loss of the probabilities above). 0 disables early stopping (max_rounds are used).
+    double validation_fraction = 0.2;
+    int patience = 60;
+    // After early stopping, train again on all training trees for the chosen number of rounds
+    // (the held-out trees are too valuable with 20 trees per species to be left out).
+    bool refit = true;
+    std::uint64_t seed = 1;            // validation split
+};
+
+struct Stump {
+    int feature = 0;
+    double threshold = 0;
+    double a = 0;                      // value for classes in the set when v_f > threshold
+    double b = 0;                      // value for classes in the set when v_f <= threshold
+    std::vector<int> sharing;          // classes of S, ascending
+    std::vector<double> k;             // per class; used for classes outside S
+    // Per-class values above/below the threshold (derived from the above; used by evaluation).
+    std::vector<double> above, below;
+    void finalise(int classes);
+};
+
+struct JointBoostModel {
+    std::vector<std::string> classes;        // class names, index = class id
+    std::vector<std::string> feature_names;  // the columns the stumps index
+    std::vector<Stump> stumps;
+
+    int class_count() const { return static_cast<int>(classes.size()); }
+    // H(v, c) for one feature vector (length feature_names.size()).
+    std::vector<double> scores(const double* features) const;
+    // Normalised logistic of 2H (see above); sums to 1.
+    std::vector<double> probabilities(const double* features) const;
+};
+
+// Maps scores H to probabilities (the one documented mapping).
+std::vector<double> probabilities_from_scores(const std::vector<double>& scores);
+
+struct JointBoostReport {
+    int rounds = 0;                          // stumps in the returned model
+    int rounds_tried = 0;                    // rounds run before early stopping
+    std::vector<double> training_loss;       // mean exp(-z H) over trees and classes after each round
+    std::vector<double> validation_error;    // error rate on the held-out trees after each round
+    std::vector<double> validation_logloss;  // mean log-loss on the held-out trees after each round
+};
+
+// Trains on `table` with class ids `labels` (0..classes.size()-1, one per row). Throws
+// Error::input when fewer than two classes are present, a value is not finite or labels and
+// rows disagree.
+JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels,
+                                 const std::vector<std::string>& classes, const JointBoostOptions& options,
+                                 JointBoostReport* report = nullptr);
+
+// The boosting rounds themselves, without early stopping (exposed for tests): `rounds` stumps.
+JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels,
+                                      const std::vector<std::string>& classes, int rounds,
+                                      std::vector<double>* training_loss = nullptr);
+
+// Model file: JSON with "format": "treelobes-jointboost", "version": 1, the class and feature
+// names, the probability mapping and the stumps. Written atomically; the reader checks the
+// format, version and every index and throws Error::input naming the file otherwise.
+inline constexpr int kJointBoostModelVersion = 1;
+void save_jointboost(const JointBoostModel& model, const std::filesystem::path& path);
+JointBoostModel load_jointboost(const std::filesystem::path& path);
+
+}  // namespace treelobes::classify

@@ -1,0 +1,243 @@
+// Writing the evaluation report: JSON summary, CSV tables, confusion heat maps (PNG) and a
+// Markdown page. The heat map carries its own 3x5 pixel font: render/ has no text and the
+// labels are what makes a confusion matrix readable.
+#include "classify/evaluation.hpp"
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "render/image.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+namespace treelobes::classify {
+
+namespace {
+
+using nlohmann::json;
+
+// ---- 3x5 bitmap font (rows top to bottom) ----
+const std::map<char, const char*>& glyphs() {
+    static const std::map<char, const char*> g = {
+        {'0', "111101101101111"}, {'1', "010110010010111"}, {'2', "111001111100111"}, {'3', "111001111001111"},
+        {'4', "101101111001001"}, {'5', "111100111001111"}, {'6', "111100111101111"}, {'7', "111001001001001"},
+        {'8', "111101111101111"}, {'9', "111101111001111"}, {'A', "010101111101101"}, {'B', "110101110101110"},
+        {'C', "011100100100011"}, {'D', "110101101101110"}, {'E', "111100110100111"}, {'F', "111100110100100"},
+        {'G', "011100101101011"}, {'H', "101101111101101"}, {'I', "111010010010111"}, {'J', "001001001101010"},
+        {'K', "101101110101101"}, {'L', "100100100100111"}, {'M', "101111111101101"}, {'N', "110101101101101"},
+        {'O', "010101101101010"}, {'P', "110101110100100"}, {'Q', "010101101110011"}, {'R', "110101110101101"},
+        {'S', "011100010001110"}, {'T', "111010010010010"}, {'U', "101101101101111"}, {'V', "101101101101010"},
+        {'W', "101101111111101"}, {'X', "101101010101101"}, {'Y', "101101010010010"}, {'Z', "111001010100111"},
+        {'_', "000000000000111"}, {'.', "000000000000010"}, {'-', "000000111000000"}, {'%', "101001010100101"},
+        {' ', "000000000000000"}, {'/', "001001010100100"}, {'(', "010100100100010"}, {')', "010001001001010"},
+        {':', "000010000010000"}, {'=', "000111000111000"},
+    };
+    return g;
+}
+
+void draw_text(render::Image& image, int x, int y, const std::string& text, int scale, render::Rgba colour) {
+    for (char ch : text) {
+        const auto it = glyphs().find(static_cast<char>(std::toupper(static_cast<unsigned char>(ch))));
+        if (it != glyphs().end())
+            for (int row = 0; row < 5; ++row)
+                for (int col = 0; col < 3; ++col)
+                    if (it->second[row * 3 + col] == '1')
+                        image.fill_rect(x + col * scale, y + row * scale, x + (col + 1) * scale, y + (row + 1) * scale, colour);
+        x += 4 * scale;
+    }
+}
+
+int text_width(const std::string& text, int scale) { return static_cast<int>(text.size()) * 4 * scale; }
+
+std::vector<std::vector<double>> row_percentages(const std::vector<std::vector<double>>& counts) {
+    auto out = counts;
+    for (auto& row : out) {
+        double total = 0;
+        for (double v : row) total += v;
+        for (double& v : row) v = total > 0 ? 100.0 * v / total : 0.0;
+    }
+    return out;
+}
+
+// Rows: true species, columns: predicted (numbered like the rows); white (0 %) to dark blue (100 %).
+void write_heatmap(const std::vector<std::vector<double>>& percent, const std::vector<std::string>& classes, const std::string& title,
+                   const std::filesystem::path& path) {
+    const int n = static_cast<int>(classes.size()), cell = 40, scale = 2, margin = 12;
+    int label_width = 0;
+    for (int c = 0; c < n; ++c) label_width = std::max(label_width, text_width(std::to_string(c + 1) + " " + classes[c], scale));
+    const int left = margin + label_width + 8, top = margin + 5 * scale + 14 + 5 * scale + 8;
+    const int width = std::max(left + n * cell + margin, margin + text_width(title, scale) + margin);
+    render::Image image(width, top + n * cell + margin + 5 * scale + 10, {255, 255, 255, 255});
+    draw_text(image, margin, margin, title, scale, {0, 0, 0, 255});
+    for (int c = 0; c < n; ++c) {
+        const std::string number = std::to_string(c + 1);
+        draw_text(image, left + c * cell + (cell - text_width(number, scale)) / 2, top - 5 * scale - 6, number, scale, {0, 0, 0, 255});
+        draw_text(image, margin, top + c * cell + (cell - 5 * scale) / 2, number + " " + classes[c], scale, {0, 0, 0, 255});
+    }
+    for (int r = 0; r < n; ++r)
+        for (int c = 0; c < n; ++c) {
+            const double v = std::clamp(percent[r][c] / 100.0, 0.0, 1.0);
+            const auto shade = [&](double white, double full) { return static_cast<std::uint8_t>(white + (full - white) * v); };
+            const render::Rgba colour{shade(255, 8), shade(255, 48), shade(255, 107), 255};
+            image.fill_rect(left + c * cell + 1, top + r * cell + 1, left + (c + 1) * cell, top + (r + 1) * cell, colour);
+            if (percent[r][c] >= 0.5) {
+                char text[16];
+                std::snprintf(text, sizeof text, "%.0f", percent[r][c]);
+                const render::Rgba ink = v > 0.5 ? render::Rgba{255, 255, 255, 255} : render::Rgba{0, 0, 0, 255};
+                draw_text(image, left + c * cell + (cell - text_width(text, scale)) / 2, top + r * cell + (cell - 5 * scale) / 2, text, scale, ink);
+            }
+        }
+    draw_text(image, left, top + n * cell + 6, "ROWS: TRUE SPECIES  COLUMNS: PREDICTED  (% OF ROW)", 1, {80, 80, 80, 255});
+    render::write_png(image, path);
+}
+
+std::string percent(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", 100 * v);
+    return text;
+}
+
+void write_confusion_csv(const std::vector<std::vector<double>>& counts, const std::vector<std::string>& classes,
+                         const std::filesystem::path& path) {
+    const auto p = row_percentages(counts);
+    std::ostringstream out;
+    out << "true\\predicted";
+    for (const auto& c : classes) out << ',' << c;
+    out << ",predictions\n";
+    for (std::size_t r = 0; r < classes.size(); ++r) {
+        out << classes[r];
+        double total = 0;
+        for (std::size_t c = 0; c < classes.size(); ++c) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%.1f", p[r][c]);
+            out << ',' << text;
+            total += counts[r][c];
+        }
+        out << ',' << static_cast<long>(total) << '\n';
+    }
+    write_file_atomically(path, out.str());
+}
+
+json scores_json(const Scores& s, const std::vector<std::string>& classes) {
+    json species = json::object(), voted = json::object();
+    for (std::size_t c = 0; c < classes.size(); ++c) {
+        species[classes[c]] = s.species_rate[c];
+        if (s.voted) voted[classes[c]] = s.voted_species_rate[c];
+    }
+    json j = {{"experiments", s.experiments},
+              {"average_recognition_rate", s.average_rate},
+              {"tree_accuracy", s.tree_accuracy},
+              {"species_rate", species},
+              {"confident_fraction", s.confident_fraction},
+              {"confident_accuracy", s.confident_accuracy},
+              {"unconfident_accuracy", s.unconfident_accuracy},
+              {"train_seconds_total", s.train_seconds},
+              {"train_seconds_mean", s.experiments ? s.train_seconds / s.experiments : 0.0},
+              {"predict_seconds_total", s.predict_seconds},
+              {"mean_rounds", s.mean_rounds}};
+    if (s.voted) {
+        j["voted_average_recognition_rate"] = s.voted_average_rate;
+        j["voted_tree_accuracy"] = s.voted_tree_accuracy;
+        j["voted_species_rate"] = voted;
+    }
+    return j;
+}
+
+std::string safe_name(std::string name) {
+    for (char& ch : name)
+        if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+    return name;
+}
+
+}  // namespace
+
+void write_report(const EvaluationReport& report, const EvaluationOptions& options, const std::string& directory,
+                  const std::string& extra_json) {
+    const std::filesystem::path dir(directory);
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) throw Error::input(directory, "cannot create the report folder (" + ec.message() + ")");
+    json summary = json::parse(extra_json);
+    summary["classes"] = report.classes;
+    summary["options"] = {{"splits", options.splits},
+                          {"train_fraction", options.train_fraction},
+                          {"seed", options.seed},
+                          {"confidence_factor", options.voting.confidence_factor},
+                          {"voting_radius_m", options.voting.radius_m}};
+    summary["site_groups"] = report.site_groups;
+    summary["seconds"] = report.seconds;
+    for (const auto& c : report.classifiers) {
+        json entry = {{"random_splits", scores_json(c.random_splits, report.classes)}};
+        if (c.site_split.experiments > 0) entry["site_split"] = scores_json(c.site_split, report.classes);
+        summary["classifiers"][c.name] = entry;
+        const std::string stem = safe_name(c.name);
+        write_confusion_csv(c.random_splits.confusion, report.classes, dir / ("confusion_" + stem + ".csv"));
+        write_heatmap(row_percentages(c.random_splits.confusion), report.classes,
+                      c.name + " " + std::to_string(c.random_splits.experiments) + " SPLITS: " + percent(c.random_splits.average_rate) + " %",
+                      dir / ("confusion_" + stem + ".png"));
+        if (c.site_split.experiments > 0)
+            write_confusion_csv(c.site_split.confusion, report.classes, dir / ("site_confusion_" + stem + ".csv"));
+    }
+    write_file_atomically(dir / "summary.json", summary.dump(2) + "\n");
+
+    std::ostringstream csv;
+    csv << "species,trees,train_per_split";
+    for (const auto& c : report.classifiers) {
+        csv << ',' << safe_name(c.name) << "_rate";
+        if (c.random_splits.voted) csv << ',' << safe_name(c.name) << "_voted_rate";
+        if (c.site_split.experiments > 0) csv << ',' << safe_name(c.name) << "_site_rate";
+    }
+    csv << '\n';
+    for (std::size_t k = 0; k < report.classes.size(); ++k) {
+        const auto& first = report.classifiers.front().random_splits;
+        csv << report.classes[k] << ',' << first.species_trees[k] << ',' << first.species_train[k];
+        for (const auto& c : report.classifiers) {
+            csv << ',' << percent(c.random_splits.species_rate[k]);
+            if (c.random_splits.voted) csv << ',' << percent(c.random_splits.voted_species_rate[k]);
+            if (c.site_split.experiments > 0) csv << ',' << percent(c.site_split.species_rate[k]);
+        }
+        csv << '\n';
+    }
+    write_file_atomically(dir / "per_species.csv", csv.str());
+    write_file_atomically(dir / "report.md", report_summary(report));
+}
+
+std::string report_summary(const EvaluationReport& report) {
+    std::ostringstream out;
+    out << "Species classification: " << report.classes.size() << " species, "
+        << (report.classifiers.empty() ? 0 : report.classifiers.front().random_splits.experiments) << " random 50/50 splits";
+    if (!report.site_groups.empty()) out << ", site split over " << report.site_groups.size() << " groups";
+    char line[256];
+    std::snprintf(line, sizeof line, " (%.1f s)\n\n", report.seconds);
+    out << line;
+    out << "| classifier | average recognition rate | tree accuracy | confident: share / accuracy | unconfident accuracy | with voting | site split | train s/split |\n"
+        << "|---|---|---|---|---|---|---|---|\n";
+    for (const auto& c : report.classifiers) {
+        const Scores& s = c.random_splits;
+        out << "| " << c.name << " | " << percent(s.average_rate) << " % | " << percent(s.tree_accuracy) << " % | "
+            << percent(s.confident_fraction) << " % / " << percent(s.confident_accuracy) << " % | " << percent(s.unconfident_accuracy)
+            << " % | " << (s.voted ? percent(s.voted_average_rate) + " %" : std::string("-")) << " | "
+            << (c.site_split.experiments > 0 ? percent(c.site_split.average_rate) + " %" : std::string("-")) << " | ";
+        std::snprintf(line, sizeof line, "%.3f", s.experiments ? s.train_seconds / s.experiments : 0.0);
+        out << line << " |\n";
+    }
+    out << "\n| species | trees |";
+    for (const auto& c : report.classifiers) out << ' ' << c.name << " |";
+    out << "\n|---|---|";
+    for (std::size_t k = 0; k < report.classifiers.size(); ++k) out << "---|";
+    out << '\n';
+    for (std::size_t k = 0; k < report.classes.size(); ++k) {
+        out << "| " << report.classes[k] << " | " << report.classifiers.front().random_splits.species_trees[k] << " |";
+        for (const auto& c : report.classifiers) out << ' ' << percent(c.random_splits.species_rate[k]) << " % |";
+        out << '\n';
+    }
+    return out.str();
+}
+
+}  // namespace treelobes::classify

@@ -1,0 +1,71 @@
+// The lobe-based tree representation of seed 001 §4-5: the main branching structure (a
+// skeletal graph with allometric diameters), one closed lobe surface per low-confidence
+// cluster with its seed point, and the species parameters needed to synthesize the tree again.
+// build_lobe_tree() derives it from a skeleton reconstruction (reconstruct/reconstruct_tree.hpp);
+// lobes/tlobe_io.hpp stores it.
+#pragma once
+
+#include "core/point_cloud.hpp"
+#include "core/tree_graph.hpp"
+#include "core/triangle_mesh.hpp"
+#include "lobes/alpha_shape.hpp"
+#include "reconstruct/reconstruct_tree.hpp"
+
+#include <Eigen/Core>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace treelobes::lobes {
+
+struct Lobe {
+    TriangleMesh mesh;                  // closed 2-manifold, outward, in the tree's frame (origin 0)
+    int seed_node = -1;                 // p_i as a node of LobeTree::skeleton
+    Eigen::Vector3f seed_direction{0, 0, 1};  // unit vector from p_i toward the cluster's centroid
+    std::size_t points = 0;             // points of cluster C_i
+    double volume() const { return mesh.signed_volume(); }
+    double area() const { return mesh.area(); }
+};
+
+struct LobeTree {
+    TreeGraph skeleton;                 // main branching structure; radius = d(u)/2 (seed 001 Eq. 1)
+    std::string species;                // may be empty (no species given)
+    double beta = 1.5, gamma = 1.5, fs = 1.0;  // seed 001 Table 1 parameters used
+    double alpha_factor = 5.0;
+    double root_diameter = 0.0;         // d_root (metres)
+    std::vector<Lobe> lobes;
+
+    // Seed point p_i of a lobe: position, thickness (d at p_i) and direction.
+    Eigen::Vector3f seed_position(const Lobe& lobe) const { return skeleton.nodes[lobe.seed_node].position; }
+    float seed_thickness(const Lobe& lobe) const { return 2.0f * skeleton.nodes[lobe.seed_node].radius; }
+};
+
+struct LobeOptions {
+    AlphaShapeOptions alpha;            // alpha = alpha_factor * alpha_min (default 5)
+    std::size_t min_cluster_points = 30;  // smaller clusters stay on the skeleton as branches
+    std::size_t max_shape_points = 6000;  // larger clusters are thinned on a grid before the alpha shape
+    std::size_t face_budget = 12000;    // faces over all lobes after simplification, shared by area
+    std::size_t max_lobe_faces = 600;   // per lobe, at most
+    std::size_t min_lobe_faces = 12;    // per lobe, at least (when the alpha shape has more)
+    double simplify_tolerance = 0.02;   // metres: collapses below this error always happen
+};
+
+struct LobeReport {
+    std::size_t low_confidence_edges = 0;
+    std::size_t clusters = 0;           // before the fallbacks below
+    std::size_t kept_small = 0;         // clusters under min_cluster_points kept as branches
+    std::size_t kept_no_shape = 0;      // clusters without a 3D alpha shape (flat, collinear) kept as branches
+    std::size_t lobe_points = 0;        // points inside lobes
+    std::size_t main_points = 0;        // points on the main structure
+    std::size_t faces_before_simplification = 0;
+    std::vector<std::pair<std::string, double>> seconds;
+};
+
+// `cloud` is the cloud `reconstruction` was made from (its point_internode indexes it).
+// `species` and the parameters in `reconstruction_options` are recorded in the result.
+LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& reconstruction,
+                         const ReconstructOptions& reconstruction_options, const std::string& species,
+                         const LobeOptions& options = {}, LobeReport* report = nullptr);
+
+}  // namespace treelobes::lobes

@@ -1,0 +1,65 @@
+// Compact byte coding for the .tlobe file (docs/tlobe.md): LEB128 varints, zigzag signed
+// varints, little-endian floats, and a lossless-after-quantization triangle mesh coder.
+//
+// Mesh coding: vertices are renumbered in order of first use by the faces, so every corner
+// either introduces the next new vertex (code 0) or refers back to an earlier one (code
+// next - index >= 1, small for neighbouring faces). Vertex positions are quantized to a grid of
+// `quantum` metres in the tree's frame and coded as zigzag deltas from the previous vertex.
+// The whole .tlobe payload is deflated afterwards, which removes most remaining redundancy.
+#pragma once
+
+#include "core/triangle_mesh.hpp"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+namespace treelobes::lobes {
+
+class ByteWriter {
+public:
+    void u8(std::uint8_t v) { bytes_.push_back(static_cast<char>(v)); }
+    void varint(std::uint64_t v);
+    void svarint(std::int64_t v) { varint((static_cast<std::uint64_t>(v) << 1) ^ static_cast<std::uint64_t>(v >> 63)); }
+    void f32(float v);
+    void f64(double v);
+    void string(std::string_view s);
+    const std::string& bytes() const { return bytes_; }
+
+private:
+    std::string bytes_;
+};
+
+// Reads what ByteWriter wrote; every overrun or malformed value throws Error(InvalidInput)
+// naming `context` (the file).
+class ByteReader {
+public:
+    ByteReader(std::string_view bytes, std::string context) : bytes_(bytes), context_(std::move(context)) {}
+    std::uint8_t u8();
+    std::uint64_t varint();
+    std::int64_t svarint() {
+        const std::uint64_t v = varint();
+        return static_cast<std::int64_t>(v >> 1) ^ -static_cast<std::int64_t>(v & 1);
+    }
+    float f32();
+    double f64();
+    std::string string();
+    // A count that must be plausible for the bytes left (each item takes >= `min_bytes`).
+    std::size_t count(std::size_t min_bytes, const char* what);
+    bool at_end() const { return pos_ == bytes_.size(); }
+    [[noreturn]] void fail(const std::string& what) const;
+
+private:
+    std::string_view bytes_;
+    std::size_t pos_ = 0;
+    std::string context_;
+};
+
+// Integer grid coordinate of a value (round to nearest); throws Error(Usage) if out of int32 range.
+std::int64_t quantize(double value, double quantum);
+
+// The mesh's vertices are taken in its local frame (its origin is not stored).
+void encode_mesh(const TriangleMesh& mesh, double quantum, ByteWriter& out);
+TriangleMesh decode_mesh(ByteReader& in, double quantum);
+
+}  // namespace treelobes::lobes

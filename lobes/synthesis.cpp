@@ -1,0 +1,190 @@
+#include "lobes/synthesis.hpp"
+
+#include "core/error.hpp"
+#include "reconstruct/skeleton.hpp"
+
+#include <Eigen/Geometry>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+
+namespace treelobes::lobes {
+
+namespace {
+
+constexpr float kMinTwigRadius = 0.0008f;  // metres: thinner twigs are drawn this thick
+constexpr std::size_t kMinPatchesPerLobe = 20;
+constexpr double kCellsPerPatch = 2;
+constexpr double kMinLeafShare = 0.1;  // leaves are thinned at most to this fraction
+
+// An open prism of `sides` faces around segment a-b (twigs are too thin for caps to show).
+void add_prism(TriangleMesh& mesh, const Eigen::Vector3f& a, const Eigen::Vector3f& b, float ra, float rb, int sides) {
+    const Eigen::Vector3f axis = b - a;
+    if (axis.norm() < 1e-6f) return;
+    const Eigen::Vector3f t = axis.normalized();
+    const Eigen::Vector3f u = t.unitOrthogonal(), v = t.cross(u);
+    const int base = static_cast<int>(mesh.vertices.size());
+    for (int k = 0; k < sides; ++k) {
+        const float angle = 2.0f * std::numbers::pi_v<float> * k / sides;
+        const Eigen::Vector3f n = std::cos(angle) * u + std::sin(angle) * v;
+        mesh.vertices.push_back(a + ra * n);
+        mesh.vertices.push_back(b + rb * n);
+    }
+    for (int k = 0; k < sides; ++k) {
+        const int k1 = (k + 1) % sides;
+        const int a0 = base + 2 * k, b0 = a0 + 1, a1 = base + 2 * k1, b1 = a1 + 1;
+        mesh.faces.push_back({a0, a1, b1});  // counter-clockwise seen from outside
+        mesh.faces.push_back({a0, b1, b0});
+    }
+}
+
+// A leaf blade: a rhombus (broad leaves, leaflets) or a thin strip (needles), two triangles.
+void add_leaf(TriangleMesh& mesh, const Eigen::Vector3f& base, const Eigen::Vector3f& direction, const Eigen::Vector3f& normal,
+              float length, float width, LeafShape shape) {
+    const Eigen::Vector3f side = normal.cross(direction).normalized() * (0.5f * width);
+    const int i = static_cast<int>(mesh.vertices.size());
+    const Eigen::Vector3f tip = base + length * direction;
+    if (shape == LeafShape::Needle) {
+        mesh.vertices.insert(mesh.vertices.end(), {base - side, base + side, tip + side, tip - side});
+    } else {
+        const Eigen::Vector3f mid = base + 0.45f * length * direction;
+        mesh.vertices.insert(mesh.vertices.end(), {base, mid + side, tip, mid - side});
+    }
+    mesh.faces.push_back({i, i + 1, i + 2});
+    mesh.faces.push_back({i, i + 2, i + 3});
+}
+
+std::size_t prefix(double fraction, std::size_t n) {
+    return std::min(n, static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(n))));
+}
+
+}  // namespace
+
+TriangleMesh SynthesizedMesh::combined() const {
+    TriangleMesh all = wood;
+    all.append(leaves);
+    return all;
+}
+
+TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, const SynthesisOptions& o) {
+    TexturedTree out;
+    out.library = build_patch_library(species, o.library);
+    out.lobes.resize(tree.lobes.size());
+    double total_volume = 0;
+    for (const Lobe& lobe : tree.lobes) total_volume += std::max(lobe.volume(), 0.0);
+    // Triangles per patch, on average over the library. Leafy species (compound leaves,
+    // needles) carry several times more leaf than twig triangles per patch; their leaves are
+    // thinned to at most the twig triangles (stochastic pruning, enlarged to keep the leaf
+    // area, as for the LOD) so that the budget buys patches that reach the whole lobe.
+    double wood = 0, leaf = 0;
+    for (const Patch& p : out.library.patches) {
+        wood += 2.0 * static_cast<double>(p.segments.size()) * o.twig_sides;
+        leaf += 2.0 * static_cast<double>(p.leaves.size());
+    }
+    out.leaf_share = leaf > wood && leaf > 0 ? std::max(wood / leaf, kMinLeafShare) : 1.0;
+    const double patch_count = static_cast<double>(std::max<std::size_t>(out.library.patches.size(), 1));
+    const double triangles = std::max(1.0, (wood + out.leaf_share * leaf) / patch_count);
+    const double max_patches = static_cast<double>(o.max_triangles) / triangles;
+    // Budget allocation: every lobe first gets its volume share of the tree's patches; the
+    // patches that lobes filled before spending their share are then handed to the lobes that
+    // ran out, again by volume (a lobe's texturing is a sequential process, so the larger
+    // budget extends the same fill - determinism is kept). Without the second round the big
+    // crown lobes stopped half-filled while the triangle budget was far from spent.
+    auto texture = [&](std::size_t i, double patches) {
+        const Lobe& lobe = tree.lobes[i];
+        const DockingPoint seed{tree.seed_position(lobe), lobe.seed_direction, std::max(tree.seed_thickness(lobe), 0.002f)};
+        TexturingOptions lobe_options = o.texturing;
+        const auto budget = static_cast<std::size_t>(std::llround(patches));
+        lobe_options.max_patches_per_lobe = std::min(o.texturing.max_patches_per_lobe, std::max<std::size_t>(budget, kMinPatchesPerLobe));
+        // Fill cells scaled to the budget: with fewer patches than cells, the growth from the
+        // seed never meets filled cells, so it fills the lobe densely near the seed and stops
+        // half-way; with about kCellsPerPatch cells per patch, docking points in filled parts
+        // are dropped and the patches spread over the whole lobe (measured: 1 cell per patch
+        // leaves budget unspent, 4 leaves small lobes sparse).
+        lobe_options.max_fill_cells = std::min(o.texturing.max_fill_cells, kCellsPerPatch * static_cast<double>(lobe_options.max_patches_per_lobe));
+        out.lobes[i] = texture_lobe(lobe.mesh, seed, out.library, lobe_options, i);
+        return lobe_options.max_patches_per_lobe;
+    };
+    auto share = [&](const Lobe& lobe, double volume) { return volume > 0 ? std::max(lobe.volume(), 0.0) / volume : 1.0; };
+    std::vector<std::size_t> caps(tree.lobes.size());
+    tbb::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { caps[i] = texture(i, share(tree.lobes[i], total_volume) * max_patches); });
+    double used = 0, starved_volume = 0;
+    std::vector<std::size_t> starved;  // lobes that spent their whole budget below the fill target
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        used += static_cast<double>(out.lobes[i].instances.size());
+        if (out.lobes[i].instances.size() >= caps[i] && caps[i] < o.texturing.max_patches_per_lobe) {
+            starved.push_back(i);
+            starved_volume += std::max(tree.lobes[i].volume(), 0.0);
+        }
+    }
+    const double spare = max_patches - used;
+    if (spare >= 1 && !starved.empty())
+        tbb::parallel_for(std::size_t{0}, starved.size(), [&](std::size_t k) {
+            const std::size_t i = starved[k];
+            texture(i, static_cast<double>(caps[i]) + share(tree.lobes[i], starved_volume) * spare);
+        });
+    return out;
+}
+
+SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textured, double fraction, const SynthesisOptions& o) {
+    if (!(fraction > 0 && fraction <= 1)) throw Error::usage("synthesis: --lod must be in (0, 1], got " + std::to_string(fraction));
+    if (o.twig_sides < 3 || o.twig_sides > 16) throw Error::usage("synthesis: twig sides must be 3..16");
+    SynthesizedMesh out;
+    out.wood.origin = out.leaves.origin = tree.skeleton.origin;
+
+    // Main skeleton: the thickest fraction of the edges (ties: pre-order, parents first).
+    const std::size_t n = tree.skeleton.size();
+    if (n >= 2) {
+        std::vector<int> nodes(n - 1);
+        std::iota(nodes.begin(), nodes.end(), 1);
+        std::stable_sort(nodes.begin(), nodes.end(), [&](int a, int b) { return tree.skeleton.nodes[a].radius > tree.skeleton.nodes[b].radius; });
+        std::vector<bool> keep(n, false);
+        keep[0] = true;
+        out.skeleton_edges = std::max<std::size_t>(1, prefix(fraction, nodes.size()));
+        for (std::size_t i = 0; i < out.skeleton_edges; ++i) keep[nodes[i]] = true;
+        for (std::size_t u = 1; u < n; ++u)  // a thickness tie could leave a parent out: close upward
+            if (keep[u])
+                for (int p = tree.skeleton.nodes[u].parent; p > 0 && !keep[p]; p = tree.skeleton.nodes[p].parent) keep[p] = true;
+        std::vector<int> new_index;
+        const TreeGraph reduced = keep_nodes(tree.skeleton, keep, new_index);
+        if (reduced.size() >= 2) out.wood = build_branch_mesh(reduced, o.main_branches);
+        out.wood.origin = tree.skeleton.origin;
+    }
+
+    // Twig segments: the thickest fraction over all placed patches.
+    std::vector<float> thickness;
+    for (const auto& lobe : textured.lobes)
+        for (const auto& inst : lobe.instances)
+            for (const auto& s : textured.library.patches[inst.patch].segments) thickness.push_back(s.thickness_a * inst.scale);
+    float min_thickness = 0;
+    if (!thickness.empty() && fraction < 1) {
+        const std::size_t kept = std::max<std::size_t>(1, prefix(fraction, thickness.size()));
+        std::nth_element(thickness.begin(), thickness.begin() + static_cast<std::ptrdiff_t>(kept - 1), thickness.end(), std::greater<>());
+        min_thickness = thickness[kept - 1];
+    }
+    for (const auto& lobe : textured.lobes)
+        for (const auto& inst : lobe.instances) {
+            const Patch& patch = textured.library.patches[inst.patch];
+            for (const auto& s : patch.segments) {
+                if (s.thickness_a * inst.scale < min_thickness) continue;
+                add_prism(out.wood, inst.apply(s.a), inst.apply(s.b), std::max(0.5f * s.thickness_a * inst.scale, kMinTwigRadius),
+                          std::max(0.5f * s.thickness_b * inst.scale, kMinTwigRadius), o.twig_sides);
+                ++out.twig_segments;
+            }
+            // Stochastic pruning: a prefix of the shuffled leaves, enlarged to keep the leaf area.
+            const std::size_t kept = prefix(fraction * textured.leaf_share, patch.leaves.size());
+            const float enlarge = kept > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(kept)) : 1.0f;
+            for (std::size_t i = 0; i < kept; ++i) {
+                const PatchLeaf& leaf = patch.leaves[i];
+                add_leaf(out.leaves, inst.apply(leaf.base), inst.rotation * leaf.direction, inst.rotation * leaf.normal,
+                         leaf.length * enlarge, leaf.width * enlarge, textured.library.leaf_shape);
+                ++out.leaf_count;
+            }
+        }
+    return out;
+}
+
+}  // namespace treelobes::lobes

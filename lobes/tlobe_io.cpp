@@ -1,0 +1,180 @@
+#include "lobes/tlobe_io.hpp"
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "lobes/mesh_coder.hpp"
+
+#include <zlib.h>
+
+#include <array>
+#include <cmath>
+#include <cstring>
+
+namespace treelobes::lobes {
+
+namespace {
+
+constexpr std::array<char, 4> kMagic{'T', 'L', 'O', 'B'};
+constexpr std::size_t kHeaderSize = 20;
+constexpr std::size_t kMaxPayload = std::size_t{1} << 30;  // 1 GiB: anything larger is not a .tlobe
+
+void put_u32(std::string& s, std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) s[at + i] = static_cast<char>(v >> (8 * i));
+}
+
+std::uint32_t get_u32(std::string_view s, std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 0; i < 4; ++i) v |= static_cast<std::uint32_t>(static_cast<unsigned char>(s[at + i])) << (8 * i);
+    return v;
+}
+
+// CRC-32 of the header without its CRC field, then of the compressed payload.
+std::uint32_t file_crc(std::string_view file) {
+    uLong crc = crc32(0L, Z_NULL, 0);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(file.data()), 16);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(file.data() + kHeaderSize), static_cast<uInt>(file.size() - kHeaderSize));
+    return static_cast<std::uint32_t>(crc);
+}
+
+void encode_skeleton(const TreeGraph& skeleton, const TlobeOptions& o, ByteWriter& out) {
+    out.varint(skeleton.size());
+    std::vector<std::array<std::int64_t, 3>> q(skeleton.size());
+    for (std::size_t i = 0; i < skeleton.size(); ++i) {
+        const TreeNode& node = skeleton.nodes[i];
+        for (int k = 0; k < 3; ++k) q[i][k] = quantize(node.position[k], o.quantum);
+        if (i > 0) out.varint(i - static_cast<std::size_t>(node.parent));
+        for (int k = 0; k < 3; ++k) out.svarint(q[i][k] - (i > 0 ? q[node.parent][k] : 0));
+        out.varint(static_cast<std::uint64_t>(quantize(2.0 * node.radius, o.diameter_quantum)));
+    }
+}
+
+TreeGraph decode_skeleton(ByteReader& in, double quantum, double diameter_quantum) {
+    TreeGraph skeleton;
+    const std::size_t n = in.count(4, "skeleton node count");
+    if (n == 0) in.fail("the skeleton has no root");
+    std::vector<std::array<std::int64_t, 3>> q(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        int parent = -1;
+        if (i > 0) {
+            const std::uint64_t delta = in.varint();
+            if (delta == 0 || delta > i) in.fail("skeleton node with an invalid parent");
+            parent = static_cast<int>(i - delta);
+        }
+        Eigen::Vector3f p;
+        for (int k = 0; k < 3; ++k) {
+            q[i][k] = in.svarint() + (parent >= 0 ? q[parent][k] : 0);
+            p[k] = static_cast<float>(static_cast<double>(q[i][k]) * quantum);
+        }
+        const double diameter = static_cast<double>(in.varint()) * diameter_quantum;
+        skeleton.add_node(p, static_cast<float>(diameter / 2), parent);
+    }
+    return skeleton;
+}
+
+void check_options(const TlobeOptions& o) {
+    if (!(o.quantum > 0 && o.quantum <= 1) || !(o.diameter_quantum > 0 && o.diameter_quantum <= 1))
+        throw Error::usage("tlobe: quanta must be in (0, 1] metres");
+    if (o.compression_level < 1 || o.compression_level > 9) throw Error::usage("tlobe: compression level must be 1..9");
+}
+
+}  // namespace
+
+std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
+    check_options(o);
+    ByteWriter w;
+    for (int k = 0; k < 3; ++k) w.f64(tree.skeleton.origin[k]);
+    w.f32(static_cast<float>(o.quantum));
+    w.f32(static_cast<float>(o.diameter_quantum));
+    w.string(tree.species);
+    for (double v : {tree.beta, tree.gamma, tree.fs, tree.alpha_factor, tree.root_diameter}) w.f32(static_cast<float>(v));
+    // Decoding uses the stored (float) quanta, so encode with exactly those.
+    const double quantum = static_cast<float>(o.quantum);
+    TlobeOptions stored = o;
+    stored.quantum = quantum;
+    stored.diameter_quantum = static_cast<float>(o.diameter_quantum);
+    encode_skeleton(tree.skeleton, stored, w);
+    w.varint(tree.lobes.size());
+    for (const Lobe& lobe : tree.lobes) {
+        if (lobe.seed_node < 0 || static_cast<std::size_t>(lobe.seed_node) >= tree.skeleton.size())
+            throw Error(ExitCode::Internal, "tlobe: lobe seed is not a skeleton node");
+        w.varint(static_cast<std::uint64_t>(lobe.seed_node));
+        w.varint(lobe.points);
+        for (int k = 0; k < 3; ++k) w.svarint(std::lround(lobe.seed_direction[k] * 127.0f));
+        if (lobe.mesh.origin != Eigen::Vector3d::Zero() && lobe.mesh.origin != tree.skeleton.origin)
+            throw Error(ExitCode::Internal, "tlobe: lobe mesh is not in the tree's frame");
+        encode_mesh(lobe.mesh, quantum, w);
+    }
+
+    const std::string& raw = w.bytes();
+    uLongf packed_size = compressBound(static_cast<uLong>(raw.size()));
+    std::string file(kHeaderSize + packed_size, '\0');
+    if (compress2(reinterpret_cast<Bytef*>(file.data() + kHeaderSize), &packed_size, reinterpret_cast<const Bytef*>(raw.data()),
+                  static_cast<uLong>(raw.size()), o.compression_level) != Z_OK)
+        throw Error(ExitCode::Internal, "tlobe: deflate failed");
+    file.resize(kHeaderSize + packed_size);
+    std::memcpy(file.data(), kMagic.data(), 4);
+    file[4] = static_cast<char>(kTlobeMajorVersion);
+    file[5] = static_cast<char>(kTlobeMinorVersion);
+    file[6] = file[7] = 0;  // flags, reserved
+    put_u32(file, 8, static_cast<std::uint32_t>(raw.size()));
+    put_u32(file, 12, static_cast<std::uint32_t>(packed_size));
+    put_u32(file, 16, file_crc(file));
+    return file;
+}
+
+LobeTree decode_tlobe(std::string_view file, const std::string& name) {
+    if (file.size() < kHeaderSize || std::memcmp(file.data(), kMagic.data(), 4) != 0)
+        throw Error::input(name, "not a .tlobe file (no TLOB header)");
+    const int major = static_cast<unsigned char>(file[4]), minor = static_cast<unsigned char>(file[5]);
+    if (major != kTlobeMajorVersion)
+        throw Error::input(name, ".tlobe version " + std::to_string(major) + "." + std::to_string(minor) +
+                                     " is not supported (this build reads version " + std::to_string(kTlobeMajorVersion) + ".x)");
+    const std::uint32_t raw_size = get_u32(file, 8), packed_size = get_u32(file, 12);
+    if (packed_size != file.size() - kHeaderSize) throw Error::input(name, "truncated .tlobe file (payload size mismatch)");
+    if (get_u32(file, 16) != file_crc(file)) throw Error::input(name, "corrupt .tlobe file (CRC-32 mismatch)");
+    if (raw_size > kMaxPayload) throw Error::input(name, "implausible .tlobe payload size");
+    std::string raw(raw_size, '\0');
+    uLongf unpacked = raw_size;
+    if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &unpacked, reinterpret_cast<const Bytef*>(file.data() + kHeaderSize),
+                   packed_size) != Z_OK ||
+        unpacked != raw_size)
+        throw Error::input(name, "corrupt .tlobe payload (inflate failed)");
+
+    ByteReader in(raw, name);
+    LobeTree tree;
+    Eigen::Vector3d origin;
+    for (int k = 0; k < 3; ++k) origin[k] = in.f64();
+    const double quantum = in.f32(), diameter_quantum = in.f32();
+    if (!(quantum > 0 && quantum <= 1) || !(diameter_quantum > 0 && diameter_quantum <= 1) || !origin.allFinite())
+        in.fail("invalid quantization or origin");
+    tree.species = in.string();
+    tree.beta = in.f32();
+    tree.gamma = in.f32();
+    tree.fs = in.f32();
+    tree.alpha_factor = in.f32();
+    tree.root_diameter = in.f32();
+    tree.skeleton = decode_skeleton(in, quantum, diameter_quantum);
+    tree.skeleton.origin = origin;
+    const std::size_t lobes = in.count(6, "lobe count");
+    tree.lobes.resize(lobes);
+    for (Lobe& lobe : tree.lobes) {
+        const std::uint64_t seed = in.varint();
+        if (seed >= tree.skeleton.size()) in.fail("lobe seed is not a skeleton node");
+        lobe.seed_node = static_cast<int>(seed);
+        lobe.points = static_cast<std::size_t>(in.varint());
+        Eigen::Vector3f d;
+        for (int k = 0; k < 3; ++k) d[k] = static_cast<float>(in.svarint());
+        lobe.seed_direction = d.norm() > 0 ? Eigen::Vector3f(d.normalized()) : Eigen::Vector3f::UnitZ();
+        lobe.mesh = decode_mesh(in, quantum);
+    }
+    if (!in.at_end()) in.fail("trailing bytes after the last lobe");
+    return tree;
+}
+
+void write_tlobe(const LobeTree& tree, const std::filesystem::path& path, const TlobeOptions& options) {
+    write_file_atomically(path, encode_tlobe(tree, options));
+}
+
+LobeTree read_tlobe(const std::filesystem::path& path) { return decode_tlobe(read_file(path), path.string()); }
+
+}  // namespace treelobes::lobes

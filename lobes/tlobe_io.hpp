@@ -1,0 +1,35 @@
+// The .tlobe file: a lobe-based tree representation (lobes/lobe_tree.hpp) in a few kilobytes.
+// Layout, quantization and checksums are specified in docs/tlobe.md; in short: a 20-byte
+// header (magic "TLOB", major/minor version, sizes, CRC-32 over header and payload) followed
+// by a deflated payload holding the species parameters, the main skeleton (pre-order parent
+// deltas, quantized positions and allometric diameters), and per lobe its seed point and its
+// closed surface coded by lobes/mesh_coder.hpp.
+#pragma once
+
+#include "lobes/lobe_tree.hpp"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace treelobes::lobes {
+
+inline constexpr std::uint8_t kTlobeMajorVersion = 1;
+inline constexpr std::uint8_t kTlobeMinorVersion = 0;
+
+struct TlobeOptions {
+    double quantum = 0.005;           // metres: grid of skeleton positions and lobe vertices
+    double diameter_quantum = 0.0005; // metres: grid of branch diameters
+    int compression_level = 9;        // deflate level 1..9
+};
+
+// Bytes of the file. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
+std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {});
+// Parses a file's bytes; any inconsistency throws Error(InvalidInput) naming `name`.
+// Decoded lobes have origin 0 (the tree's frame), the skeleton the stored origin.
+LobeTree decode_tlobe(std::string_view bytes, const std::string& name);
+
+void write_tlobe(const LobeTree& tree, const std::filesystem::path& path, const TlobeOptions& options = {});
+LobeTree read_tlobe(const std::filesystem::path& path);
+
+}  // namespace treelobes::lobes

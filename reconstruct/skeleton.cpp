@@ -1,0 +1,619 @@
+#include "reconstruct/skeleton.hpp"
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "reconstruct/kd_tree.hpp"
+#include "reconstruct/ransac_fit.hpp"
+#include "reconstruct/shortest_paths.hpp"
+#include "reconstruct/union_find.hpp"
+
+#include <Eigen/Geometry>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <optional>
+
+namespace treelobes {
+
+namespace {
+
+void check_options(const SkeletonOptions& o) {
+    auto non_negative = [](float v, const char* what) {
+        if (!(v >= 0.0f) || !std::isfinite(v)) throw Error::usage(std::string("skeleton: ") + what + " must be >= 0");
+    };
+    non_negative(o.bin_width, "bin width");
+    non_negative(o.internode_length, "internode length");
+    non_negative(o.min_twig_length, "minimum twig length");
+    non_negative(o.merge_distance, "merge distance");
+    non_negative(o.max_edge_length, "maximum edge length");
+    if (o.smoothing_iterations < 0 || o.smoothing_iterations > 100) throw Error::usage("skeleton: smoothing iterations must be in 0..100");
+}
+
+float median_nearest_distance(const NeighbourGraph& g) {
+    std::vector<float> nearest;
+    nearest.reserve(g.vertex_count());
+    for (std::size_t i = 0; i < g.vertex_count(); ++i) {
+        if (g.offsets[i] == g.offsets[i + 1]) continue;
+        nearest.push_back(*std::min_element(g.lengths.begin() + g.offsets[i], g.lengths.begin() + g.offsets[i + 1]));
+    }
+    if (nearest.empty()) return 0.0f;
+    auto mid = nearest.begin() + static_cast<long>(nearest.size() / 2);
+    std::nth_element(nearest.begin(), mid, nearest.end());
+    return *mid;
+}
+
+// Typical distance between neighbouring samples on the bark, from the median distance d6 to the
+// 6th neighbour: on a surface sampled with density rho, d6 = sqrt(6 / (pi rho)), so the
+// sampling distance 1/sqrt(rho) is d6 sqrt(pi / 6). The nearest-neighbour distance is not
+// used: random sampling makes it half the sampling distance, regular TLS grids nearly all of it.
+float sampling_distance(const KnnTable& near) {
+    std::vector<float> d6;
+    const std::size_t n = near.indices.size() / static_cast<std::size_t>(near.k);
+    d6.reserve(n);
+    for (std::size_t i = 0; i < n; ++i)
+        if (near.row(i)[5] >= 0) d6.push_back(near.row_distances(i)[5]);
+    if (d6.empty()) return 0.0f;
+    auto mid = d6.begin() + static_cast<long>(d6.size() / 2);
+    std::nth_element(d6.begin(), mid, d6.end());
+    return std::sqrt(*mid) * std::sqrt(std::numbers::pi_v<float> / 6.0f);
+}
+
+// Bin clusters: connected pieces of the points that share a geodesic bin.
+struct Clusters {
+    std::vector<int> of_point;
+    std::vector<int> parent;  // parent cluster; -1 = hangs from the root node
+    std::vector<int> bin;
+    std::vector<Eigen::Vector3d> sum;
+    std::vector<double> sum_sq;  // of squared norms, for the spread
+    std::vector<int> count;
+    std::size_t size() const { return parent.size(); }
+    Eigen::Vector3d centroid(int c) const { return sum[c] / static_cast<double>(count[c]); }
+    // RMS distance of the points from their centroid: about the branch radius for a slice of
+    // a thick branch, about w / sqrt(12) for a thin one.
+    double spread(int c) const {
+        return std::sqrt(std::max(0.0, sum_sq[c] / static_cast<double>(count[c]) - centroid(c).squaredNorm()));
+    }
+};
+
+// Even the geodesic distance on a kNN graph is ragged by a few per cent between neighbours
+// (each path zigzags its own way), which would cut a branch's cross-section into arcs lying in
+// different bins. A few passes of neighbour averaging make the level sets clean cross-sections.
+std::vector<float> smoothed_lengths(const NeighbourGraph& graph, const std::vector<float>& length, int passes) {
+    std::vector<float> current = length, next(length.size());
+    for (int pass = 0; pass < passes; ++pass) {
+        for (std::size_t i = 0; i < current.size(); ++i) {
+            double sum = current[i];
+            for (std::uint32_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) sum += current[graph.targets[e]];
+            next[i] = static_cast<float>(sum / static_cast<double>(1 + graph.offsets[i + 1] - graph.offsets[i]));
+        }
+        current.swap(next);
+    }
+    return current;
+}
+
+// The parent of a cluster is where the weighted shortest-path tree (seed 001: weights
+// ||u-v||^beta) mostly enters it from: every point whose tree parent lies in an earlier
+// cluster of a lower bin votes for that cluster. A majority is robust where single paths are
+// not (one path may arrive through a small fragment of bark). Clusters that receive no vote
+// (reached across a bridge or through the smoothing) hang from the cluster holding the
+// geodesic parent of their first point.
+std::vector<int> cluster_parents(const Clusters& c, const std::vector<int>& first_point, const ShortestPaths& geodesic,
+                                 const ShortestPaths& weighted) {
+    std::vector<std::pair<int, int>> votes;  // (cluster, voted parent)
+    for (std::size_t u = 0; u < c.of_point.size(); ++u) {
+        const int w = weighted.parent[u];
+        if (w < 0) continue;
+        const int a = c.of_point[u], b = c.of_point[w];
+        if (a >= 0 && b >= 0 && b < a && c.bin[b] < c.bin[a]) votes.emplace_back(a, b);
+    }
+    std::sort(votes.begin(), votes.end());
+    std::vector<int> parent(c.bin.size(), -1);
+    std::vector<std::size_t> best(c.bin.size(), 0);
+    for (std::size_t i = 0; i < votes.size();) {
+        std::size_t j = i;
+        while (j < votes.size() && votes[j] == votes[i]) ++j;
+        if (j - i > best[votes[i].first]) {  // ties: the smaller cluster number (sorted first)
+            best[votes[i].first] = j - i;
+            parent[votes[i].first] = votes[i].second;
+        }
+        i = j;
+    }
+    for (std::size_t k = 0; k < parent.size(); ++k)
+        if (best[k] == 0) {
+            const int up = geodesic.parent[first_point[k]];
+            parent[k] = up < 0 ? -1 : c.of_point[up];
+        }
+    return parent;
+}
+
+Clusters cluster_bins(std::span<const Eigen::Vector3f> points, const NeighbourGraph& graph, const KnnTable& near,
+                      const ShortestPaths& sp, const ShortestPaths& weighted, float width, float join, int smoothing) {
+    const int n = static_cast<int>(points.size());
+    const std::vector<float> level = smoothed_lengths(graph, sp.length, smoothing);
+    std::vector<int> bin(points.size());
+    for (int i = 0; i < n; ++i) bin[i] = static_cast<int>(std::floor(level[i] / width));
+    UnionFind sets(points.size());
+    for (int i = 0; i < n; ++i)
+        for (std::uint32_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
+            const int j = graph.targets[e];
+            if (j > i && bin[i] == bin[j]) sets.unite(i, j);
+        }
+    // Same-bin points up to `join` apart belong together even without a graph edge: on sparse
+    // bark a bin's band is only two or three samples tall and its kNN edges leave gaps.
+    const float join2 = join * join;
+    for (int i = 0; i < n; ++i) {
+        const int* row = near.row(i);
+        const float* d2 = near.row_distances(i);
+        for (int j = 0; j < near.k; ++j)
+            if (row[j] >= 0 && d2[j] <= join2 && bin[row[j]] == bin[i]) sets.unite(i, row[j]);
+    }
+    // Clusters are numbered in the order their first point was settled, so clusters of lower
+    // bins mostly have smaller numbers.
+    Clusters c;
+    c.of_point.assign(points.size(), -1);
+    std::vector<int> id_of_set(points.size(), -1), first_point;
+    for (int u : sp.order) {
+        const int set = sets.find(u);
+        if (id_of_set[set] < 0) {
+            id_of_set[set] = static_cast<int>(c.bin.size());
+            first_point.push_back(u);
+            c.bin.push_back(bin[u]);
+            c.sum.emplace_back(Eigen::Vector3d::Zero());
+            c.sum_sq.push_back(0.0);
+            c.count.push_back(0);
+        }
+        const int id = id_of_set[set];
+        c.of_point[u] = id;
+        c.sum[id] += points[u].cast<double>();
+        c.sum_sq[id] += points[u].cast<double>().squaredNorm();
+        ++c.count[id];
+    }
+    c.parent = cluster_parents(c, first_point, sp, weighted);
+    return c;
+}
+
+// True when some point of the clusters `a` is closer than `gap` to some point of the clusters
+// `b`: arcs of one wide ring, split where the ring dips into the next bin, nearly touch.
+bool gap_below(std::span<const Eigen::Vector3f> points, const std::vector<std::vector<int>>& points_of, const std::vector<int>& a,
+               const std::vector<int>& b, double gap) {
+    const float g2 = static_cast<float>(gap * gap);
+    for (int ca : a)
+        for (int i : points_of[ca])
+            for (int cb : b)
+                for (int j : points_of[cb])
+                    if ((points[i] - points[j]).squaredNorm() < g2) return true;
+    return false;
+}
+
+// Sibling clusters of one bin are pieces of one branch cross-section (sparse or one-sided
+// scans) when their centroids are closer than `distance`, or closer than 0.9 times the sum of
+// their spreads while both lie within the parent's footprint (twice its spread). Two arcs of
+// one ring pass this test (centroid distance about 1.3 r against spreads of about 0.8 r each);
+// two separate stems do not, however close. Arcs of a wide ring (one-sided or sparse scans of
+// a thick stem) that nearly touch (a gap under a quarter of the footprint) merge as well.
+// Merged siblings' children meet as siblings in the next bin and are merged in turn.
+Clusters merge_fragments(std::span<const Eigen::Vector3f> points, const Clusters& in, float distance, float root_spread) {
+    const int m = static_cast<int>(in.size());
+    std::vector<std::vector<int>> points_of(m);
+    for (std::size_t i = 0; i < in.of_point.size(); ++i) points_of[in.of_point[i]].push_back(static_cast<int>(i));
+    std::vector<int> rep(m);
+    std::iota(rep.begin(), rep.end(), 0);
+    std::vector<std::vector<int>> members(m), children(m + 1);  // children[m]: hanging from the root
+    for (int c = 0; c < m; ++c) {
+        members[c] = {c};
+        children[in.parent[c] < 0 ? m : in.parent[c]].push_back(c);
+    }
+    Clusters work = in;
+    auto merge_into = [&](int keep, int gone) {
+        for (int x : members[gone]) rep[x] = keep;
+        members[keep].insert(members[keep].end(), members[gone].begin(), members[gone].end());
+        members[gone].clear();
+        work.sum[keep] += work.sum[gone];
+        work.sum_sq[keep] += work.sum_sq[gone];
+        work.count[keep] += work.count[gone];
+    };
+    for (int p = -1; p < m; ++p) {
+        if (p >= 0 && rep[p] != p) continue;
+        std::vector<int> kids;
+        if (p < 0) kids = children[m];
+        else
+            for (int x : members[p]) kids.insert(kids.end(), children[x].begin(), children[x].end());
+        std::sort(kids.begin(), kids.end());
+        const double footprint = 2.0 * (p < 0 ? root_spread : work.spread(p));
+        // Greedy in cluster order: each kid joins the first earlier kid of its bin close enough.
+        for (std::size_t a = 0; a < kids.size(); ++a)
+            for (std::size_t b = 0; b < a; ++b) {
+                const int ka = kids[a], kb = kids[b];
+                if (rep[kb] != kb || rep[ka] != ka || in.bin[ka] != in.bin[kb]) continue;
+                const double d = (work.centroid(ka) - work.centroid(kb)).norm();
+                const bool fragments = d < footprint && d < 0.9 * (work.spread(ka) + work.spread(kb));
+                if (d < distance || fragments ||
+                    (d < footprint && gap_below(points, points_of, members[ka], members[kb], 0.25 * footprint))) {
+                    merge_into(kb, ka);
+                    break;
+                }
+            }
+    }
+    Clusters out;
+    std::vector<int> new_id(m, -1);
+    for (int c = 0; c < m; ++c)
+        if (rep[c] == c) {
+            new_id[c] = static_cast<int>(out.parent.size());
+            out.parent.push_back(in.parent[c] < 0 ? -1 : new_id[rep[in.parent[c]]]);
+            out.bin.push_back(in.bin[c]);
+            out.sum.push_back(work.sum[c]);
+            out.sum_sq.push_back(work.sum_sq[c]);
+            out.count.push_back(work.count[c]);
+        }
+    out.of_point.resize(in.of_point.size());
+    for (std::size_t i = 0; i < in.of_point.size(); ++i) out.of_point[i] = new_id[rep[in.of_point[i]]];
+    return out;
+}
+
+// Where a cluster sits on its branch axis. The centroid of a thick branch's slice lies on the
+// scanned side of the bark, not on the axis (a half-visible stem puts it 0.64 r off), so for
+// wide clusters a circle is fitted across the local branch direction and its centre used
+// when the fit is trustworthy (enough of the circle seen, small residuals).
+std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> points, const Clusters& c, float spacing, bool fit) {
+    std::vector<Eigen::Vector3f> position(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) position[k] = c.centroid(static_cast<int>(k)).cast<float>();
+    if (!fit) return position;
+    std::vector<std::vector<int>> members(c.size()), children(c.size());
+    for (std::size_t i = 0; i < points.size(); ++i) members[c.of_point[i]].push_back(static_cast<int>(i));
+    for (std::size_t k = 0; k < c.size(); ++k)
+        if (c.parent[k] >= 0) children[c.parent[k]].push_back(static_cast<int>(k));
+    std::vector<Eigen::Vector2f> flat;
+    std::size_t tried = 0, moved = 0, inherited = 0;
+    // Offset from the centroid to the fitted axis; a thick slice whose own fit is not trusted
+    // takes its parent's (a one-sided scan is one-sided all along the stem).
+    std::vector<Eigen::Vector3f> offset(c.size(), Eigen::Vector3f::Zero());
+    std::vector<bool> has_offset(c.size(), false);
+    for (std::size_t k = 0; k < c.size(); ++k) {
+        // A window of three bins (parent, cluster, only child) gives the fit more of the bark.
+        const int below = c.parent[k];
+        const int above = children[k].size() == 1 ? children[k].front() : -1;
+        // The branch direction over up to three clusters either side: slice centroids of a
+        // one-sided scan zigzag, and a tilted projection plane smears the circle. Positions
+        // below are final already (parents come first). At a branch end or a fork the last
+        // slice is often a partial arc: the direction then comes from the nodes below.
+        int low = static_cast<int>(k), high = static_cast<int>(k);
+        for (int step = 0; step < 3; ++step) {
+            if (c.parent[low] >= 0) low = c.parent[low];
+            if (children[high].size() == 1) high = children[high].front();
+        }
+        const Eigen::Vector3f from = position[low];
+        const Eigen::Vector3f to = high != static_cast<int>(k) ? c.centroid(high).cast<float>()
+                                   : (below >= 0 && low != below) ? position[below] : position[k];
+        if ((to - from).norm() < 1e-6f) continue;
+        const Eigen::Vector3f direction = (to - from).normalized();
+        const Eigen::Vector3f u = direction.unitOrthogonal(), v = direction.cross(u);
+        flat.clear();
+        double spread = 0;
+        for (int window : {below, static_cast<int>(k), above}) {
+            if (window < 0) continue;
+            for (int i : members[window]) {
+                const Eigen::Vector3f d = points[i] - position[k];
+                flat.emplace_back(d.dot(u), d.dot(v));
+                spread += flat.back().squaredNorm();
+            }
+        }
+        if (flat.size() < 12) continue;
+        spread = std::sqrt(spread / static_cast<double>(flat.size()));
+        if (spread < std::max(2.0 * spacing, 0.04)) continue;  // thin branch: the centroid is near the axis already
+        ++tried;
+        const CircleFit circle = fit_circle(flat, std::max(0.005f, spacing), 0.5f * static_cast<float>(spread),
+                                            4.0f * static_cast<float>(spread), 100);
+        const bool trusted = circle.ok && circle.coverage >= 0.2f && circle.inliers * 2 >= flat.size() &&
+                             circle.rms < 0.25f * circle.radius && circle.centre.norm() < circle.radius;
+        if (!trusted) {
+            const double parent_spread = below >= 0 ? c.spread(below) : 0.0;
+            // Only along an unbranched stretch of similar thickness, and only a clearly
+            // one-sided offset (a full ring's offset is fit noise, not worth passing on).
+            if (below >= 0 && has_offset[below] && children[below].size() == 1 &&
+                std::abs(c.spread(static_cast<int>(k)) - parent_spread) < 0.3 * parent_spread &&
+                offset[below].norm() > 0.5 * parent_spread) {
+                offset[k] = offset[below];
+                has_offset[k] = true;
+                position[k] += offset[k];
+                ++inherited;
+            }
+            continue;
+        }
+        ++moved;
+        offset[k] = circle.centre.x() * u + circle.centre.y() * v;
+        has_offset[k] = true;
+        position[k] += offset[k];
+    }
+    log_debug("skeleton: circle fits tried on " + std::to_string(tried) + " of " + std::to_string(c.size()) + " clusters, " +
+              std::to_string(moved) + " moved onto the fitted axis, " + std::to_string(inherited) + " took their parent's offset");
+    return position;
+}
+
+// Clusters reached from the base only across a gap longer than `max_gap` (the longest edge on
+// the shortest path of their best-connected point), and everything above them. Such pieces
+// hang on a guessed connection; the lobe stage rather than the skeleton should represent them.
+std::vector<bool> detached_clusters(const Clusters& c, const NeighbourGraph& graph, const ShortestPaths& sp, float max_gap) {
+    std::vector<bool> detached(c.size(), false);
+    if (!(max_gap > 0)) return detached;
+    std::vector<float> gap(sp.parent.size(), 0.0f);
+    for (int v : sp.order) {
+        const int u = sp.parent[v];
+        if (u < 0) continue;
+        float length = 0;
+        for (std::uint32_t e = graph.offsets[v]; e < graph.offsets[v + 1]; ++e)
+            if (graph.targets[e] == u) length = graph.lengths[e];
+        gap[v] = std::max(gap[u], length);
+    }
+    std::vector<float> best(c.size(), std::numeric_limits<float>::infinity());
+    for (std::size_t i = 0; i < gap.size(); ++i) best[c.of_point[i]] = std::min(best[c.of_point[i]], gap[i]);
+    for (std::size_t k = 0; k < c.size(); ++k)  // parents come first
+        detached[k] = best[k] > max_gap || (c.parent[k] >= 0 && detached[c.parent[k]]);
+    return detached;
+}
+
+// Node 0 at the stem foot, node c+1 at the axis position of cluster c. Until allometry sets
+// the radii, a node's radius holds its cluster's spread (a measured thickness) for pruning.
+TreeGraph cluster_tree(const Clusters& c, const std::vector<Eigen::Vector3f>& position, const Eigen::Vector3f& root,
+                       float root_spread) {
+    TreeGraph tree;
+    tree.add_node(root, root_spread, -1);
+    for (std::size_t k = 0; k < c.size(); ++k)
+        tree.add_node(position[k], static_cast<float>(c.spread(static_cast<int>(k))), c.parent[k] + 1);
+    return tree;
+}
+
+std::vector<float> chain_lengths(const TreeGraph& tree, const std::vector<std::vector<int>>& chains) {
+    std::vector<float> lengths;
+    for (const auto& chain : chains) {
+        float l = 0;
+        for (std::size_t i = 1; i < chain.size(); ++i) l += tree.edge_length(chain[i]);
+        lengths.push_back(l);
+    }
+    return lengths;
+}
+
+// Distance from p to the polyline through `nodes`.
+float distance_to_polyline(const TreeGraph& tree, const std::vector<int>& nodes, const Eigen::Vector3f& p) {
+    float best = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < nodes.size(); ++i) {
+        const Eigen::Vector3f a = tree.nodes[nodes[i]].position;
+        if (i + 1 == nodes.size()) {
+            best = std::min(best, (p - a).norm());
+            break;
+        }
+        const Eigen::Vector3f ab = tree.nodes[nodes[i + 1]].position - a;
+        const float t = ab.squaredNorm() > 0 ? std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0f, 1.0f) : 0.0f;
+        best = std::min(best, (a + t * ab - p).norm());
+    }
+    return best;
+}
+
+// Removes spurious leaf chains hanging from a fork: those whose tip stays closer than
+// `min_length` (or than twice the thickness of the fork: bark bumps and scan fragments of a
+// thick stem) to the axis the fork belongs to (the node below the fork and the fork's longest
+// chain). Never every branch of a fork: the chain holding the most points survives (at a
+// ragged branch end, a longer chain may be a few points of bark). Repeats until nothing
+// changes. Updates node_of_point.
+std::size_t prune_twigs(TreeGraph& tree, float min_length, std::vector<int>& node_of_point) {
+    std::size_t removed = 0;
+    for (int round = 0; round < 20; ++round) {
+        const auto chains = tree_chains(tree);
+        const auto lengths = chain_lengths(tree, chains);
+        std::vector<std::size_t> points_of_node(tree.size(), 0);
+        for (int node : node_of_point) ++points_of_node[node];
+        std::vector<std::size_t> weight(chains.size(), 0);
+        for (std::size_t k = 0; k < chains.size(); ++k)
+            for (std::size_t i = 1; i < chains[k].size(); ++i) weight[k] += points_of_node[chains[k][i]];
+        std::map<int, std::vector<std::size_t>> by_fork;  // fork -> its chains
+        for (std::size_t k = 0; k < chains.size(); ++k) by_fork[chains[k].front()].push_back(k);
+        std::vector<bool> keep(tree.size(), true);
+        bool changed = false;
+        for (const auto& [fork, list] : by_fork) {
+            if (list.size() < 2) continue;
+            std::size_t longest = list.front();  // the fork's main chain
+            for (std::size_t k : list) if (weight[k] > weight[longest]) longest = k;
+            std::vector<int> axis = chains[longest];
+            if (tree.nodes[fork].parent >= 0) axis.insert(axis.begin(), tree.nodes[fork].parent);
+            const float limit = std::max(min_length, 2.0f * tree.nodes[fork].radius);
+            for (std::size_t k : list) {
+                const bool leaf = tree.nodes[chains[k].back()].children.empty();
+                if (k == longest || !leaf) continue;
+                const float reach = std::min(lengths[k], distance_to_polyline(tree, axis, tree.nodes[chains[k].back()].position));
+                if (reach >= limit) continue;
+                for (std::size_t i = 1; i < chains[k].size(); ++i) keep[chains[k][i]] = false;
+                removed += chains[k].size() - 1;
+                changed = true;
+            }
+        }
+        if (!changed) break;
+        std::vector<int> new_index;
+        tree = keep_nodes(tree, keep, new_index);
+        for (int& node : node_of_point) node = new_index[node];
+    }
+    return removed;
+}
+
+// Laplacian smoothing of chain interiors; forks, tips and the root stay where they are.
+void smooth_chains(TreeGraph& tree, int iterations) {
+    const auto chains = tree_chains(tree);
+    for (int it = 0; it < iterations; ++it)
+        for (const auto& chain : chains) {
+            if (chain.size() < 3) continue;
+            std::vector<Eigen::Vector3f> p;
+            for (int node : chain) p.push_back(tree.nodes[node].position);
+            for (std::size_t i = 1; i + 1 < chain.size(); ++i)
+                tree.nodes[chain[i]].position = 0.25f * p[i - 1] + 0.5f * p[i] + 0.25f * p[i + 1];
+        }
+}
+
+// Position at arc length `s` along a polyline with cumulative lengths `arc`.
+Eigen::Vector3f point_at(const std::vector<Eigen::Vector3f>& p, const std::vector<float>& arc, float s) {
+    const auto it = std::upper_bound(arc.begin(), arc.end(), s);
+    const std::size_t i = std::clamp<std::size_t>(static_cast<std::size_t>(it - arc.begin()), 1, p.size() - 1);
+    const float span = arc[i] - arc[i - 1];
+    const float t = span > 0 ? std::clamp((s - arc[i - 1]) / span, 0.0f, 1.0f) : 1.0f;
+    return p[i - 1] + t * (p[i] - p[i - 1]);
+}
+
+// Resamples every chain to round(L / l) internodes of equal length; forks and tips stay
+// exact. new_of_old[old node] = new node at the upper end of the internode covering it.
+TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old) {
+    TreeGraph out;
+    out.origin = tree.origin;
+    out.add_node(tree.nodes[0].position, 0.0f, -1);
+    new_of_old.assign(tree.size(), -1);
+    new_of_old[0] = 0;
+    for (const auto& chain : tree_chains(tree)) {
+        std::vector<Eigen::Vector3f> p;
+        std::vector<float> arc{0.0f};
+        for (std::size_t i = 0; i < chain.size(); ++i) {
+            p.push_back(tree.nodes[chain[i]].position);
+            if (i > 0) arc.push_back(arc.back() + (p[i] - p[i - 1]).norm());
+        }
+        const float total = arc.back();
+        int previous = new_of_old[chain.front()];
+        if (total < 1e-6f) {  // coincident nodes: nothing to add
+            for (std::size_t i = 1; i < chain.size(); ++i) new_of_old[chain[i]] = previous;
+            continue;
+        }
+        const int m = std::max(1, static_cast<int>(std::lround(total / l)));
+        const float step = total / static_cast<float>(m);
+        std::vector<int> created(static_cast<std::size_t>(m) + 1, previous);
+        for (int t = 1; t <= m; ++t) {
+            const Eigen::Vector3f pos = t == m ? p.back() : point_at(p, arc, step * static_cast<float>(t));
+            previous = out.add_node(pos, 0.0f, previous);
+            created[t] = previous;
+        }
+        for (std::size_t i = 1; i < chain.size(); ++i) {
+            const int t = std::clamp(static_cast<int>(std::ceil(arc[i] / step - 1e-4f)), 1, m);
+            new_of_old[chain[i]] = created[t];
+        }
+    }
+    return out;
+}
+
+}  // namespace
+
+TreeGraph keep_nodes(const TreeGraph& tree, const std::vector<bool>& keep, std::vector<int>& new_index) {
+    if (tree.empty() || !keep[0]) throw Error(ExitCode::Internal, "keep_nodes: the root must be kept");
+    TreeGraph out;
+    out.origin = tree.origin;
+    new_index.assign(tree.size(), -1);
+    for (int u : tree.preorder()) {
+        const int parent = tree.nodes[u].parent;
+        if (keep[u]) new_index[u] = out.add_node(tree.nodes[u].position, tree.nodes[u].radius, parent < 0 ? -1 : new_index[parent]);
+        else new_index[u] = new_index[parent];
+    }
+    return out;
+}
+
+std::vector<std::vector<int>> tree_chains(const TreeGraph& tree) {
+    std::vector<std::vector<int>> chains;
+    for (int start : tree.preorder()) {
+        const auto& kids = tree.nodes[start].children;
+        if (start != 0 && kids.size() < 2) continue;
+        for (int child : kids) {
+            std::vector<int> chain{start, child};
+            while (tree.nodes[chain.back()].children.size() == 1) chain.push_back(tree.nodes[chain.back()].children.front());
+            chains.push_back(std::move(chain));
+        }
+    }
+    return chains;
+}
+
+SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, const SkeletonOptions& o, const std::string& name,
+                                    const KdTree* given_index, const KnnTable* given_near) {
+    check_options(o);
+    if (points.size() < 10) throw Error::input(name, "too few points for a skeleton (" + std::to_string(points.size()) + ")");
+    for (const auto& p : points)
+        if (!p.allFinite()) throw Error::input(name, "a point has a non-finite coordinate");
+
+    SkeletonResult r;
+    auto clock = std::chrono::steady_clock::now();
+    auto lap = [&clock](const char* what) {  // stage timings for --log-level debug
+        const auto now = std::chrono::steady_clock::now();
+        log_debug(std::string("skeleton: ") + what + " " + std::to_string(std::chrono::duration<double>(now - clock).count()) + " s");
+        clock = now;
+    };
+    std::optional<KdTree> own_index;
+    if (!given_index || given_index->size() != points.size()) given_index = &own_index.emplace(points);
+    const KdTree& index = *given_index;
+    const int width = skeleton_table_width(o);
+    KnnTable own_near;
+    if (!given_near || given_near->k != width || given_near->indices.size() != points.size() * static_cast<std::size_t>(width)) {
+        own_near = knn_of_all_points(index, width);
+        given_near = &own_near;
+    }
+    const KnnTable& near = *given_near;
+    const NeighbourGraph graph = build_neighbour_graph(points, {o.neighbours, o.beta, o.max_edge_length, true}, &index, &near);
+    r.graph_components = graph.components;
+    r.bridges = graph.bridges;
+    r.longest_bridge = graph.longest_bridge;
+    lap("neighbour graph");
+    r.spacing = median_nearest_distance(graph);
+    const float sampling = sampling_distance(near);
+    r.bin_width = o.bin_width > 0 ? o.bin_width : std::clamp(2.5f * sampling, 0.02f, 0.5f);
+    log_debug("skeleton: nearest-neighbour spacing " + std::to_string(r.spacing) + " m, sampling distance " + std::to_string(sampling) + " m");
+    r.internode_length = o.internode_length > 0 ? o.internode_length : r.bin_width;
+    const float twig = o.min_twig_length > 0 ? o.min_twig_length : 2.0f * r.bin_width;
+    const float merge = o.merge_distance > 0 ? o.merge_distance : r.bin_width;
+
+    r.base = find_tree_base(points, graph, o.base);
+    // The weighted tree and the geodesic distances are independent runs: one per core.
+    ShortestPaths weighted, sp;
+    tbb::parallel_invoke([&] { weighted = shortest_paths(graph, r.base.sources); },
+                         [&] { sp = shortest_paths(graph, r.base.sources, EdgeCost::Length); });
+    lap("base and shortest paths");
+    const float root_spread = r.base.circle_fitted ? r.base.foot_radius : 0.0f;
+    const Clusters clusters =
+        merge_fragments(points, cluster_bins(points, graph, near, sp, weighted, r.bin_width, r.bin_width, o.geodesic_smoothing), merge, root_spread);
+    r.clusters = clusters.size();
+    lap("bins");
+
+    TreeGraph tree = cluster_tree(clusters, axis_positions(points, clusters, r.spacing, o.fit_axes), r.base.position, root_spread);
+    lap("axis fits");
+    std::vector<int> node_of_point(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) node_of_point[i] = clusters.of_point[i] + 1;
+    const std::vector<bool> detached = detached_clusters(clusters, graph, sp, o.max_gap);
+    if (std::find(detached.begin(), detached.end(), true) != detached.end()) {
+        std::vector<bool> keep(tree.size(), true);
+        for (std::size_t k = 0; k < detached.size(); ++k) keep[k + 1] = !detached[k];
+        for (std::size_t i = 0; i < points.size(); ++i) r.detached_points += detached[clusters.of_point[i]];
+        std::vector<int> new_index;
+        tree = keep_nodes(tree, keep, new_index);
+        for (int& node : node_of_point) node = new_index[node];
+    }
+    r.pruned_nodes = prune_twigs(tree, twig, node_of_point);
+    smooth_chains(tree, o.smoothing_iterations);
+
+    for (auto& node : tree.nodes) node.radius = 0.0f;  // spreads served their purpose
+    std::vector<int> map;
+    tree = resample(tree, r.internode_length, map);
+    for (int& node : node_of_point) node = map[node];
+    tree.order_children_by_subtree_length();
+    tree = keep_nodes(tree, std::vector<bool>(tree.size(), true), map);
+    for (int& node : node_of_point) node = map[node];
+    // The root has no internode of its own: its points belong to the first internode above it.
+    const int first = tree.nodes[0].children.empty() ? 0 : tree.nodes[0].children.front();
+    for (int& node : node_of_point)
+        if (node == 0) node = first;
+
+    lap("prune, smooth, resample");
+    r.tree = std::move(tree);
+    r.point_internode = std::move(node_of_point);
+    r.point_geodesic = sp.length;
+    return r;
+}
+
+TreeGraph extract_skeleton(const PointCloud& cloud, const SkeletonOptions& options) {
+    SkeletonResult r = reconstruct_skeleton(cloud.positions, options);
+    r.tree.origin = cloud.origin;
+    return r.tree;
+}
+
+}  // namespace treelobes

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Regenerates data/synthetic/ (the committed sample used by the README demo and tests) with the
+# `treelobes synth` commands below. Same binary + same species.yaml -> byte-identical files.
+#
+#   scripts/regenerate_synthetic.sh            rewrite data/synthetic/
+#   scripts/regenerate_synthetic.sh --check    regenerate into a temporary folder and compare
+#
+# The binary is $TREELOBES_BIN, or build/bin/treelobes. Layout: single trees at the top level
+# (<species>_<seed>.las, _skeleton.ply, _truth.json, some _mesh.ply), the tile in tile/.
+# data/synthetic/README.md is written by hand and not regenerated.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BIN=${TREELOBES_BIN:-build/bin/treelobes}
+[[ -x "$BIN" ]] || { echo "regenerate_synthetic: $BIN not found (build first or set TREELOBES_BIN)" >&2; exit 1; }
+export TREELOBES_SPECIES=config/species.yaml
+# LAS headers carry a creation date; SOURCE_DATE_EPOCH (the reproducible-builds convention) pins it.
+export SOURCE_DATE_EPOCH=${SOURCE_DATE_EPOCH:-1735689600}  # 2025-01-01
+
+generate() {
+    local out=$1
+    mkdir -p "$out"
+    rm -rf "$out/tile" "$out"/*.las "$out"/*.ply "$out"/*_truth.json
+    # Three small single trees: two terrestrial scans (the palm with its mesh), one airborne.
+    "$BIN" --log-level warn synth tree --species palm --seed 1 --height 8 --angular-step 0.8 --max-leaves 1500 --out "$out" >/dev/null
+    "$BIN" --log-level warn synth tree --species lagerstroemia --seed 2 --height 5 --angular-step 0.8 --max-leaves 3000 --no-mesh --out "$out" >/dev/null
+    "$BIN" --log-level warn synth tree --species birch --seed 3 --height 9 --scanner als --pulse-density 80 --max-leaves 4000 --no-mesh --out "$out" >/dev/null
+    # One small airborne tile: five species of modest size, ground, understory and noise.
+    "$BIN" --log-level warn synth tile --trees 8 --size 25 --seed 4 --pulse-density 8 --max-leaves 3000 \
+        --species pine birch palm lagerstroemia ailanthus_altissima --out "$out/tile" >/dev/null
+    # summary.json holds timings and memory, which differ between runs: not part of the sample.
+    rm -f "$out/tile/summary.json"
+}
+
+if [[ "${1:-}" == "--check" ]]; then
+    tmp=$(mktemp -d)
+    trap 'rm -rf "$tmp"' EXIT
+    generate "$tmp"
+    status=0
+    fresh=$(cd "$tmp" && find . -type f | sort)
+    kept=$(cd data/synthetic && find . -type f ! -name README.md | sort)
+    if [[ "$fresh" != "$kept" ]]; then
+        diff <(echo "$kept") <(echo "$fresh") | sed 's/^/  file list: /' >&2 || true
+        status=1
+    fi
+    while read -r f; do
+        [[ -f "data/synthetic/$f" ]] || continue
+        cmp -s "$tmp/$f" "data/synthetic/$f" || { echo "  differs: $f" >&2; status=1; }
+    done <<<"$fresh"
+    if ((status)); then
+        echo "regenerate_synthetic: data/synthetic differs from a fresh run" >&2
+        exit 1
+    fi
+    echo "data/synthetic is byte-identical to a fresh run ($(echo "$fresh" | wc -l) files)"
+else
+    generate data/synthetic
+    du -sh data/synthetic
+fi

@@ -1,0 +1,93 @@
+#include "lobes/closed_mesh.hpp"
+#include "lobes/lobe_tree.hpp"
+#include "lobes/tlobe_io.hpp"
+
+#include "core/error.hpp"
+#include "reconstruct/synthetic_clouds.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace treelobes;
+using namespace treelobes::lobes;
+
+namespace {
+
+// A scanned trunk (0..3 m, r 12 cm) carrying a crown: a ball of foliage points of radius 0.9 m
+// centred 0.8 m above the trunk top. The bark edges are confident, the crown's are not.
+PointCloud trunk_and_crown(std::size_t* crown_points = nullptr) {
+    PointCloud cloud = test::cloud_from({{{0, 0, 0}, {0, 0, 3.0f}, 0.12f}}, 2500.0f);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-0.9f, 0.9f);
+    std::size_t added = 0;
+    while (added < 5000) {
+        const Eigen::Vector3f p(u(rng), u(rng), u(rng));
+        if (p.norm() > 0.9f) continue;
+        cloud.positions.push_back(p + Eigen::Vector3f(0, 0, 3.8f));
+        ++added;
+    }
+    if (crown_points) *crown_points = added;
+    return cloud;
+}
+
+struct Built {
+    TreeReconstruction reconstruction;
+    LobeTree tree;
+    LobeReport report;
+};
+
+Built build(const PointCloud& cloud, double fs) {
+    ReconstructOptions ro;
+    ro.allometry.fs = fs;
+    Built b{reconstruct_tree(cloud, ro, "trunk_and_crown"), {}, {}};
+    b.tree = build_lobe_tree(cloud, b.reconstruction, ro, "test", {}, &b.report);
+    return b;
+}
+
+}  // namespace
+
+TEST(LobeTree, CrownBecomesClosedLobesSeededOnTheTrunk) {
+    std::size_t crown = 0;
+    const PointCloud cloud = trunk_and_crown(&crown);
+    const Built b = build(cloud, 1.0);
+    ASSERT_GE(b.tree.lobes.size(), 1u);
+    EXPECT_GE(b.report.lobe_points, crown / 2);  // most of the crown is in lobes
+    EXPECT_GE(b.tree.skeleton.size(), 2u);      // the trunk stays explicit
+    double lobe_volume = 0;
+    for (const Lobe& lobe : b.tree.lobes) {
+        EXPECT_TRUE(check_closed(lobe.mesh).closed());
+        EXPECT_GT(lobe.volume(), 0.0);
+        EXPECT_LE(lobe.mesh.faces.size(), LobeOptions{}.max_lobe_faces);
+        ASSERT_GE(lobe.seed_node, 0);
+        ASSERT_LT(static_cast<std::size_t>(lobe.seed_node), b.tree.skeleton.size());
+        EXPECT_NEAR(lobe.seed_direction.norm(), 1.0f, 1e-4f);
+        EXPECT_GT(b.tree.seed_thickness(lobe), 0.0f);
+        lobe_volume += lobe.volume();
+    }
+    // The crown ball holds 3.05 m^3; lobes hull most of it and nothing far beyond.
+    EXPECT_GT(lobe_volume, 1.0);
+    EXPECT_LT(lobe_volume, 3.2);
+    EXPECT_EQ(b.tree.fs, 1.0);
+    EXPECT_EQ(b.tree.species, "test");
+}
+
+TEST(LobeTree, SmallerFsPutsMorePointsIntoLobesAndOutputIsDeterministic) {
+    const PointCloud cloud = trunk_and_crown();
+    const Built wide = build(cloud, 1.0);
+    const Built narrow = build(cloud, 0.2);
+    EXPECT_GE(narrow.report.low_confidence_edges, wide.report.low_confidence_edges);
+    EXPECT_GE(narrow.report.lobe_points, wide.report.lobe_points);
+    EXPECT_LE(narrow.tree.skeleton.size(), wide.tree.skeleton.size());
+    const Built again = build(cloud, 1.0);
+    EXPECT_TRUE(encode_tlobe(again.tree) == encode_tlobe(wide.tree)) << "same input, different .tlobe bytes";
+}
+
+TEST(LobeTree, RejectsAReconstructionOfAnotherCloud) {
+    const PointCloud cloud = trunk_and_crown();
+    ReconstructOptions ro;
+    const TreeReconstruction r = reconstruct_tree(cloud, ro, "x");
+    PointCloud other = cloud;
+    other.positions.pop_back();
+    EXPECT_THROW(build_lobe_tree(other, r, ro, ""), Error);
+}

@@ -1,0 +1,160 @@
+#include "lobes/alpha_shape.hpp"
+#include "lobes/patch_library.hpp"
+#include "lobes/synthesis.hpp"
+#include "lobes/texturing.hpp"
+
+#include "config/species_profile.hpp"
+#include "core/error.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+using namespace treelobes;
+using namespace treelobes::lobes;
+using treelobes::test::error_code_of;
+
+namespace {
+
+const SpeciesProfile& species(const std::string& name) {
+    static const std::vector<SpeciesProfile> profiles = load_species_profiles(default_species_file());
+    return find_species_profile(profiles, name);
+}
+
+// An axis-aligned closed box, outward.
+TriangleMesh box(const Eigen::Vector3f& lo, const Eigen::Vector3f& hi) {
+    TriangleMesh m;
+    for (int i = 0; i < 8; ++i) m.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(), i & 4 ? hi.z() : lo.z());
+    m.faces = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+               {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    return m;
+}
+
+// A lobe tree: a 2 m trunk of two edges and one 2 x 2 x 1.5 m box lobe seeded at its top.
+LobeTree boxed_tree() {
+    LobeTree t;
+    t.skeleton.add_node({0, 0, 0}, 0.08f, -1);
+    t.skeleton.add_node({0, 0, 1}, 0.06f, 0);
+    t.skeleton.add_node({0, 0, 2}, 0.03f, 1);
+    Lobe lobe;
+    lobe.mesh = box({-1, -1, 1.9f}, {1, 1, 3.4f});
+    lobe.seed_node = 2;
+    lobe.seed_direction = {0, 0, 1};
+    t.lobes.push_back(lobe);
+    return t;
+}
+
+}  // namespace
+
+TEST(PatchLibrary, BranchletsArePartitionedIntoPatchesWithDockingPoints) {
+    PatchLibraryOptions o;
+    const PatchLibrary lib = build_patch_library(species("lagerstroemia"), o);
+    EXPECT_EQ(lib.branchlets, 24);
+    ASSERT_GT(lib.patches.size(), 24u * 3);
+    std::size_t docks = 0, terminal = 0, leaves = 0;
+    for (const Patch& p : lib.patches) {
+        ASSERT_FALSE(p.segments.empty());
+        EXPECT_LT(p.segments.front().a.norm(), 1e-6f);  // root at the origin
+        EXPECT_NEAR(p.root_direction.norm(), 1.0f, 1e-4f);
+        EXPECT_GE(p.root_thickness, 0.6f * o.min_twig_thickness);
+        EXPECT_LE(p.root_thickness, o.max_root_thickness + 1e-6f);
+        for (const auto& d : p.docks) {
+            EXPECT_LT(d.thickness, p.root_thickness);  // twigs are thinner than their parent
+            EXPECT_GE(d.thickness, o.min_twig_thickness);
+        }
+        docks += p.docks.size();
+        terminal += p.docks.empty() ? 1 : 0;
+        leaves += p.leaves.size();
+    }
+    EXPECT_GT(docks, 0u);
+    EXPECT_GT(terminal, 0u);  // the smallest patches end the texturing
+    EXPECT_GT(leaves, 0u);
+    // Deterministic for a seed, different for another seed or species.
+    const PatchLibrary again = build_patch_library(species("lagerstroemia"), o);
+    ASSERT_EQ(again.patches.size(), lib.patches.size());
+    EXPECT_EQ(again.patches.back().segments.back().b, lib.patches.back().segments.back().b);
+    o.seed = 2;
+    EXPECT_NE(build_patch_library(species("lagerstroemia"), o).patches[0].segments.back().b, lib.patches[0].segments.back().b);
+    EXPECT_EQ(build_patch_library(species("pine")).leaf_shape, LeafShape::Needle);
+    o.branchlets = 0;
+    EXPECT_EQ(error_code_of([&] { build_patch_library(species("pine"), o); }), ExitCode::Usage);
+}
+
+TEST(LobeVolume, InsideTestMatchesABox) {
+    const LobeVolume v(box({0, 0, 0}, {2, 1, 1}), 20);
+    EXPECT_TRUE(v.inside({1, 0.5f, 0.5f}));
+    EXPECT_TRUE(v.inside({0.1f, 0.1f, 0.9f}));
+    EXPECT_FALSE(v.inside({1, 0.5f, 1.2f}));
+    EXPECT_FALSE(v.inside({-0.2f, 0.5f, 0.5f}));
+    // Cell size 0.1 m: the box holds 20 x 10 x 10 cells.
+    EXPECT_NEAR(v.inside_cells(), 2000, 250);
+}
+
+TEST(Texturing, FillsALobeDeterministically) {
+    const LobeTree tree = boxed_tree();
+    const PatchLibrary lib = build_patch_library(species("lagerstroemia"));
+    TexturingOptions o;
+    o.fill_cell = 0.2;
+    const DockingPoint seed{tree.seed_position(tree.lobes[0]), {0, 0, 1}, tree.seed_thickness(tree.lobes[0])};
+    const LobeTexture t = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0);
+    ASSERT_GT(t.instances.size(), 10u);
+    EXPECT_GE(t.filled, o.fill_target);
+    // Most twig geometry lies inside the lobe.
+    const LobeVolume volume(tree.lobes[0].mesh, 40);
+    std::size_t inside = 0, total = 0;
+    for (const auto& inst : t.instances)
+        for (const auto& s : lib.patches[inst.patch].segments) {
+            inside += volume.inside(inst.apply(s.b)) ? 1 : 0;
+            ++total;
+        }
+    EXPECT_GT(static_cast<double>(inside) / total, 0.7);
+    const LobeTexture again = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0);
+    ASSERT_EQ(again.instances.size(), t.instances.size());
+    EXPECT_EQ(again.instances.back().translation, t.instances.back().translation);
+}
+
+TEST(Synthesis, LodKeepsThickestEdgesAndLeafArea) {
+    const LobeTree tree = boxed_tree();
+    SynthesisOptions o;
+    o.texturing.fill_cell = 0.2;
+    const TexturedTree textured = texture_tree(tree, species("lagerstroemia"), o);
+    const SynthesizedMesh full = synthesized_mesh(tree, textured, 1.0, o);
+    const SynthesizedMesh half = synthesized_mesh(tree, textured, 0.5, o);
+    EXPECT_EQ(full.skeleton_edges, 2u);
+    EXPECT_EQ(half.skeleton_edges, 1u);
+    EXPECT_GT(full.triangles(), half.triangles());
+    EXPECT_LT(half.twig_segments, full.twig_segments);
+    EXPECT_GE(half.twig_segments, full.twig_segments / 2);
+    EXPECT_LT(half.leaf_count, full.leaf_count);
+    EXPECT_GE(half.leaf_count, full.leaf_count / 2);
+    // Stochastic pruning enlarges the kept leaves: the leaf area stays about the same.
+    EXPECT_NEAR(half.leaves.area(), full.leaves.area(), 0.15 * full.leaves.area());
+    EXPECT_EQ(full.leaves.faces.size(), 2 * full.leaf_count);
+    EXPECT_EQ(error_code_of([&] { synthesized_mesh(tree, textured, 0.0, o); }), ExitCode::Usage);
+    EXPECT_EQ(error_code_of([&] { synthesized_mesh(tree, textured, 1.5, o); }), ExitCode::Usage);
+}
+
+TEST(Synthesis, LeafyPatchesAreThinnedToTheTriangleBudget) {
+    const LobeTree tree = boxed_tree();
+    SynthesisOptions o;
+    o.max_triangles = 150000;
+    // Lagerstroemia patches carry fewer leaf than twig triangles: no thinning.
+    EXPECT_DOUBLE_EQ(texture_tree(tree, species("lagerstroemia"), o).leaf_share, 1.0);
+    // Mahogany's compound leaves outweigh its twigs: leaves are thinned and the budget holds.
+    const TexturedTree textured = texture_tree(tree, species("mahogany"), o);
+    EXPECT_LT(textured.leaf_share, 1.0);
+    EXPECT_GT(textured.leaf_share, 0.0);
+    const SynthesizedMesh mesh = synthesized_mesh(tree, textured, 1.0, o);
+    EXPECT_LE(mesh.triangles(), static_cast<std::size_t>(1.1 * static_cast<double>(o.max_triangles)));
+    double full_leaf_triangles = 0;
+    for (const auto& lobe : textured.lobes)
+        for (const auto& inst : lobe.instances)
+            full_leaf_triangles += 2.0 * static_cast<double>(textured.library.patches[inst.patch].leaves.size());
+    EXPECT_LT(static_cast<double>(mesh.leaves.faces.size()), 0.9 * full_leaf_triangles);  // thinned
+    // The kept leaves are enlarged: the leaf area stays about that of the unthinned patches.
+    TexturedTree unthinned = textured;
+    unthinned.leaf_share = 1;
+    const double full_area = synthesized_mesh(tree, unthinned, 1.0, o).leaves.area();
+    EXPECT_NEAR(mesh.leaves.area(), full_area, 0.15 * full_area);
+}

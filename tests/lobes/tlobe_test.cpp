@@ -1,0 +1,133 @@
+#include "lobes/closed_mesh.hpp"
+#include "lobes/mesh_coder.hpp"
+#include "lobes/tlobe_io.hpp"
+
+#include "core/error.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+using namespace treelobes;
+using namespace treelobes::lobes;
+using treelobes::test::error_code_of;
+
+namespace {
+
+// A closed octahedron around `c` with half-size `r`, outward.
+TriangleMesh octahedron(const Eigen::Vector3f& c, float r) {
+    TriangleMesh m;
+    m.vertices = {c + Eigen::Vector3f(r, 0, 0), c + Eigen::Vector3f(-r, 0, 0), c + Eigen::Vector3f(0, r, 0),
+                  c + Eigen::Vector3f(0, -r, 0), c + Eigen::Vector3f(0, 0, r), c + Eigen::Vector3f(0, 0, -r)};
+    m.faces = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+    return m;
+}
+
+LobeTree sample_tree() {
+    LobeTree t;
+    t.skeleton.origin = {612345.25, 5812345.5, 101.0};
+    t.skeleton.add_node({0, 0, 0}, 0.15f, -1);
+    t.skeleton.add_node({0.01f, 0, 1.0f}, 0.12f, 0);
+    t.skeleton.add_node({0.3f, -0.2f, 2.0f}, 0.05f, 1);
+    t.skeleton.add_node({-0.4f, 0.1f, 1.9f}, 0.04f, 1);
+    t.species = "lagerstroemia";
+    t.beta = 1.3;
+    t.gamma = 1.6;
+    t.fs = 0.85;
+    t.alpha_factor = 5.0;
+    t.root_diameter = 0.3;
+    for (int i : {2, 3}) {
+        Lobe lobe;
+        lobe.mesh = octahedron(t.skeleton.nodes[i].position + Eigen::Vector3f(0, 0, 0.5f), 0.4f + 0.1f * i);
+        lobe.seed_node = i;
+        lobe.seed_direction = Eigen::Vector3f(0.2f * i, 0.1f, 1.0f).normalized();
+        lobe.points = 1000u * i;
+        t.lobes.push_back(lobe);
+    }
+    return t;
+}
+
+}  // namespace
+
+TEST(MeshCoder, RoundTripWithinHalfAQuantum) {
+    const TriangleMesh m = octahedron({1.234f, -5.678f, 9.1f}, 0.37f);
+    ByteWriter w;
+    encode_mesh(m, 0.005, w);
+    ByteReader r(w.bytes(), "test");
+    const TriangleMesh d = decode_mesh(r, 0.005);
+    EXPECT_TRUE(r.at_end());
+    ASSERT_EQ(d.faces.size(), m.faces.size());
+    ASSERT_EQ(d.vertices.size(), m.vertices.size());
+    EXPECT_TRUE(check_closed(d).closed());
+    // Vertices are renumbered in order of first use; corner by corner the positions agree.
+    for (std::size_t f = 0; f < m.faces.size(); ++f)
+        for (int k = 0; k < 3; ++k)
+            EXPECT_LE((d.vertices[d.faces[f][k]] - m.vertices[m.faces[f][k]]).cwiseAbs().maxCoeff(), 0.0025f + 1e-5f);
+}
+
+TEST(ByteCoder, VarintsAndZigzag) {
+    ByteWriter w;
+    for (std::int64_t v : {0LL, 1LL, -1LL, 63LL, -64LL, 1000000LL, -123456789LL}) w.svarint(v);
+    w.varint(300);
+    EXPECT_EQ(w.bytes().size(), 1u + 1 + 1 + 1 + 1 + 3 + 4 + 2);
+    ByteReader r(w.bytes(), "test");
+    for (std::int64_t v : {0LL, 1LL, -1LL, 63LL, -64LL, 1000000LL, -123456789LL}) EXPECT_EQ(r.svarint(), v);
+    EXPECT_EQ(r.varint(), 300u);
+    EXPECT_EQ(error_code_of([&] { r.u8(); }), ExitCode::InvalidInput);
+}
+
+TEST(Tlobe, RoundTripKeepsEverythingWithinTheQuanta) {
+    const LobeTree t = sample_tree();
+    const std::string bytes = encode_tlobe(t);
+    const LobeTree d = decode_tlobe(bytes, "sample.tlobe");
+    EXPECT_EQ(d.species, t.species);
+    EXPECT_FLOAT_EQ(d.beta, 1.3f);
+    EXPECT_FLOAT_EQ(d.fs, 0.85f);
+    EXPECT_FLOAT_EQ(d.root_diameter, 0.3f);
+    EXPECT_EQ(d.skeleton.origin, t.skeleton.origin);  // doubles, exactly
+    ASSERT_EQ(d.skeleton.size(), t.skeleton.size());
+    for (std::size_t i = 0; i < t.skeleton.size(); ++i) {
+        EXPECT_EQ(d.skeleton.nodes[i].parent, t.skeleton.nodes[i].parent);
+        EXPECT_EQ(d.skeleton.nodes[i].children, t.skeleton.nodes[i].children);
+        EXPECT_LE((d.skeleton.nodes[i].position - t.skeleton.nodes[i].position).cwiseAbs().maxCoeff(), 0.0026f);
+        EXPECT_NEAR(d.skeleton.nodes[i].radius, t.skeleton.nodes[i].radius, 0.00026f);
+    }
+    ASSERT_EQ(d.lobes.size(), 2u);
+    for (std::size_t k = 0; k < 2; ++k) {
+        EXPECT_EQ(d.lobes[k].seed_node, t.lobes[k].seed_node);
+        EXPECT_EQ(d.lobes[k].points, t.lobes[k].points);
+        EXPECT_GT(d.lobes[k].seed_direction.dot(t.lobes[k].seed_direction), 0.999f);
+        EXPECT_TRUE(check_closed(d.lobes[k].mesh).closed());
+        EXPECT_NEAR(d.lobes[k].volume(), t.lobes[k].volume(), 0.02 * t.lobes[k].volume());
+    }
+    // Decoding then encoding again gives the same bytes (quantization is idempotent).
+    EXPECT_TRUE(encode_tlobe(d) == bytes) << "re-encoding changed the bytes";
+}
+
+TEST(Tlobe, DetectsCorruptionTruncationAndForeignFiles) {
+    const std::string bytes = encode_tlobe(sample_tree());
+    std::string flipped = bytes;
+    flipped[bytes.size() / 2] ^= 0x10;
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(flipped, "x"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(bytes.substr(0, bytes.size() - 3), "x"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe("ply\nformat ascii 1.0\n", "x"); }), ExitCode::InvalidInput);
+    std::string future = bytes;
+    future[4] = 2;  // major version 2
+    try {
+        decode_tlobe(future, "future.tlobe");
+        ADD_FAILURE() << "version 2 accepted";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ExitCode::InvalidInput);
+        EXPECT_NE(std::string(e.what()).find("version 2.0"), std::string::npos) << e.what();
+    }
+}
+
+TEST(Tlobe, FileRoundTripAndBadOptions) {
+    test::TempDir dir;
+    const LobeTree t = sample_tree();
+    write_tlobe(t, dir / "t.tlobe");
+    EXPECT_EQ(read_tlobe(dir / "t.tlobe").lobes.size(), 2u);
+    EXPECT_EQ(error_code_of([&] { read_tlobe(dir / "missing.tlobe"); }), ExitCode::InvalidInput);
+    TlobeOptions bad;
+    bad.quantum = 0;
+    EXPECT_EQ(error_code_of([&] { encode_tlobe(t, bad); }), ExitCode::Usage);
+}

@@ -1,0 +1,146 @@
+// kd-tree, neighbour graph (with component bridging) and Dijkstra on small clouds whose
+// answers can be worked out by hand or by brute force.
+#include "core/error.hpp"
+#include "reconstruct/kd_tree.hpp"
+#include "reconstruct/neighbour_graph.hpp"
+#include "reconstruct/shortest_paths.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+using namespace treelobes;
+
+namespace {
+
+std::vector<Eigen::Vector3f> random_points(int n, unsigned seed, float scale = 1.0f) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, scale);
+    std::vector<Eigen::Vector3f> p(n);
+    for (auto& q : p) q = {u(rng), u(rng), u(rng)};
+    return p;
+}
+
+// Points every `step` metres from a to b (inclusive).
+void add_line(std::vector<Eigen::Vector3f>& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b, float step) {
+    const int n = static_cast<int>(std::round((b - a).norm() / step));
+    for (int i = 0; i <= n; ++i) p.push_back(a + (b - a) * (static_cast<float>(i) / static_cast<float>(n)));
+}
+
+}  // namespace
+
+TEST(KdTree, KnnMatchesBruteForce) {
+    const auto points = random_points(2000, 1);
+    const KdTree tree(points);
+    const auto queries = random_points(50, 2);
+    std::vector<int> idx;
+    std::vector<float> d2;
+    for (const auto& q : queries) {
+        tree.knn(q, 7, idx, d2);
+        std::vector<std::pair<float, int>> all;
+        for (std::size_t i = 0; i < points.size(); ++i) all.emplace_back((points[i] - q).squaredNorm(), static_cast<int>(i));
+        std::sort(all.begin(), all.end());
+        ASSERT_EQ(idx.size(), 7u);
+        for (int k = 0; k < 7; ++k) EXPECT_FLOAT_EQ(d2[k], all[k].first);
+        EXPECT_EQ(tree.nearest(q), all[0].second);
+        tree.radius_search(q, 0.1f, idx, d2);
+        const auto inside = std::count_if(all.begin(), all.end(), [](const auto& e) { return e.first < 0.01f; });
+        EXPECT_EQ(static_cast<long>(idx.size()), inside);
+        EXPECT_TRUE(std::is_sorted(d2.begin(), d2.end()));
+    }
+}
+
+TEST(KdTree, KnnTableExcludesThePointItselfAndPadsSmallClouds) {
+    const std::vector<Eigen::Vector3f> points{{0, 0, 0}, {1, 0, 0}, {3, 0, 0}};
+    const KdTree tree(points);
+    const KnnTable table = knn_of_all_points(tree, 4);
+    EXPECT_EQ(table.row(0)[0], 1);
+    EXPECT_EQ(table.row(0)[1], 2);
+    EXPECT_EQ(table.row(0)[2], -1);  // only two other points exist
+    EXPECT_FLOAT_EQ(table.row_distances(2)[0], 4.0f);
+    const KdTree empty(std::vector<Eigen::Vector3f>{});
+    EXPECT_EQ(empty.nearest({0, 0, 0}), -1);
+}
+
+TEST(NeighbourGraph, SymmetricSortedRowsWithPowerWeights) {
+    const auto points = random_points(500, 3);
+    NeighbourGraphOptions options;
+    options.neighbours = 6;
+    options.beta = 1.7;
+    const NeighbourGraph g = build_neighbour_graph(points, options);
+    ASSERT_EQ(g.vertex_count(), 500u);
+    for (std::size_t i = 0; i < 500; ++i) {
+        ASSERT_GE(g.offsets[i + 1] - g.offsets[i], 6u);  // own k neighbours at least
+        EXPECT_TRUE(std::is_sorted(g.targets.begin() + g.offsets[i], g.targets.begin() + g.offsets[i + 1]));
+        for (std::uint32_t e = g.offsets[i]; e < g.offsets[i + 1]; ++e) {
+            const int j = g.targets[e];
+            EXPECT_NEAR(g.lengths[e], (points[i] - points[j]).norm(), 1e-6f);
+            EXPECT_NEAR(g.weights[e], std::pow(g.lengths[e], 1.7f), 1e-6f);
+            // j lists i as well.
+            EXPECT_TRUE(std::binary_search(g.targets.begin() + g.offsets[j], g.targets.begin() + g.offsets[j + 1], static_cast<int>(i)));
+        }
+    }
+    EXPECT_THROW(build_neighbour_graph(points, {1, 1.0, 0.0f, true}), Error);
+}
+
+TEST(NeighbourGraph, PiecesAreJoinedByTheShortestBridges) {
+    // Three lines of 100 points (larger than the exact-search limit for small pieces) and a
+    // 3-point clump; gaps of 0.5 m, 0.3 m and 0.2 m.
+    std::vector<Eigen::Vector3f> p;
+    add_line(p, {0, 0, 0}, {0, 0, 1}, 0.01f);          // A
+    add_line(p, {0, 0, 1.5f}, {0, 0, 2.5f}, 0.01f);    // B: 0.5 m above A
+    add_line(p, {0.3f, 0, 1.5f}, {1.3f, 0, 1.5f}, 0.01f);  // C: 0.3 m beside B's foot
+    p.push_back({0, 0, 2.7f});                         // D: 0.2 m above B
+    p.push_back({0, 0.01f, 2.71f});
+    p.push_back({0, -0.01f, 2.71f});
+    NeighbourGraphOptions options;
+    options.neighbours = 4;
+    const NeighbourGraph g = build_neighbour_graph(p, options);
+    EXPECT_EQ(g.components, 4u);
+    EXPECT_EQ(g.bridges, 3u);
+    std::size_t pieces = 0;
+    connected_components(g, &pieces);
+    EXPECT_EQ(pieces, 1u);
+    EXPECT_NEAR(g.longest_bridge, 0.5f, 1e-4f);
+    // C must join B (0.3 m), not the largest piece: the bridge ends at B's foot (1.5 m).
+    const int c_first = 101 + 101;
+    bool found = false;
+    for (std::uint32_t e = g.offsets[c_first]; e < g.offsets[c_first + 1]; ++e)
+        if (std::abs(g.lengths[e] - 0.3f) < 1e-4f) found = true;
+    EXPECT_TRUE(found);
+}
+
+TEST(ShortestPaths, SingleSourceDistancesAndParents) {
+    // An L: 0..1 m along x then 0..1 m along y, points 0.1 m apart.
+    std::vector<Eigen::Vector3f> p;
+    add_line(p, {0, 0, 0}, {1, 0, 0}, 0.1f);
+    add_line(p, {1, 0.1f, 0}, {1, 1, 0}, 0.1f);
+    const NeighbourGraph g = build_neighbour_graph(p, {2, 2.0, 0.0f, true});
+    const std::vector<int> source{0};
+    const ShortestPaths sp = shortest_paths(g, source);
+    EXPECT_EQ(sp.parent[0], -1);
+    EXPECT_NEAR(sp.length.back(), 2.0f, 1e-4f);
+    EXPECT_NEAR(sp.cost.back(), 20 * 0.01, 1e-5);  // 20 edges of 0.1 m, weight 0.1^2
+    EXPECT_EQ(sp.order.front(), 0);
+    // Parents are settled before their children.
+    std::vector<int> rank(p.size());
+    for (std::size_t i = 0; i < sp.order.size(); ++i) rank[sp.order[i]] = static_cast<int>(i);
+    for (std::size_t v = 1; v < p.size(); ++v) EXPECT_LT(rank[sp.parent[v]], rank[v]);
+}
+
+TEST(ShortestPaths, MultiSourceSplitsBetweenSources) {
+    std::vector<Eigen::Vector3f> p;
+    add_line(p, {0, 0, 0}, {2, 0, 0}, 0.1f);  // 21 points
+    const NeighbourGraph g = build_neighbour_graph(p, {2, 1.0, 0.0f, true});
+    const std::vector<int> sources{0, 20};
+    const ShortestPaths sp = shortest_paths(g, sources);
+    for (int v = 0; v < 10; ++v) EXPECT_EQ(sp.source[v], 0);
+    for (int v = 11; v <= 20; ++v) EXPECT_EQ(sp.source[v], 1);
+    EXPECT_NEAR(sp.length[10], 1.0f, 1e-5f);
+    // Same input, same answer (the midpoint's tie is broken the same way).
+    EXPECT_EQ(shortest_paths(g, sources).source, sp.source);
+    const std::vector<int> repeated{3, 3};
+    EXPECT_THROW(shortest_paths(g, repeated), Error);
+}

@@ -1,0 +1,158 @@
+// Skeleton extraction on synthetic bark clouds whose true skeleton is known.
+#include "core/error.hpp"
+#include "reconstruct/allometry.hpp"
+#include "reconstruct/skeleton.hpp"
+#include "synthetic_clouds.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace treelobes;
+using test::Segment;
+
+namespace {
+
+float max_axis_error(const TreeGraph& tree, const std::vector<Segment>& truth) {
+    float worst = 0;
+    for (const auto& node : tree.nodes) worst = std::max(worst, test::distance_to_axes(node.position, truth));
+    return worst;
+}
+
+}  // namespace
+
+TEST(Skeleton, CylinderGivesOneStraightChainAlongTheAxis) {
+    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f}};
+    const PointCloud cloud = test::cloud_from(truth, 4000);
+    const SkeletonResult r = reconstruct_skeleton(cloud.positions, {});
+    const TreeGraph& tree = r.tree;
+    tree.validate("cylinder");
+    EXPECT_EQ(tree.tip_count(), 1u);
+    EXPECT_LT(max_axis_error(tree, truth), 0.02f);
+    EXPECT_NEAR(tree.nodes[0].position.z(), 0.0f, 0.03f);
+    EXPECT_NEAR(tree.total_length(), 3.0f, 0.2f);
+    // Near-uniform internodes: every one within half an internode of the target length,
+    // except the first (root to the first bin) and the last.
+    for (std::size_t i = 2; i + 1 < tree.size(); ++i)
+        EXPECT_NEAR(tree.edge_length(static_cast<int>(i)), r.internode_length, 0.5f * r.internode_length) << "internode " << i;
+}
+
+TEST(Skeleton, YShapeHasOneForkMainBranchFirstAndAssignedPoints) {
+    const auto truth = test::y_tree();
+    const PointCloud cloud = test::cloud_from(truth, 3000);
+    const SkeletonResult r = reconstruct_skeleton(cloud.positions, {});
+    const TreeGraph& tree = r.tree;
+    tree.validate("y");
+    ASSERT_EQ(tree.tip_count(), 2u);
+    EXPECT_LT(max_axis_error(tree, truth), 0.05f);
+    // The fork sits near (0, 0, 2).
+    int forks = 0;
+    for (const auto& node : tree.nodes)
+        if (node.children.size() == 2) {
+            ++forks;
+            EXPECT_LT((node.position - Eigen::Vector3f(0, 0, 2)).norm(), 0.25f);
+            // Main child first: the longer branch (1.41 m towards +x, against 1.20 m).
+            const auto& first = tree.nodes[node.children[0]];
+            EXPECT_GT(first.position.x(), node.position.x() - 0.02f);
+        }
+    EXPECT_EQ(forks, 1);
+    // Vertex 0 is the root, nodes are in pre-order (parents before children).
+    EXPECT_EQ(tree.nodes[0].parent, -1);
+    for (std::size_t i = 1; i < tree.size(); ++i) EXPECT_LT(tree.nodes[i].parent, static_cast<int>(i));
+    // Every point has an internode (a non-root node) that lies close to it.
+    ASSERT_EQ(r.point_internode.size(), cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const int node = r.point_internode[i];
+        ASSERT_GT(node, 0);
+        ASSERT_LT(node, static_cast<int>(tree.size()));
+        const Eigen::Vector3f a = tree.nodes[tree.nodes[node].parent].position, b = tree.nodes[node].position;
+        const float t = std::clamp((cloud.positions[i] - a).dot(b - a) / std::max(1e-9f, (b - a).squaredNorm()), 0.0f, 1.0f);
+        EXPECT_LT((a + t * (b - a) - cloud.positions[i]).norm(), 0.35f) << "point " << i;
+        EXPECT_GE(r.point_geodesic[i], 0.0f);
+    }
+}
+
+TEST(Skeleton, OneSidedThickStemStaysOnItsAxis) {
+    // Only the +x half of a 0.3 m stem is scanned: centroids would sit 0.19 m off the axis.
+    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 4}, 0.3f}};
+    const PointCloud cloud = test::cloud_from(truth, 1500, 11, 0.5f);
+    // The median node is what this checks: at 1500 points per square metre some slices hold
+    // too little of the half ring for a trusted circle and keep their centroid.
+    auto median_error = [&truth](const TreeGraph& tree) {
+        std::vector<float> error;
+        for (std::size_t i = 1; i + 1 < tree.size(); ++i) error.push_back(test::distance_to_axes(tree.nodes[i].position, truth));
+        std::nth_element(error.begin(), error.begin() + static_cast<long>(error.size() / 2), error.end());
+        return error[error.size() / 2];
+    };
+    const SkeletonResult r = reconstruct_skeleton(cloud.positions, {});
+    EXPECT_EQ(r.tree.tip_count(), 1u);
+    EXPECT_LT(median_error(r.tree), 0.06f);
+    SkeletonOptions plain;
+    plain.fit_axes = false;
+    const SkeletonResult centroids = reconstruct_skeleton(cloud.positions, plain);
+    EXPECT_GT(median_error(centroids.tree), 0.12f);
+}
+
+TEST(Skeleton, DetachedPieceIsBridgedIntoTheOneTree) {
+    // A branch piece floating 0.25 m beside the stem (occlusion gap) still joins the tree.
+    std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f}, {{0.35f, 0, 1.5f}, {1.2f, 0, 2.2f}, 0.04f}};
+    const PointCloud cloud = test::cloud_from(truth, 3000);
+    const SkeletonResult r = reconstruct_skeleton(cloud.positions, {});
+    r.tree.validate("gap");
+    EXPECT_GE(r.graph_components, 2u);
+    EXPECT_GE(r.bridges, 1u);
+    EXPECT_EQ(r.tree.tip_count(), 2u);
+    bool reaches_piece = false;
+    for (const auto& node : r.tree.nodes) reaches_piece |= (node.position - Eigen::Vector3f(1.1f, 0, 2.1f)).norm() < 0.2f;
+    EXPECT_TRUE(reaches_piece);
+    // With max_gap below the gap, the piece stays out of the skeleton but its points keep an internode.
+    SkeletonOptions strict;
+    strict.max_gap = 0.1f;
+    const SkeletonResult cut = reconstruct_skeleton(cloud.positions, strict);
+    EXPECT_EQ(cut.tree.tip_count(), 1u);
+    EXPECT_GT(cut.detached_points, 0u);
+    for (int node : cut.point_internode) EXPECT_GT(node, 0);
+}
+
+TEST(Skeleton, DeterministicAndRejectsBadInput) {
+    const PointCloud cloud = test::cloud_from(test::y_tree(), 2000);
+    const SkeletonResult a = reconstruct_skeleton(cloud.positions, {});
+    const SkeletonResult b = reconstruct_skeleton(cloud.positions, {});
+    ASSERT_EQ(a.tree.size(), b.tree.size());
+    for (std::size_t i = 0; i < a.tree.size(); ++i) EXPECT_EQ(a.tree.nodes[i].position, b.tree.nodes[i].position);
+    EXPECT_EQ(a.point_internode, b.point_internode);
+
+    std::vector<Eigen::Vector3f> few(5, Eigen::Vector3f::Zero());
+    EXPECT_THROW(reconstruct_skeleton(few, {}), Error);
+    std::vector<Eigen::Vector3f> bad = cloud.positions;
+    bad[3].x() = std::nanf("");
+    EXPECT_THROW(reconstruct_skeleton(bad, {}), Error);
+    SkeletonOptions negative;
+    negative.bin_width = -1.0f;
+    EXPECT_THROW(reconstruct_skeleton(cloud.positions, negative), Error);
+    // extract_skeleton keeps the cloud's origin.
+    PointCloud shifted = cloud;
+    shifted.origin = {500000.0, 6000000.0, 10.0};
+    EXPECT_EQ(extract_skeleton(shifted).origin, shifted.origin);
+}
+
+TEST(Allometry, EquationOneAndTwo) {
+    // Trunk 0-1-2 (2 m) and a lateral 1-3 (1 m): l(root) = 3, l(1) = 2, l(2) = l(3) = 0.
+    TreeGraph tree;
+    tree.add_node({0, 0, 0}, 0, -1);
+    tree.add_node({0, 0, 1}, 0, 0);
+    tree.add_node({0, 0, 2}, 0, 1);
+    tree.add_node({1, 0, 1}, 0, 1);
+    AllometryOptions o;
+    o.gamma = 1.5;
+    o.fs = 0.9;
+    const AllometricDiameters d = apply_allometry(tree, 0.4, o);
+    EXPECT_FLOAT_EQ(d.diameter[0], 0.4f);
+    EXPECT_NEAR(d.diameter[1], 0.4 * std::pow(2.0 / 3.0, 1.5), 1e-6);
+    EXPECT_FLOAT_EQ(d.diameter[2], 0.0f);
+    EXPECT_NEAR(d.lobe_diameter[1], 0.9f * d.diameter[1], 1e-7);
+    EXPECT_FLOAT_EQ(tree.nodes[0].radius, 0.2f);
+    EXPECT_THROW(apply_allometry(tree, 0.0, o), Error);
+    o.fs = 1.5;
+    EXPECT_THROW(apply_allometry(tree, 0.4, o), Error);
+}
