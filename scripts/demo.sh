@@ -23,9 +23,9 @@ step "reconstruct: skeleton, radii and branch mesh of two scanned trees"
 
 step "eval: reconstructed skeletons against the true ones"
 for tree in lagerstroemia_2 palm_1; do
-    "$BIN" --json eval skeleton --skeleton "$OUT/reconstruct/${tree}_skeleton.ply" \
-        --reference "$SAMPLE/${tree}_skeleton.ply" > "$OUT/eval_${tree}.json"
-    echo "$tree: $(cat "$OUT/eval_${tree}.json")"
+    args=(eval skeleton --skeleton "$OUT/reconstruct/${tree}_skeleton.ply" --reference "$SAMPLE/${tree}_skeleton.ply")
+    "$BIN" "${args[@]}"
+    "$BIN" --json "${args[@]}" > "$OUT/eval_${tree}.json"
 done
 
 step "lobes + synthesize: lobe-based representation and full tree of the Lagerstroemia"
