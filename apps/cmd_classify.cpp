@@ -101,6 +101,7 @@ int run_features(const FeaturesCommand& c, const GlobalOptions& global) {
     const json summary = {{"command", "classify features"}, {"treelobes", kVersion},   {"trees", batch.table.rows()},
                           {"features", batch.table.cols()},  {"failed", batch.failures.size()}, {"points", batch.points},
                           {"seconds", batch.seconds},        {"feature_seconds_per_tree", batch.feature_seconds / batch.table.rows()},
+                          {"cpu_seconds_per_tree", batch.cpu_seconds / batch.table.rows()},
                           {"out", c.out}};
     print(summary, global,
           std::to_string(batch.table.rows()) + " trees x " + std::to_string(batch.table.cols()) + " features -> " + c.out +
@@ -327,6 +328,7 @@ int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
         write_feature_csv(table, fs::path(c.out) / "features.csv");
         extra["feature_seconds_per_tree"] = batch.feature_seconds / static_cast<double>(table.rows());
         extra["feature_seconds_total"] = batch.seconds;
+        extra["feature_cpu_seconds_per_tree"] = batch.cpu_seconds / static_cast<double>(table.rows());
         extra["points"] = batch.points;
     }
     // Only labelled trees that gave features take part.

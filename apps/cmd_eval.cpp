@@ -118,7 +118,7 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
         ->check(CLI::PositiveNumber)->capture_default_str();
     sub->add_option("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")
         ->check(CLI::PositiveNumber)->capture_default_str();
-    sub->add_option("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored")
+    sub->add_option("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
         ->check(CLI::NonNegativeNumber)->capture_default_str();
     sub->add_option("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
     sub->callback([options, &global, &job] { job = [options, &global] { return run_eval_skeleton(*options, global); }; });

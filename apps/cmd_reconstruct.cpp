@@ -3,7 +3,8 @@
 // input is listed in DIR/failures.jsonl and the others go on (exit 3). Finished trees are
 // skipped on a re-run unless --overwrite.
 #include "apps/command.hpp"
-#include "config/species_library.hpp"
+#include "apps/reconstruction_flags.hpp"
+#include "apps/summary_values.hpp"
 #include "core/atomic_file.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
@@ -16,8 +17,6 @@
 
 #include <nlohmann/json.hpp>
 #include <tbb/global_control.h>
-
-#include <sys/resource.h>
 
 #include <chrono>
 #include <cmath>
@@ -37,9 +36,7 @@ namespace {
 struct ReconstructCliOptions {
     std::vector<std::string> inputs;
     std::string out;
-    std::string species;
-    std::optional<double> beta, gamma, fs;
-    std::string ground = "auto";
+    SpeciesFlags flags;
     std::string mesh_format = "ply";
     bool overwrite = false;
     bool reject_non_trees = false;
@@ -58,36 +55,9 @@ TreeOutputs outputs_for(const ReconstructCliOptions& o, const fs::path& input) {
             dir / (stem + "_summary.json")};
 }
 
-double peak_memory_mb() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports kilobytes
-}
-
-// Rounded for readable JSON (floats would print as 0.30000001192092896).
-double rounded(double value, int digits = 4) {
-    const double scale = std::pow(10.0, digits);
-    return std::round(value * scale) / scale;
-}
-
-// Species parameters first, explicit --beta/--gamma/--fs on top.
-void resolve_species(ReconstructCliOptions& o) {
-    if (!o.species.empty()) {
-        const SpeciesEntry entry = find_species(load_species_entries(default_species_file()), o.species);
-        o.species = entry.name;
-        o.stage.skeleton.beta = entry.reconstruction.beta;
-        o.stage.allometry.gamma = entry.reconstruction.gamma;
-        o.stage.allometry.fs = entry.reconstruction.fs;
-    }
-    if (o.beta) o.stage.skeleton.beta = *o.beta;
-    if (o.gamma) o.stage.allometry.gamma = *o.gamma;
-    if (o.fs) o.stage.allometry.fs = *o.fs;
-    o.stage.preprocess.ground = parse_ground_mode(o.ground);
-}
-
 nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s) {
     const auto& k = o.stage.skeleton;
-    return {{"species", o.species.empty() ? nlohmann::json() : nlohmann::json(o.species)},
+    return {{"species", o.flags.species.empty() ? nlohmann::json() : nlohmann::json(o.flags.species)},
             {"beta", k.beta},
             {"gamma", o.stage.allometry.gamma},
             {"fs", o.stage.allometry.fs},
@@ -100,7 +70,7 @@ nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s
             {"voxel_size", o.stage.preprocess.voxel_size},
             {"outlier_neighbours", o.stage.preprocess.outlier_neighbours},
             {"outlier_sigma", o.stage.preprocess.outlier_sigma},
-            {"ground", o.ground},
+            {"ground", o.flags.ground},
             {"mesh_sides", o.mesh.sides},
             {"mesh_subdivisions", o.mesh.subdivisions}};
 }
@@ -190,7 +160,7 @@ int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
     std::unique_ptr<tbb::global_control> threads;
     if (global.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(global.threads));
-    resolve_species(o);
+    apply_species_flags(o.flags, o.stage);
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
@@ -240,10 +210,7 @@ int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
 void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
     sub->add_option("inputs", o.inputs, "Point clouds of single trees (LAS, PLY, PCD, XYZ/CSV)")->required();
     sub->add_option("--out", o.out, "Output folder")->required();
-    sub->add_option("--species", o.species, "Species from config/species.yaml: sets beta, gamma and f_s");
-    sub->add_option("--beta", o.beta, "Edge weight exponent ||u-v||^beta (default 1.5, or the species')")->check(CLI::PositiveNumber);
-    sub->add_option("--gamma", o.gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(CLI::PositiveNumber);
-    sub->add_option("--fs", o.fs, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')")->check(CLI::Range(0.01, 1.0));
+    add_species_flags(sub, o.flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')");
     auto& k = o.stage.skeleton;
     sub->add_option("--neighbours", k.neighbours, "k of the neighbour graph")->check(CLI::Range(2, 64))->capture_default_str();
     sub->add_option("--bin-width", k.bin_width, "Geodesic bin width in metres (0 = from point spacing)")->check(CLI::NonNegativeNumber);
@@ -263,8 +230,6 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--outlier-neighbours", o.stage.preprocess.outlier_neighbours, "k of the outlier filter (0 = off)")
         ->check(CLI::Range(0, 64))->capture_default_str();
-    sub->add_option("--ground", o.ground, "Ground points: auto (remove a detected ground plane), remove, keep")
-        ->check(CLI::IsMember({"auto", "remove", "keep"}))->capture_default_str();
     sub->add_option("--mesh-sides", o.mesh.sides, "Vertices per ring of the branch mesh")->check(CLI::Range(3, 64))->capture_default_str();
     sub->add_option("--mesh-subdivisions", o.mesh.subdivisions, "Rings per internode of the branch mesh")->check(CLI::Range(1, 16))
         ->capture_default_str();

@@ -5,6 +5,7 @@
 //            skeletons/tree_<id>.ply
 // Every run is determined by --seed; summary.json records options, counts, timings and memory.
 #include "apps/command.hpp"
+#include "apps/summary_values.hpp"
 #include "config/species_profile.hpp"
 #include "core/atomic_file.hpp"
 #include "core/cloud_io.hpp"
@@ -19,8 +20,6 @@
 #include "synth/tree_mesh.hpp"
 
 #include <nlohmann/json.hpp>
-
-#include <sys/resource.h>
 
 #include <chrono>
 #include <cstdio>
@@ -163,12 +162,6 @@ fs::path prepare_folder(const std::string& out) {
     fs::create_directories(out, ec);
     if (ec || !fs::is_directory(out)) throw Error::input(out, "cannot create the output folder");
     return out;
-}
-
-double peak_memory_mb() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return usage.ru_maxrss / 1024.0;  // Linux: kilobytes
 }
 
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }

@@ -35,7 +35,7 @@ with open(dst, "w") as out:
         out.write(prefix + "/" + line + "\n")
 PY
   python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(f'{sys.argv[2]}: {d[\"trees\"]} trees, {d[\"points\"]} points, ' \
-    f'{d[\"feature_seconds_per_tree\"]:.2f} s per tree (mean {d[\"points\"]/d[\"trees\"]:.0f} points), {d[\"seconds\"]:.0f} s wall')" \
+    f'{d[\"cpu_seconds_per_tree\"]:.2f} s CPU per tree with reading (mean {d[\"points\"]/d[\"trees\"]:.0f} points), {d[\"seconds\"]:.0f} s wall')" \
     "$OUT/${name}_features.json" "$name"
 }
 features tls

@@ -8,6 +8,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <map>
 #include <mutex>
 
@@ -44,6 +45,7 @@ Eigen::Vector2d mean_position(const PointCloud& cloud) {
 
 FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const FeatureOptions& options) {
     const auto start = std::chrono::steady_clock::now();
+    const std::clock_t cpu_start = std::clock();
     FeatureBatch batch;
     batch.table.feature_names = feature_names();
     std::mutex mutex;
@@ -102,6 +104,7 @@ FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const 
         batch.feature_seconds += r.seconds;
     }
     batch.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    batch.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     return batch;
 }
 

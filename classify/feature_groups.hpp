@@ -3,10 +3,12 @@
 #pragma once
 
 #include "classify/features.hpp"
+#include "reconstruct/kd_tree.hpp"
 
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,11 @@ struct TreeFrame {
     float trunk_diameter = 0;             // metres; 0 when no stem is visible (shape group sets it)
     float crown_base = 0;                 // metres (shape group sets it)
     const FeatureOptions* options = nullptr;
+    // One neighbour search serves the normals and the skeleton: a kd-tree over `points` and
+    // their kNN table (nearest first, at least normal_neighbours and skeleton_table_width wide),
+    // read mostly from the cleaning's outlier query.
+    std::shared_ptr<const KdTree> index;
+    std::shared_ptr<const KnnTable> neighbours;
 };
 
 class Catalogue {

@@ -5,6 +5,7 @@
 #include "classify/feature_groups.hpp"
 #include "core/error.hpp"
 #include "reconstruct/preprocess.hpp"
+#include "reconstruct/skeleton.hpp"
 
 #include <Eigen/Eigenvalues>
 
@@ -155,7 +156,10 @@ Eigen::Vector2f principal_axis(const std::vector<Eigen::Vector3f>& points, const
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
     Eigen::Vector2d major = eig.eigenvectors().col(1);
     double third = 0;
-    for (const auto& p : points) third += std::pow((p.head<2>() - centre).cast<double>().dot(major), 3);
+    for (const auto& p : points) {
+        const double t = (p.head<2>() - centre).cast<double>().dot(major);
+        third += t * t * t;  // not std::pow: it costs a libm call per point
+    }
     if (third < 0) major = -major;
     return major.cast<float>();
 }
@@ -177,7 +181,10 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
     const Eigen::Vector2f major = principal_axis(raw, axis);
     Eigen::Vector2f minor(-major.y(), major.x());
     double third = 0;
-    for (const auto& p : raw) third += std::pow(static_cast<double>((p.head<2>() - axis).dot(minor)), 3);
+    for (const auto& p : raw) {
+        const double t = (p.head<2>() - axis).dot(minor);
+        third += t * t * t;
+    }
     if (third < 0) minor = -minor;
     PointCloud local;
     local.positions.reserve(raw.size());
@@ -189,6 +196,7 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
     frame.voxel = static_cast<float>(std::clamp(rough_height * options.voxel_fraction, options.min_voxel, options.max_voxel));
     PreprocessOptions clean;
     clean.voxel_size = frame.voxel;
+    clean.table_width = std::max(options.normal_neighbours, skeleton_table_width(SkeletonOptions{}));
     const Preprocessed pre = preprocess_cloud(local, clean, name);
 
     // Ground: the plane's height under the stem when the scan has ground, else the lowest points.
@@ -197,6 +205,9 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
     const Eigen::Vector3f shift(0, 0, ground);
     for (const auto& p : pre.points) frame.points.push_back(p - shift);
     for (const auto& p : local.positions) frame.raw.push_back(p - shift);
+    // The table holds indices and distances, unchanged by the shift; the index holds coordinates.
+    frame.neighbours = pre.neighbours;
+    frame.index = std::make_shared<const KdTree>(frame.points);
     frame.height = detail::quantile(coordinate(frame.points, 2), 0.999);
     if (!(frame.height >= 0.5f)) throw Error::input(name, "not a tree: less than 0.5 m above the ground");
 

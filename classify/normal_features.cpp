@@ -1,8 +1,8 @@
 // Local-geometry features: normals, curvature and eigen-features from the covariance of each
 // voxel point's k nearest neighbours (PCL's normal estimation: pcl::eigen33 on the
 // neighbourhood covariance; normal = eigenvector of the smallest eigenvalue, curvature =
-// lambda_min / sum lambda as in pcl::solvePlaneParameters). Neighbours come from the project's
-// kd-tree (reconstruct/kd_tree.hpp).
+// lambda_min / sum lambda as in pcl::solvePlaneParameters). Neighbours come from the frame's kNN
+// table (one query shared with the cleaning and the skeleton, see TreeFrame).
 #include "classify/feature_groups.hpp"
 #include "reconstruct/kd_tree.hpp"
 
@@ -29,9 +29,9 @@ struct LocalShape {
     bool valid = false;
 };
 
-std::vector<LocalShape> local_shapes(const std::vector<Eigen::Vector3f>& points, int k, std::vector<float>& nn_distance) {
-    const KdTree tree(points);
-    const KnnTable knn = knn_of_all_points(tree, k);
+// `knn`: the frame's table over `points`, at least k wide; its first k columns are the k nearest.
+std::vector<LocalShape> local_shapes(const std::vector<Eigen::Vector3f>& points, const KnnTable& knn, int k,
+                                     std::vector<float>& nn_distance) {
     std::vector<LocalShape> shapes(points.size());
     nn_distance.assign(points.size(), 0.0f);
     tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
@@ -111,7 +111,7 @@ void describe_normals(Catalogue& c) {
 
 void compute_normals(const TreeFrame& f, FeatureSink& out) {
     std::vector<float> nn_distance;
-    const auto shapes = local_shapes(f.points, f.options->normal_neighbours, nn_distance);
+    const auto shapes = local_shapes(f.points, *f.neighbours, std::min(f.options->normal_neighbours, f.neighbours->k), nn_distance);
     std::vector<double> elevation(kAngleBins, 0), axis_angle(kAngleBins, 0), curvature(kCurvatureBins, 0), direction(kDirectionBins, 0);
     std::vector<std::vector<double>> layered(3, std::vector<double>(kLayerAngleBins, 0));
     std::vector<double> layer_count(3, 0);

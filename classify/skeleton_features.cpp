@@ -194,7 +194,7 @@ void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
     SkeletonOptions options;
     options.bin_width = std::clamp(0.25f * f.crown_radius, 2 * f.voxel, 4 * f.voxel);  // narrow crowns need finer bins
     options.internode_length = options.bin_width;
-    SkeletonResult result = reconstruct_skeleton(f.points, options, "");
+    SkeletonResult result = reconstruct_skeleton(f.points, options, "", f.index.get(), f.neighbours.get());
     TreeGraph& t = result.tree;
     if (t.size() < 2) {
         skip_skeleton(out);

@@ -2,6 +2,8 @@
 
 #include "core/error.hpp"
 
+#include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 
 namespace treelobes::encode {
@@ -47,7 +49,32 @@ std::string write_symbols(const std::vector<Internode>& internodes, CodeKind kin
     return out;
 }
 
+namespace {
+
+// check_symbols's verdict without branches on the symbols: moves and terminators alternate
+// unpredictably, and the mispredicted branches made the check cost as much as decoding the
+// skeleton. Returns false on any defect, which the detailed pass then locates and reports.
+bool valid_symbols(const std::string& symbols, std::size_t& internodes) {
+    if (symbols.empty() || symbols.back() != kTip) return false;
+    std::size_t terminators = 0;
+    std::int64_t queued_forks = 0, fewest_queued = 0;
+    bool unknown = false;
+    for (std::size_t i = 0; i + 1 < symbols.size(); ++i) {
+        const unsigned digit = static_cast<unsigned>(static_cast<unsigned char>(symbols[i])) - unsigned{'0'};
+        unknown |= digit > 8;
+        terminators += digit >= 6;
+        // A 7 inside the code takes a queued lateral; the count may never go below zero.
+        queued_forks += std::int64_t{digit == 6} - std::int64_t{digit == 7};
+        fewest_queued = std::min(fewest_queued, queued_forks);
+    }
+    internodes = terminators + 1;
+    return !unknown && fewest_queued >= 0 && queued_forks == 0;
+}
+
+}  // namespace
+
 std::size_t check_symbols(const std::string& symbols, const std::string& context) {
+    if (std::size_t internodes = 0; valid_symbols(symbols, internodes)) return internodes;
     if (symbols.empty()) throw Error::input(context, "empty chain code (a tree needs at least one internode ending in 7)");
     std::size_t internodes = 0;
     std::size_t queued_forks = 0;  // laterals announced by a 6 and not yet started

@@ -265,14 +265,17 @@ std::vector<std::vector<int>> axes_of(const TreeGraph& tree) {
 
 // Fraction of an axis' samples within tolerance of the other skeleton; the tolerance is
 // max(match_distance, radius) with the radius from `own_radius` or the matched segment.
+// Segments whose child node is not thicker than `min_diameter` are not sampled: a reference
+// branch is scored over its part thicker than the threshold, not over the thin twig it tapers into.
 double matched_fraction(const TreeGraph& tree, const Eigen::Vector3d& tree_origin, const std::vector<int>& axis,
-                        const NearestSegment& other, const SkeletonGraph& other_graph, bool use_own_radius, const EvalOptions& o,
-                        const Eigen::Vector3d& origin) {
+                        const NearestSegment& other, const SkeletonGraph& other_graph, bool use_own_radius, double min_diameter,
+                        const EvalOptions& o, const Eigen::Vector3d& origin) {
     std::size_t total = 0, matched = 0;
     std::vector<int> found;
     std::vector<float> d2;
     for (std::size_t i = 1; i < axis.size(); ++i) {
         const TreeNode &a = tree.nodes[axis[i - 1]], &b = tree.nodes[axis[i]];
+        if (min_diameter > 0 && 2.0 * b.radius <= min_diameter) continue;
         const Eigen::Vector3f pa = (tree_origin + a.position.cast<double>() - origin).cast<float>();
         const Eigen::Vector3f pb = (tree_origin + b.position.cast<double>() - origin).cast<float>();
         const int n = std::max(1, static_cast<int>(std::ceil((pb - pa).norm() / o.sample_step)));
@@ -300,12 +303,12 @@ BranchDetection detect_branches(const SkeletonGraph& ours, const SkeletonGraph& 
         // Thickness of an axis: its first node above the fork.
         if (2.0 * ref.tree->nodes[axis[1]].radius <= o.min_branch_diameter) continue;
         ++b.reference_branches;
-        b.detected += matched_fraction(*ref.tree, ref.tree->origin, axis, to_ours, ours, true, o, origin) >= o.min_matched_fraction;
+        b.detected += matched_fraction(*ref.tree, ref.tree->origin, axis, to_ours, ours, true, o.min_branch_diameter, o, origin) >= o.min_matched_fraction;
     }
     for (const auto& axis : axes_of(*ours.tree)) {
         if (axis_length(*ours.tree, axis) < o.min_branch_length) continue;
         ++b.skeleton_branches;
-        b.correct += matched_fraction(*ours.tree, ours.tree->origin, axis, to_ref, ref, false, o, origin) >= o.min_matched_fraction;
+        b.correct += matched_fraction(*ours.tree, ours.tree->origin, axis, to_ref, ref, false, 0.0, o, origin) >= o.min_matched_fraction;
     }
     b.recall = b.reference_branches ? static_cast<double>(b.detected) / static_cast<double>(b.reference_branches) : 0.0;
     b.precision = b.skeleton_branches ? static_cast<double>(b.correct) / static_cast<double>(b.skeleton_branches) : 0.0;

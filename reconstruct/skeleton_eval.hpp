@@ -9,6 +9,14 @@
 //   points    a dense list of skeleton points "x y z" (WoodSKE), commas or whitespace.
 // Both sides are sampled every `sample_step` along their segments (points are used as they are)
 // and distances are measured from each sample to the nearest segment (or point) of the other.
+// Branch detection (reference trees with radii): the axes of a tree are root-to-tip along main
+// children plus fork-to-tip for every lateral child. A reference axis is a scored branch when it
+// leaves its fork thicker than `min_branch_diameter`, and it is detected when at least
+// `min_matched_fraction` of its samples on segments still thicker than that lie within
+// max(match_distance, reference radius) of the skeleton (the thin twig a branch tapers into is
+// not part of "a branch thicker than 2 cm"). Precision: a skeleton axis of at least
+// `min_branch_length` is correct when that fraction of all its samples lies within
+// max(match_distance, radius of the nearest reference segment) of the reference.
 #pragma once
 
 #include "core/tree_graph.hpp"
@@ -71,7 +79,7 @@ struct EvalOptions {
     double sample_step = 0.01;          // metres between samples along segments
     double min_branch_diameter = 0.02;  // reference branches thinner than this are not scored
     double match_distance = 0.05;       // metres: a sample within max(this, the branch radius) is matched
-    double min_matched_fraction = 0.5;  // of a branch's length, to count it detected / correct
+    double min_matched_fraction = 0.5;  // of a branch's (thick part's) length, to count it detected / correct
     double min_branch_length = 0.1;     // metres: shorter axes of the skeleton are not scored for precision
 };
 

@@ -69,6 +69,38 @@ TEST(SkeletonEval, ShiftMissingBranchAndPieces) {
     EXPECT_EQ(compare_skeletons(pieces, ref).components, 2u);
 }
 
+// A reference branch is scored over its part thicker than min_branch_diameter: a 0.4 m thick
+// lateral that tapers into a 1.6 m thin twig counts as detected when its thick part is found,
+// and as missed when only the twig is.
+TEST(SkeletonEval, BranchRecallScoresTheThickPart) {
+    test::TempDir dir;
+    // Trunk 0 -> (0,0,4) (the main child at the fork: longer than the lateral) and one lateral
+    // from (0,0,1) through `bend` to `tip`.
+    const auto tree = [](const Eigen::Vector3f& bend, const Eigen::Vector3f& tip, float bend_radius, float tip_radius) {
+        TreeGraph t;
+        t.add_node({0, 0, 0}, 0.10f, -1);
+        t.add_node({0, 0, 1}, 0.10f, 0);
+        t.add_node({0, 0, 4}, 0.08f, 1);
+        t.add_node(bend, bend_radius, 1);
+        t.add_node(tip, tip_radius, 3);
+        return t;
+    };
+    const SkeletonGraph reference = write_and_read(tree({0.4f, 0, 1}, {2.0f, 0, 1}, 0.02f, 0.004f), dir, "ref.ply");  // 4 cm, then an 8 mm twig
+    // Ours follows the thick part, then turns up away from the twig: detected (scored over the
+    // whole axis it would not be, 0.4 of 2 m matched).
+    const SkeletonComparison found =
+        compare_skeletons(write_and_read(tree({0.4f, 0, 1}, {0.4f, 0, 2.0f}, 0.02f, 0.01f), dir, "a.ply"), reference);
+    ASSERT_TRUE(found.branches);
+    EXPECT_EQ(found.branches->reference_branches, 2u);
+    EXPECT_DOUBLE_EQ(found.branches->recall, 1.0);
+    // Ours goes up and out, missing the thick part, and only meets the twig: missed.
+    const SkeletonComparison missed =
+        compare_skeletons(write_and_read(tree({0.6f, 0, 1.6f}, {2.0f, 0, 1}, 0.02f, 0.01f), dir, "b.ply"), reference);
+    ASSERT_TRUE(missed.branches);
+    EXPECT_EQ(missed.branches->reference_branches, 2u);
+    EXPECT_DOUBLE_EQ(missed.branches->recall, 0.5);
+}
+
 TEST(SkeletonEval, TreeQsmTableAndPointList) {
     test::TempDir dir;
     // Two stem cylinders (order 0) and one branch (order 1), TreeQSM column order.

@@ -1,0 +1,31 @@
+#include "apps/reconstruction_flags.hpp"
+
+#include "config/species_library.hpp"
+
+namespace treelobes::cli {
+
+void add_species_flags(CLI::App* sub, SpeciesFlags& flags, const std::string& fs_help) {
+    sub->add_option("--species", flags.species, "Species from config/species.yaml: sets beta, gamma and f_s");
+    sub->add_option("--beta", flags.beta, "Edge weight exponent ||u-v||^beta (default 1.5, or the species')")->check(CLI::PositiveNumber);
+    sub->add_option("--gamma", flags.gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(CLI::PositiveNumber);
+    sub->add_option("--fs", flags.fs, fs_help)->check(CLI::Range(0.01, 1.0));
+    sub->add_option("--ground", flags.ground, "Ground points: auto (remove a detected ground plane), remove, keep")
+        ->check(CLI::IsMember({"auto", "remove", "keep"}))
+        ->capture_default_str();
+}
+
+void apply_species_flags(SpeciesFlags& flags, ReconstructOptions& stage) {
+    if (!flags.species.empty()) {
+        const SpeciesEntry entry = find_species(load_species_entries(default_species_file()), flags.species);
+        flags.species = entry.name;
+        stage.skeleton.beta = entry.reconstruction.beta;
+        stage.allometry.gamma = entry.reconstruction.gamma;
+        stage.allometry.fs = entry.reconstruction.fs;
+    }
+    if (flags.beta) stage.skeleton.beta = *flags.beta;
+    if (flags.gamma) stage.allometry.gamma = *flags.gamma;
+    if (flags.fs) stage.allometry.fs = *flags.fs;
+    stage.preprocess.ground = parse_ground_mode(flags.ground);
+}
+
+}  // namespace treelobes::cli
