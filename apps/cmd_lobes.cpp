@@ -6,7 +6,8 @@
 // `treelobes synthesize FILE.tlobe --out MESH`: lobe texturing with the species' patch library,
 // the full (or --lod reduced) tree mesh, fidelity metrics against --points and a --preview PNG.
 #include "apps/command.hpp"
-#include "config/species_library.hpp"
+#include "apps/reconstruction_flags.hpp"
+#include "apps/summary_values.hpp"
 #include "core/cloud_io.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -44,32 +45,11 @@ namespace {
 struct LobesCliOptions {
     std::vector<std::string> inputs;
     std::string out;
-    std::string species;
-    std::optional<double> beta, gamma, fs;
-    std::string ground = "auto";
+    SpeciesFlags flags;
     ReconstructOptions stage;
     lobes::LobeOptions lobes;
     lobes::TlobeOptions file;
 };
-
-double rounded(double value, int digits = 4) {
-    const double scale = std::pow(10.0, digits);
-    return std::round(value * scale) / scale;
-}
-
-void resolve_species(LobesCliOptions& o) {
-    if (!o.species.empty()) {
-        const SpeciesEntry entry = find_species(load_species_entries(default_species_file()), o.species);
-        o.species = entry.name;
-        o.stage.skeleton.beta = entry.reconstruction.beta;
-        o.stage.allometry.gamma = entry.reconstruction.gamma;
-        o.stage.allometry.fs = entry.reconstruction.fs;
-    }
-    if (o.beta) o.stage.skeleton.beta = *o.beta;
-    if (o.gamma) o.stage.allometry.gamma = *o.gamma;
-    if (o.fs) o.stage.allometry.fs = *o.fs;
-    o.stage.preprocess.ground = parse_ground_mode(o.ground);
-}
 
 nlohmann::json lobe_json(const lobes::LobeTree& tree, const lobes::Lobe& lobe) {
     const Eigen::Vector3f seed = tree.seed_position(lobe);
@@ -102,7 +82,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
     const TreeReconstruction r = reconstruct_tree(cloud, o.stage, input.string());
     const auto reconstructed = std::chrono::steady_clock::now();
     lobes::LobeReport report;
-    const lobes::LobeTree tree = lobes::build_lobe_tree(cloud, r, o.stage, o.species, o.lobes, &report);
+    const lobes::LobeTree tree = lobes::build_lobe_tree(cloud, r, o.stage, o.flags.species, o.lobes, &report);
     const auto lobed = std::chrono::steady_clock::now();
     const std::string bytes = lobes::encode_tlobe(tree, o.file);
     // Read back what is written: the summary reports the decoded lobes' closedness.
@@ -122,9 +102,13 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
 
     std::size_t faces = 0;
     nlohmann::json lobes_json = nlohmann::json::array();
-    for (const auto& lobe : tree.lobes) {
-        faces += lobe.mesh.faces.size();
-        lobes_json.push_back(lobe_json(tree, lobe));
+    double occupancy_cell = 0;  // the grid the file had room for (one for all lobes), 0 = none
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        faces += tree.lobes[i].mesh.faces.size();
+        lobes_json.push_back(lobe_json(tree, tree.lobes[i]));
+        const lobes::Occupancy& occupancy = decoded.lobes[i].occupancy;
+        lobes_json.back()["occupied_cells"] = occupancy.occupied_count();
+        occupancy_cell = std::max(occupancy_cell, static_cast<double>(occupancy.cell));
     }
     nlohmann::json seconds = nlohmann::json::object();
     for (const auto& [stage, t] : r.summary.seconds) seconds["reconstruct " + stage] = rounded(t);
@@ -136,7 +120,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
     nlohmann::json summary = {
         {"treelobes", kVersion},
         {"input", input.string()},
-        {"options", {{"species", o.species.empty() ? nlohmann::json() : nlohmann::json(o.species)},
+        {"options", {{"species", o.flags.species.empty() ? nlohmann::json() : nlohmann::json(o.flags.species)},
                      {"beta", tree.beta}, {"gamma", tree.gamma}, {"fs", tree.fs}, {"alpha_factor", tree.alpha_factor},
                      {"min_cluster_points", o.lobes.min_cluster_points}, {"face_budget", o.lobes.face_budget},
                      {"quantum", o.file.quantum}}},
@@ -152,6 +136,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
         {"lobe_faces", faces},
         {"faces_before_simplification", report.faces_before_simplification},
         {"tlobe_bytes", bytes.size()},
+        {"occupancy_cell", occupancy_cell > 0 ? nlohmann::json(rounded(occupancy_cell, 4)) : nlohmann::json()},
         {"lobes", lobes_json},
         {"outputs", {{"tlobe", tlobe.string()}, {"lobes", tree.lobes.empty() ? nlohmann::json() : nlohmann::json(meshes.string())},
                      {"main_skeleton", main.string()}}},
@@ -165,7 +150,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
 }
 
 int run_lobes(LobesCliOptions& o, const GlobalOptions& global) {
-    resolve_species(o);
+    apply_species_flags(o.flags, o.stage);
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
@@ -304,7 +289,7 @@ int run_synthesize(const SynthesizeCliOptions& o, const GlobalOptions& global) {
         instances += lobe.instances.size();
         filled += lobe.filled;
         per_lobe.push_back({{"patches", lobe.instances.size()}, {"docks_used", lobe.docks_used}, {"docks_outside", lobe.docks_outside}, {"docks_redundant", lobe.docks_redundant},
-                            {"reseeds", lobe.reseeds}, {"filled", rounded(lobe.filled, 3)}});
+                            {"reseeds", lobe.reseeds}, {"target_cells", lobe.target_cells}, {"filled", rounded(lobe.filled, 3)}});
     }
     nlohmann::json summary = {
         {"treelobes", kVersion},
@@ -367,11 +352,7 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand("lobes", "Lobe-based representation (.tlobe) of single-tree scans: main skeleton + alpha-shape lobes");
     sub->add_option("inputs", o->inputs, "Point clouds of single trees (LAS, PLY, PCD, XYZ/CSV)")->required();
     sub->add_option("--out", o->out, "Output folder")->required();
-    sub->add_option("--species", o->species, "Species from config/species.yaml: sets beta, gamma and f_s");
-    sub->add_option("--beta", o->beta, "Edge weight exponent ||u-v||^beta (default 1.5, or the species')")->check(CLI::PositiveNumber);
-    sub->add_option("--gamma", o->gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(CLI::PositiveNumber);
-    sub->add_option("--fs", o->fs, "Lobe diameter factor f_s of Eq. 2: larger -> more, smaller lobes (default 1.0, or the species')")
-        ->check(CLI::Range(0.01, 1.0));
+    add_species_flags(sub, o->flags, "Lobe diameter factor f_s of Eq. 2: larger -> more, smaller lobes (default 1.0, or the species')");
     sub->add_option("--alpha-factor", o->lobes.alpha.alpha_factor, "alpha = FACTOR * alpha_min (ball radii)")
         ->check(CLI::Range(1.0, 100.0))->capture_default_str();
     sub->add_option("--min-cluster-points", o->lobes.min_cluster_points, "Smaller clusters stay on the skeleton as branches")
@@ -382,8 +363,6 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
         ->check(CLI::Range(100, 10000000))->capture_default_str();
     sub->add_option("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")
         ->check(CLI::Range(0.0001, 0.1))->capture_default_str();
-    sub->add_option("--ground", o->ground, "Ground points: auto (remove a detected ground plane), remove, keep")
-        ->check(CLI::IsMember({"auto", "remove", "keep"}))->capture_default_str();
     sub->callback([o, &global, &job] { job = [o, &global] { return run_lobes(*o, global); }; });
 
     auto so = std::make_shared<SynthesizeCliOptions>();

@@ -142,6 +142,8 @@ LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, c
         lobe.seed_node = new_index[cluster.seed_node];
         lobe.seed_direction = seed_direction(tree, cluster, points);
         lobe.points = cluster.points.size();
+        lobe.cluster_points.reserve(cluster.points.size());
+        for (int i : cluster.points) lobe.cluster_points.push_back(points[i]);
     });
     for (const Lobe& lobe : out.lobes) report.lobe_points += lobe.points;
     for (int u : r.point_internode) report.main_points += u >= 0 ? 1 : 0;

@@ -9,6 +9,7 @@
 #include "core/tree_graph.hpp"
 #include "core/triangle_mesh.hpp"
 #include "lobes/alpha_shape.hpp"
+#include "lobes/occupancy.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
 
 #include <Eigen/Core>
@@ -24,6 +25,9 @@ struct Lobe {
     int seed_node = -1;                 // p_i as a node of LobeTree::skeleton
     Eigen::Vector3f seed_direction{0, 0, 1};  // unit vector from p_i toward the cluster's centroid
     std::size_t points = 0;             // points of cluster C_i
+    std::vector<Eigen::Vector3f> cluster_points;  // C_i in the tree's frame; not stored: the .tlobe keeps
+                                                  // their occupancy, on a grid sized to the file budget
+    Occupancy occupancy;                // read from a .tlobe (empty when the file had no room for it)
     double volume() const { return mesh.signed_volume(); }
     double area() const { return mesh.area(); }
 };

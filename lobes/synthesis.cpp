@@ -73,8 +73,17 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
     TexturedTree out;
     out.library = build_patch_library(species, o.library);
     out.lobes.resize(tree.lobes.size());
+    // A lobe's share of the budget goes by the volume it is to fill: its occupied cells' when the
+    // .tlobe recorded where its points were, else its hull's.
+    std::vector<double> fill_volume(tree.lobes.size());
     double total_volume = 0;
-    for (const Lobe& lobe : tree.lobes) total_volume += std::max(lobe.volume(), 0.0);
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        const Lobe& lobe = tree.lobes[i];
+        fill_volume[i] = std::max(lobe.volume(), 0.0);
+        if (!lobe.occupancy.empty())
+            fill_volume[i] = std::min(fill_volume[i], static_cast<double>(lobe.occupancy.occupied_count()) * std::pow(static_cast<double>(lobe.occupancy.cell), 3));
+        total_volume += fill_volume[i];
+    }
     // Triangles per patch, on average over the library. Leafy species (compound leaves,
     // needles) carry several times more leaf than twig triangles per patch; their leaves are
     // thinned to at most the twig triangles (stochastic pruning, enlarged to keep the leaf
@@ -105,26 +114,26 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
         // are dropped and the patches spread over the whole lobe (measured: 1 cell per patch
         // leaves budget unspent, 4 leaves small lobes sparse).
         lobe_options.max_fill_cells = std::min(o.texturing.max_fill_cells, kCellsPerPatch * static_cast<double>(lobe_options.max_patches_per_lobe));
-        out.lobes[i] = texture_lobe(lobe.mesh, seed, out.library, lobe_options, i);
+        out.lobes[i] = texture_lobe(lobe.mesh, seed, out.library, lobe_options, i, &lobe.occupancy);
         return lobe_options.max_patches_per_lobe;
     };
-    auto share = [&](const Lobe& lobe, double volume) { return volume > 0 ? std::max(lobe.volume(), 0.0) / volume : 1.0; };
+    auto share = [&](std::size_t i, double volume) { return volume > 0 ? fill_volume[i] / volume : 1.0; };
     std::vector<std::size_t> caps(tree.lobes.size());
-    tbb::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { caps[i] = texture(i, share(tree.lobes[i], total_volume) * max_patches); });
+    tbb::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { caps[i] = texture(i, share(i, total_volume) * max_patches); });
     double used = 0, starved_volume = 0;
     std::vector<std::size_t> starved;  // lobes that spent their whole budget below the fill target
     for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
         used += static_cast<double>(out.lobes[i].instances.size());
         if (out.lobes[i].instances.size() >= caps[i] && caps[i] < o.texturing.max_patches_per_lobe) {
             starved.push_back(i);
-            starved_volume += std::max(tree.lobes[i].volume(), 0.0);
+            starved_volume += fill_volume[i];
         }
     }
     const double spare = max_patches - used;
     if (spare >= 1 && !starved.empty())
         tbb::parallel_for(std::size_t{0}, starved.size(), [&](std::size_t k) {
             const std::size_t i = starved[k];
-            texture(i, static_cast<double>(caps[i]) + share(tree.lobes[i], starved_volume) * spare);
+            texture(i, static_cast<double>(caps[i]) + share(i, starved_volume) * spare);
         });
     return out;
 }

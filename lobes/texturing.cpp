@@ -65,6 +65,25 @@ std::pair<Eigen::Vector3f, Eigen::Vector3f> bounds(const TriangleMesh& mesh) {
 
 }  // namespace
 
+// Fill cells to be reached: the lobe's inside cells; with an occupancy, those of them that
+// overlap an occupied cell (centre in an occupied cell, or an occupied cell's centre inside
+// them - occupancy cells may be larger or smaller than fill cells). When no inside cell
+// overlaps one (points outside the simplified hull), the whole lobe.
+static std::vector<char> fill_targets(const LobeVolume& grid, const Occupancy* occupancy) {
+    std::vector<char> target(grid.cell_count(), 0);
+    for (int c = 0; c < grid.cell_count(); ++c) target[c] = grid.cell_inside(c) ? 1 : 0;
+    if (occupancy == nullptr) return target;
+    std::vector<char> overlap(grid.cell_count(), 0);
+    for (int c = 0; c < grid.cell_count(); ++c) overlap[c] = target[c] && occupancy->occupied(grid.cell_centre(c)) ? 1 : 0;
+    for (std::size_t i = 0; i < occupancy->bits.size(); ++i) {
+        if (!occupancy->bits[i]) continue;
+        const int c = grid.cell(occupancy->cell_centre(i));
+        if (c >= 0 && target[c]) overlap[c] = 1;
+    }
+    if (std::find(overlap.begin(), overlap.end(), 1) == overlap.end()) return target;
+    return overlap;
+}
+
 LobeVolume::LobeVolume(const TriangleMesh& mesh, int resolution) {
     if (resolution < 1) throw Error::usage("lobe volume: resolution must be >= 1");
     const auto [lo, hi] = bounds(mesh);
@@ -147,17 +166,24 @@ Eigen::Vector3f LobeVolume::cell_centre(int c) const {
 }
 
 LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library,
-                         const TexturingOptions& o, std::uint64_t stream) {
+                         const TexturingOptions& o, std::uint64_t stream, const Occupancy* occupancy) {
     if (library.patches.empty()) throw Error::usage("lobe texturing: the patch library is empty");
     if (o.candidates < 1) throw Error::usage("lobe texturing: candidates must be >= 1");
     if (!(o.fill_cell > 0) || !(o.max_fill_cells >= 1)) throw Error::usage("lobe texturing: fill cell and cell count must be positive");
     LobeTexture texture;
     const LobeVolume volume(lobe, 40);
-    const double cell = std::max(o.fill_cell, std::cbrt(std::max(lobe.signed_volume(), 0.0) / o.max_fill_cells));
+    const bool occupied_only = occupancy != nullptr && !occupancy->empty();
+    // The volume to fill: the occupied cells' (at most the lobe's) with an occupancy.
+    double fill_volume = std::max(lobe.signed_volume(), 0.0);
+    if (occupied_only)
+        fill_volume = std::min(fill_volume, static_cast<double>(occupancy->occupied_count()) * std::pow(static_cast<double>(occupancy->cell), 3));
+    const double cell = std::max(o.fill_cell, std::cbrt(fill_volume / o.max_fill_cells));
     const LobeVolume fill_grid = LobeVolume::with_cell_size(lobe, static_cast<float>(cell));
+    const std::vector<char> target = fill_targets(fill_grid, occupied_only ? occupancy : nullptr);
     std::vector<int> filled(fill_grid.cell_count(), 0);  // patches reaching each cell
     int filled_count = 0;
-    const int fill_total = std::max(1, fill_grid.inside_cells());
+    const int fill_total = std::max(1, static_cast<int>(std::count(target.begin(), target.end(), 1)));
+    texture.target_cells = static_cast<std::size_t>(fill_total);
     lsystem::Random rng(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17);
 
     std::vector<std::vector<Sample>> samples(library.patches.size()), fit_samples(library.patches.size());
@@ -170,7 +196,7 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
     // Empty lobe cells in a fixed random order: the order in which empty regions are re-seeded.
     std::vector<int> fill_order;
     for (int c = 0; c < fill_grid.cell_count(); ++c)
-        if (fill_grid.cell_inside(c)) fill_order.push_back(c);
+        if (target[c]) fill_order.push_back(c);
     for (std::size_t i = fill_order.size(); i > 1; --i) std::swap(fill_order[i - 1], fill_order[rng.next() % i]);
     // Cells on the lobe's surface first: the hull runs through the cluster's outermost points
     // (alpha-shape vertices are input points), where a scan sees the foliage, while much of a
@@ -202,7 +228,7 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
     std::size_t created = 0;
     queue.push({seed, true, created++});
     std::vector<int> order(library.patches.size());
-    auto reaches = [&](int cell) { return cell >= 0 && fill_grid.cell_inside(cell) && filled[cell] < kPatchesPerCell; };
+    auto reaches = [&](int cell) { return cell >= 0 && target[cell] && filled[cell] < kPatchesPerCell; };
     while (texture.instances.size() < o.max_patches_per_lobe) {
         if (queue.empty()) {
             if (static_cast<double>(filled_count) / fill_total >= o.fill_target ||

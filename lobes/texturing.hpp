@@ -17,10 +17,16 @@
 // Patches without docking points end a path. When the queue runs dry while part of the lobe is
 // still empty, a new docking point is taken on the placed twig nearest to the empty region
 // (pointing into it; empty cells on the lobe surface first), until the lobe is filled (`fill_target`) or the patch budget is spent.
+// With the lobe's occupancy (lobes/occupancy.hpp, the cells that held scan points), only the
+// fill cells that overlap occupied cells are to be filled: fitting scores, dropping of
+// redundant docking points, re-seeding and the fill target all count those cells, and the fill
+// cells are sized by their volume, so the budget goes where the scan saw the crown rather than
+// into the hull's empty space.
 // Deterministic for a seed (per-lobe random streams; lobes are independent).
 #pragma once
 
 #include "core/triangle_mesh.hpp"
+#include "lobes/occupancy.hpp"
 #include "lobes/patch_library.hpp"
 
 #include <Eigen/Core>
@@ -82,11 +88,13 @@ struct LobeTexture {
     std::size_t docks_outside = 0;     // docking points outside the lobe, not used
     std::size_t docks_redundant = 0;   // docking points whose best patch reaches no cell short of patches
     std::size_t reseeds = 0;
-    double filled = 0;                 // fraction of lobe cells reached
+    double filled = 0;                 // fraction of lobe cells (occupied ones, with an occupancy) reached
+    std::size_t target_cells = 0;      // fill cells to be reached
 };
 
-// Textures one lobe (closed mesh) from its seed. `stream` selects the random stream (the lobe index).
+// Textures one lobe (closed mesh) from its seed. `stream` selects the random stream (the lobe
+// index). `occupancy` may be null or empty (then the whole lobe is filled).
 LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library,
-                         const TexturingOptions& options, std::uint64_t stream);
+                         const TexturingOptions& options, std::uint64_t stream, const Occupancy* occupancy = nullptr);
 
 }  // namespace treelobes::lobes

@@ -3,6 +3,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "lobes/mesh_coder.hpp"
+#include "lobes/occupancy.hpp"
 
 #include <zlib.h>
 
@@ -79,8 +80,10 @@ void check_options(const TlobeOptions& o) {
 
 }  // namespace
 
-std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
-    check_options(o);
+namespace {
+
+// The payload with lobe i's occupancy taken from `occupancy[i]`.
+std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const std::vector<const Occupancy*>& occupancy) {
     ByteWriter w;
     for (int k = 0; k < 3; ++k) w.f64(tree.skeleton.origin[k]);
     w.f32(static_cast<float>(o.quantum));
@@ -94,7 +97,8 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
     stored.diameter_quantum = static_cast<float>(o.diameter_quantum);
     encode_skeleton(tree.skeleton, stored, w);
     w.varint(tree.lobes.size());
-    for (const Lobe& lobe : tree.lobes) {
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        const Lobe& lobe = tree.lobes[i];
         if (lobe.seed_node < 0 || static_cast<std::size_t>(lobe.seed_node) >= tree.skeleton.size())
             throw Error(ExitCode::Internal, "tlobe: lobe seed is not a skeleton node");
         w.varint(static_cast<std::uint64_t>(lobe.seed_node));
@@ -103,13 +107,16 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
         if (lobe.mesh.origin != Eigen::Vector3d::Zero() && lobe.mesh.origin != tree.skeleton.origin)
             throw Error(ExitCode::Internal, "tlobe: lobe mesh is not in the tree's frame");
         encode_mesh(lobe.mesh, quantum, w);
+        encode_occupancy(*occupancy[i], quantum, w);
     }
+    return w.bytes();
+}
 
-    const std::string& raw = w.bytes();
+std::string pack(const std::string& raw, int level) {
     uLongf packed_size = compressBound(static_cast<uLong>(raw.size()));
     std::string file(kHeaderSize + packed_size, '\0');
     if (compress2(reinterpret_cast<Bytef*>(file.data() + kHeaderSize), &packed_size, reinterpret_cast<const Bytef*>(raw.data()),
-                  static_cast<uLong>(raw.size()), o.compression_level) != Z_OK)
+                  static_cast<uLong>(raw.size()), level) != Z_OK)
         throw Error(ExitCode::Internal, "tlobe: deflate failed");
     file.resize(kHeaderSize + packed_size);
     std::memcpy(file.data(), kMagic.data(), 4);
@@ -122,13 +129,46 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
     return file;
 }
 
+}  // namespace
+
+std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
+    check_options(o);
+    const double quantum = static_cast<float>(o.quantum);
+    std::vector<const Occupancy*> stored(tree.lobes.size());
+    bool from_points = false;
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        stored[i] = &tree.lobes[i].occupancy;
+        from_points = from_points || !tree.lobes[i].cluster_points.empty();
+    }
+    if (!from_points) return pack(encode_payload(tree, o, stored), o.compression_level);
+    // Finest grid first; a grid that some lobe's extent makes too large is skipped.
+    std::vector<Occupancy> grids(tree.lobes.size());
+    std::vector<const Occupancy*> use(tree.lobes.size());
+    for (double size : o.occupancy_cells) {
+        const auto cell = static_cast<float>(static_cast<double>(std::max<long long>(1, std::llround(size / quantum))) * quantum);
+        bool fits = true;
+        for (const Lobe& lobe : tree.lobes) fits = fits && occupancy_cell_count(lobe.cluster_points, cell) <= kMaxOccupancyCells;
+        if (!fits) continue;
+        for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+            grids[i] = tree.lobes[i].cluster_points.empty() ? tree.lobes[i].occupancy : occupancy_of(tree.lobes[i].cluster_points, cell);
+            use[i] = &grids[i];
+        }
+        std::string file = pack(encode_payload(tree, o, use), o.compression_level);
+        if (file.size() <= o.max_bytes) return file;
+    }
+    const Occupancy none;
+    for (auto& p : use) p = &none;
+    return pack(encode_payload(tree, o, use), o.compression_level);
+}
+
 LobeTree decode_tlobe(std::string_view file, const std::string& name) {
     if (file.size() < kHeaderSize || std::memcmp(file.data(), kMagic.data(), 4) != 0)
         throw Error::input(name, "not a .tlobe file (no TLOB header)");
     const int major = static_cast<unsigned char>(file[4]), minor = static_cast<unsigned char>(file[5]);
     if (major != kTlobeMajorVersion)
         throw Error::input(name, ".tlobe version " + std::to_string(major) + "." + std::to_string(minor) +
-                                     " is not supported (this build reads version " + std::to_string(kTlobeMajorVersion) + ".x)");
+                                     " is not supported (this build reads version " + std::to_string(kTlobeMajorVersion) +
+                                     ".x; run `treelobes lobes` on the scan again)");
     const std::uint32_t raw_size = get_u32(file, 8), packed_size = get_u32(file, 12);
     if (packed_size != file.size() - kHeaderSize) throw Error::input(name, "truncated .tlobe file (payload size mismatch)");
     if (get_u32(file, 16) != file_crc(file)) throw Error::input(name, "corrupt .tlobe file (CRC-32 mismatch)");
@@ -166,6 +206,7 @@ LobeTree decode_tlobe(std::string_view file, const std::string& name) {
         for (int k = 0; k < 3; ++k) d[k] = static_cast<float>(in.svarint());
         lobe.seed_direction = d.norm() > 0 ? Eigen::Vector3f(d.normalized()) : Eigen::Vector3f::UnitZ();
         lobe.mesh = decode_mesh(in, quantum);
+        lobe.occupancy = decode_occupancy(in, quantum);
     }
     if (!in.at_end()) in.fail("trailing bytes after the last lobe");
     return tree;

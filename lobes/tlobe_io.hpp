@@ -3,7 +3,9 @@
 // header (magic "TLOB", major/minor version, sizes, CRC-32 over header and payload) followed
 // by a deflated payload holding the species parameters, the main skeleton (pre-order parent
 // deltas, quantized positions and allometric diameters), and per lobe its seed point and its
-// closed surface coded by lobes/mesh_coder.hpp.
+// closed surface coded by lobes/mesh_coder.hpp, then (version 2) the lobe's occupancy
+// (lobes/occupancy.hpp) on the finest grid of occupancy_cells that keeps the file within
+// max_bytes.
 #pragma once
 
 #include "lobes/lobe_tree.hpp"
@@ -11,19 +13,26 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace treelobes::lobes {
 
-inline constexpr std::uint8_t kTlobeMajorVersion = 1;
+inline constexpr std::uint8_t kTlobeMajorVersion = 2;
 inline constexpr std::uint8_t kTlobeMinorVersion = 0;
 
 struct TlobeOptions {
     double quantum = 0.005;           // metres: grid of skeleton positions and lobe vertices
     double diameter_quantum = 0.0005; // metres: grid of branch diameters
     int compression_level = 9;        // deflate level 1..9
+    std::size_t max_bytes = 39000;    // the occupancy grid is coarsened until the file fits (target < 40 kB)
+    // Metres, finest first, steps of about 1.2 (each one costs an encoding pass).
+    std::vector<double> occupancy_cells{0.03, 0.035, 0.04, 0.05, 0.06, 0.07, 0.085, 0.1, 0.12, 0.14,
+                                        0.17, 0.2, 0.24, 0.3, 0.35, 0.4, 0.5, 0.6, 0.8};
 };
 
-// Bytes of the file. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
+// Bytes of the file. Lobes with cluster_points get their occupancy on the finest grid of
+// occupancy_cells (rounded to the quantum) at which the file fits max_bytes; none if no grid
+// fits. Lobes without cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
 std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {});
 // Parses a file's bytes; any inconsistency throws Error(InvalidInput) naming `name`.
 // Decoded lobes have origin 0 (the tree's frame), the skeleton the stored origin.

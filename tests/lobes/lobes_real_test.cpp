@@ -34,7 +34,15 @@ TEST(LobesReal, AdtreeTree13GivesClosedLobesInAFewKilobytes) {
     EXPECT_LT(bytes.size(), 40000u);
     const LobeTree decoded = decode_tlobe(bytes, "tree13.tlobe");
     ASSERT_EQ(decoded.lobes.size(), tree.lobes.size());
-    for (const Lobe& lobe : decoded.lobes) EXPECT_TRUE(check_closed(lobe.mesh).closed());
+    for (std::size_t k = 0; k < decoded.lobes.size(); ++k) {
+        const Lobe& lobe = decoded.lobes[k];
+        EXPECT_TRUE(check_closed(lobe.mesh).closed());
+        // The file has room for the occupancy (a few kB of lobes): every cluster point is in an occupied cell.
+        ASSERT_FALSE(lobe.occupancy.empty());
+        EXPECT_LE(lobe.occupancy.cell, 0.1f);
+        for (const auto& p : tree.lobes[k].cluster_points) ASSERT_TRUE(lobe.occupancy.occupied(p));
+    }
+    EXPECT_EQ(encode_tlobe(tree), bytes);  // deterministic
 }
 
 TEST(LobesReal, CliWritesTlobeMeshesAndSummary) {

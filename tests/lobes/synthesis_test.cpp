@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 using namespace treelobes;
@@ -112,6 +113,57 @@ TEST(Texturing, FillsALobeDeterministically) {
     const LobeTexture again = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0);
     ASSERT_EQ(again.instances.size(), t.instances.size());
     EXPECT_EQ(again.instances.back().translation, t.instances.back().translation);
+}
+
+TEST(Texturing, FillPrefersOccupiedCells) {
+    // The box lobe's points sit in one 0.8 m corner (a quarter of its width, 1/40 of its volume):
+    // with their occupancy the patches go there; without it they spread over the whole box.
+    const LobeTree tree = boxed_tree();
+    const PatchLibrary lib = build_patch_library(species("lagerstroemia"));
+    TexturingOptions o;
+    o.fill_cell = 0.1;
+    o.max_fill_cells = 2000;
+    o.max_patches_per_lobe = 400;
+    std::vector<Eigen::Vector3f> pts;
+    for (float x = 0.2f; x < 1.0f; x += 0.05f)
+        for (float y = 0.2f; y < 1.0f; y += 0.05f)
+            for (float z = 2.6f; z < 3.4f; z += 0.05f) pts.emplace_back(x, y, z);
+    const Occupancy occupancy = occupancy_of(pts, 0.1f);
+    const DockingPoint seed{tree.seed_position(tree.lobes[0]), {0, 0, 1}, tree.seed_thickness(tree.lobes[0])};
+    const LobeTexture uniform = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0);
+    const LobeTexture guided = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0, &occupancy);
+    const Occupancy none;
+    const LobeTexture empty_occupancy = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0, &none);
+    ASSERT_EQ(empty_occupancy.instances.size(), uniform.instances.size());  // an empty occupancy changes nothing
+    EXPECT_EQ(empty_occupancy.instances.back().translation, uniform.instances.back().translation);
+    // Targets: the corner's 0.51 m^3 (plus the rim cells it touches) on 0.1 m cells against the
+    // box's 6 m^3 on 0.144 m cells (2,000 cells).
+    EXPECT_LT(guided.target_cells, uniform.target_cells / 3);
+    EXPECT_GE(guided.filled, o.fill_target);
+    // Share of twig ends in occupied cells, and the median distance from the points to the
+    // nearest twig end.
+    auto fit = [&](const LobeTexture& t) {
+        std::vector<Eigen::Vector3f> ends;
+        for (const auto& inst : t.instances)
+            for (const auto& s : lib.patches[inst.patch].segments) ends.push_back(inst.apply(s.b));
+        std::size_t in = 0;
+        for (const auto& e : ends) in += occupancy.occupied(e) ? 1 : 0;
+        std::vector<float> d;
+        for (std::size_t i = 0; i < pts.size(); i += 7) {
+            float best = 1e9f;
+            for (const auto& e : ends) best = std::min(best, (e - pts[i]).norm());
+            d.push_back(best);
+        }
+        std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
+        return std::pair{static_cast<double>(in) / static_cast<double>(ends.size()), d[d.size() / 2]};
+    };
+    const auto [uniform_share, uniform_median] = fit(uniform);
+    const auto [guided_share, guided_median] = fit(guided);
+    EXPECT_GT(guided_share, 2 * uniform_share) << uniform_share << " -> " << guided_share;
+    EXPECT_LT(guided_median, 0.5f * uniform_median) << uniform_median << " -> " << guided_median;
+    const LobeTexture again = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0, &occupancy);
+    ASSERT_EQ(again.instances.size(), guided.instances.size());
+    EXPECT_EQ(again.instances.back().translation, guided.instances.back().translation);
 }
 
 TEST(Synthesis, LodKeepsThickestEdgesAndLeafArea) {

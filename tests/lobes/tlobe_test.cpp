@@ -1,11 +1,14 @@
 #include "lobes/closed_mesh.hpp"
 #include "lobes/mesh_coder.hpp"
+#include "lobes/occupancy.hpp"
 #include "lobes/tlobe_io.hpp"
 
 #include "core/error.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
+
+#include <random>
 
 using namespace treelobes;
 using namespace treelobes::lobes;
@@ -110,15 +113,87 @@ TEST(Tlobe, DetectsCorruptionTruncationAndForeignFiles) {
     EXPECT_EQ(error_code_of([&] { decode_tlobe(flipped, "x"); }), ExitCode::InvalidInput);
     EXPECT_EQ(error_code_of([&] { decode_tlobe(bytes.substr(0, bytes.size() - 3), "x"); }), ExitCode::InvalidInput);
     EXPECT_EQ(error_code_of([&] { decode_tlobe("ply\nformat ascii 1.0\n", "x"); }), ExitCode::InvalidInput);
-    std::string future = bytes;
-    future[4] = 2;  // major version 2
-    try {
-        decode_tlobe(future, "future.tlobe");
-        ADD_FAILURE() << "version 2 accepted";
-    } catch (const Error& e) {
-        EXPECT_EQ(e.code(), ExitCode::InvalidInput);
-        EXPECT_NE(std::string(e.what()).find("version 2.0"), std::string::npos) << e.what();
+    // Other major versions (the old 1.x without occupancy, a future one) are refused by name.
+    for (const int major : {kTlobeMajorVersion - 1, kTlobeMajorVersion + 1}) {
+        std::string other = bytes;
+        other[4] = static_cast<char>(major);
+        const std::string version = "version " + std::to_string(major) + ".0";
+        try {
+            decode_tlobe(other, "other.tlobe");
+            ADD_FAILURE() << version << " accepted";
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ExitCode::InvalidInput);
+            EXPECT_NE(std::string(e.what()).find(version), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find("treelobes lobes"), std::string::npos) << e.what();
+        }
     }
+}
+
+// Points of a lobe: a dense 0.3 m ball in one corner of the lobe and a thin vertical line.
+std::vector<Eigen::Vector3f> corner_points(const Eigen::Vector3f& centre) {
+    std::vector<Eigen::Vector3f> pts;
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-0.3f, 0.3f);
+    while (pts.size() < 3000) {
+        const Eigen::Vector3f d(u(rng), u(rng), u(rng));
+        if (d.norm() <= 0.3f) pts.push_back(centre + d);
+    }
+    for (int i = 0; i < 50; ++i) pts.push_back(centre + Eigen::Vector3f(0.5f, 0, -0.4f + 0.016f * i));
+    return pts;
+}
+
+TEST(Occupancy, GridHoldsEveryPointAndOnlyTheirCells) {
+    const auto pts = corner_points({0.7f, -0.2f, 2.4f});
+    const Occupancy o = occupancy_of(pts, 0.05f);
+    for (const auto& p : pts) EXPECT_TRUE(o.occupied(p));
+    EXPECT_FALSE(o.occupied({0.7f, -0.2f, 2.75f}));  // inside the grid, above the ball
+    EXPECT_FALSE(o.occupied({5, 5, 5}));             // outside the grid
+    // The ball's 0.113 m^3 over 0.05 m cells (about 900 cells plus its rim) and the line's 17 cells.
+    EXPECT_GT(o.occupied_count(), 900u);
+    EXPECT_LT(o.occupied_count(), 1500u);
+    ByteWriter w;
+    encode_occupancy(o, 0.005, w);
+    ByteReader r(w.bytes(), "test");
+    EXPECT_EQ(decode_occupancy(r, 0.005), o);
+    EXPECT_TRUE(r.at_end());
+    // Truncated bits and set padding bits are invalid input.
+    ByteReader short_reader(std::string_view(w.bytes()).substr(0, w.bytes().size() - 1), "test");
+    EXPECT_EQ(error_code_of([&] { decode_occupancy(short_reader, 0.005); }), ExitCode::InvalidInput);
+    const Occupancy three = occupancy_of(std::vector<Eigen::Vector3f>{{0, 0, 0}, {0.12f, 0, 0}}, 0.05f);  // 3 cells, 5 padding bits
+    ByteWriter pw;
+    encode_occupancy(three, 0.005, pw);
+    std::string padded = pw.bytes();
+    padded.back() = static_cast<char>(padded.back() | 0x80);
+    ByteReader padded_reader(padded, "test");
+    EXPECT_EQ(error_code_of([&] { decode_occupancy(padded_reader, 0.005); }), ExitCode::InvalidInput);
+}
+
+TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
+    LobeTree t = sample_tree();
+    for (Lobe& lobe : t.lobes) lobe.cluster_points = corner_points(t.seed_position(lobe) + Eigen::Vector3f(0, 0, 0.5f));
+    const std::string bytes = encode_tlobe(t);
+    const LobeTree d = decode_tlobe(bytes, "occupied.tlobe");
+    const float finest = static_cast<float>(0.03);
+    for (std::size_t k = 0; k < t.lobes.size(); ++k) {
+        ASSERT_FALSE(d.lobes[k].occupancy.empty());
+        EXPECT_NEAR(d.lobes[k].occupancy.cell, finest, 1e-6f);  // two small lobes fit the budget at the finest grid
+        EXPECT_EQ(d.lobes[k].occupancy, occupancy_of(t.lobes[k].cluster_points, d.lobes[k].occupancy.cell));
+        EXPECT_TRUE(d.lobes[k].cluster_points.empty());  // the points themselves are not stored
+    }
+    EXPECT_TRUE(encode_tlobe(d) == bytes) << "re-encoding a decoded tree changed the bytes";
+    // A smaller budget coarsens the grid; a budget below the file without occupancy drops it.
+    TlobeOptions small;
+    small.max_bytes = bytes.size() - 1;
+    const std::string coarse = encode_tlobe(t, small);
+    EXPECT_LE(coarse.size(), small.max_bytes);
+    EXPECT_GT(decode_tlobe(coarse, "coarse.tlobe").lobes[0].occupancy.cell, finest);
+    TlobeOptions tiny;
+    tiny.max_bytes = 100;
+    for (const Lobe& lobe : decode_tlobe(encode_tlobe(t, tiny), "tiny.tlobe").lobes) EXPECT_TRUE(lobe.occupancy.empty());
+    // Corruption inside the occupancy bits is still caught by the CRC.
+    std::string flipped = bytes;
+    flipped[bytes.size() - 5] ^= 0x01;
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(flipped, "x"); }), ExitCode::InvalidInput);
 }
 
 TEST(Tlobe, FileRoundTripAndBadOptions) {

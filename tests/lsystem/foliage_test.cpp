@@ -165,7 +165,9 @@ TEST(Foliage, ThresholdSelectsTexturedBoxes) {
         EXPECT_TRUE(h.boxes[0].textured);
         EXPECT_LE(h.textured_count(), previous);
         previous = h.textured_count();
-        if (threshold == 0.0) EXPECT_EQ(h.textured_count(), h.boxes.size());
+        if (threshold == 0.0) {
+            EXPECT_EQ(h.textured_count(), h.boxes.size());
+        }
     }
     EXPECT_EQ(previous, 1u);  // only the root box at 0.999
     FoliageOptions bad;
@@ -191,7 +193,9 @@ TEST(Foliage, CombinedLodAccountsForEveryLeaf) {
             EXPECT_EQ(lod.leaves.size() + f.attached_leaves.size() + f.leaves_in_textures + f.leaves_in_small_boxes,
                       drawn.leaves.size())
                 << k;
-            if (threshold == 0.0) EXPECT_TRUE(f.small_boxes.empty());
+            if (threshold == 0.0) {
+                EXPECT_TRUE(f.small_boxes.empty());
+            }
             for (int b : f.textured_boxes) EXPECT_TRUE(h.boxes[static_cast<std::size_t>(b)].textured);
             for (int b : f.small_boxes) EXPECT_FALSE(h.boxes[static_cast<std::size_t>(b)].textured);
         }

@@ -228,7 +228,9 @@ TEST(MultiresChain, GreedyRefinesCoarseToFine) {
     for (std::size_t k = 1; k < chain.lod_count(); ++k) {
         const double gain = chain.lod_length[k] - chain.lod_length[k - 1];
         EXPECT_GE(gain, 0.0);
-        if (gain > 0) EXPECT_EQ(growing++, k - 1) << "level " << k << " adds length after a level that added none";
+        if (gain > 0) {
+            EXPECT_EQ(growing++, k - 1) << "level " << k << " adds length after a level that added none";
+        }
     }
     EXPECT_EQ(growing + 1, interpret(string, s.turtle).tree.tip_count());
     EXPECT_NEAR(chain.lod_length.back(), chain.tadt.nodes[0].subtree_length, 1e-9);

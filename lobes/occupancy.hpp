@@ -1,0 +1,48 @@
+// Coarse occupancy of a lobe: which cells of a cubic grid held points of the lobe's cluster.
+// A lobe's hull (alpha = 5 alpha_min) is mostly empty space; the occupancy, stored in the .tlobe
+// (docs/tlobe.md), lets texturing (lobes/texturing.hpp) put patches where the scan saw the
+// crown instead of spreading them uniformly over the hull.
+//
+// Cells are indexed floor(p / cell) in the tree's local frame, so a grid is given by its first
+// cell, its size in cells and one bit per cell (x slowest, z fastest).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace treelobes::lobes {
+
+class ByteWriter;
+class ByteReader;
+
+struct Occupancy {
+    float cell = 0;                            // metres; 0 = no occupancy recorded
+    std::array<std::int64_t, 3> first{0, 0, 0};  // index of the grid's first cell
+    std::array<std::int64_t, 3> size{0, 0, 0};   // cells along x, y, z
+    std::vector<std::uint8_t> bits;            // 1 = the cell held a point; size[0]*size[1]*size[2] entries
+
+    bool empty() const { return cell <= 0 || bits.empty(); }
+    bool occupied(const Eigen::Vector3f& p) const;
+    std::size_t occupied_count() const;
+    Eigen::Vector3f cell_centre(std::size_t index) const;
+    bool operator==(const Occupancy&) const = default;
+};
+
+inline constexpr std::size_t kMaxOccupancyCells = std::size_t{1} << 24;  // per grid
+
+// Cells a grid over `points` would have at `cell` metres (0 for no points).
+std::size_t occupancy_cell_count(std::span<const Eigen::Vector3f> points, float cell);
+// The occupancy of `points` on a grid of `cell` metres (empty for no points); throws Error(Usage)
+// above kMaxOccupancyCells.
+Occupancy occupancy_of(std::span<const Eigen::Vector3f> points, float cell);
+
+// Coding (docs/tlobe.md): uvar cell / quantum (0 = none), svar first, uvar size, then the bits
+// packed 8 per byte. `cell` must be a multiple of `quantum`.
+void encode_occupancy(const Occupancy& occupancy, double quantum, ByteWriter& out);
+Occupancy decode_occupancy(ByteReader& in, double quantum);
+
+}  // namespace treelobes::lobes
