@@ -34,6 +34,40 @@ std::pair<std::array<std::int64_t, 3>, std::array<std::int64_t, 3>> grid_of(std:
     return {lo, {hi[0] - lo[0] + 1, hi[1] - lo[1] + 1, hi[2] - lo[2] + 1}};
 }
 
+// Octree over a grid padded to a cube of 2^depth cells (depth >= 1): level d has node (x, y, z)
+// covering cells [x, x+1) * 2^(depth-d) along x, ...; level depth is the grid itself.
+using Node = std::array<std::int64_t, 3>;
+
+Node child_of(const Node& n, int c) { return {2 * n[0] + ((c >> 2) & 1), 2 * n[1] + ((c >> 1) & 1), 2 * n[2] + (c & 1)}; }
+
+struct Pyramid {
+    int depth = 1;
+    std::vector<std::array<std::int64_t, 3>> size;  // nodes along x, y, z per level
+    std::vector<std::vector<std::uint8_t>> bits;    // per level; the leaf level is not copied
+
+    explicit Pyramid(const Occupancy& o) : grid(&o) {
+        while ((std::int64_t{1} << depth) < std::max({o.size[0], o.size[1], o.size[2]})) ++depth;
+        size.resize(depth + 1);
+        for (int d = 0; d <= depth; ++d)
+            for (int k = 0; k < 3; ++k) size[d][k] = ((o.size[k] - 1) >> (depth - d)) + 1;
+        bits.resize(depth);
+        if (o.bits.empty()) return;  // decoding: sizes only
+        for (int d = depth - 1; d >= 0; --d) {
+            bits[d].assign(static_cast<std::size_t>(size[d][0] * size[d][1] * size[d][2]), 0);
+            for (std::int64_t x = 0; x < size[d + 1][0]; ++x)
+                for (std::int64_t y = 0; y < size[d + 1][1]; ++y)
+                    for (std::int64_t z = 0; z < size[d + 1][2]; ++z)
+                        if (occupied(d + 1, {x, y, z})) bits[d][index(d, {x / 2, y / 2, z / 2})] = 1;
+        }
+    }
+    bool inside(int d, const Node& n) const { return n[0] < size[d][0] && n[1] < size[d][1] && n[2] < size[d][2]; }
+    std::size_t index(int d, const Node& n) const { return static_cast<std::size_t>((n[0] * size[d][1] + n[1]) * size[d][2] + n[2]); }
+    bool occupied(int d, const Node& n) const { return (d == depth ? grid->bits : bits[d])[index(d, n)] != 0; }
+
+private:
+    const Occupancy* grid;
+};
+
 }  // namespace
 
 bool Occupancy::occupied(const Eigen::Vector3f& p) const {
@@ -89,13 +123,24 @@ void encode_occupancy(const Occupancy& o, double quantum, ByteWriter& out) {
     out.varint(static_cast<std::uint64_t>(steps));
     for (int k = 0; k < 3; ++k) out.svarint(o.first[k]);
     for (int k = 0; k < 3; ++k) out.varint(static_cast<std::uint64_t>(o.size[k]));
-    std::uint8_t byte = 0;
-    for (std::size_t i = 0; i < o.bits.size(); ++i) {
-        byte |= static_cast<std::uint8_t>(o.bits[i] << (i % 8));
-        if (i % 8 == 7 || i + 1 == o.bits.size()) {
-            out.u8(byte);
-            byte = 0;
+    // Octree of child masks, breadth first: far fewer bytes than one bit per cell for the
+    // crown-shell occupancies of large lobes, so finer cells fit the file budget.
+    const Pyramid pyramid(o);
+    std::vector<Node> nodes{{0, 0, 0}};
+    for (int level = 0; level < pyramid.depth; ++level) {
+        std::vector<Node> next;
+        for (const Node& n : nodes) {
+            std::uint8_t mask = 0;
+            for (int c = 0; c < 8; ++c) {
+                const Node child = child_of(n, c);
+                if (pyramid.inside(level + 1, child) && pyramid.occupied(level + 1, child)) {
+                    mask |= static_cast<std::uint8_t>(1u << c);
+                    next.push_back(child);
+                }
+            }
+            out.u8(mask);
         }
+        nodes = std::move(next);
     }
 }
 
@@ -114,13 +159,23 @@ Occupancy decode_occupancy(ByteReader& in, double quantum) {
         cells *= o.size[k];
         if (cells > kMaxCells) in.fail("invalid occupancy grid size");
     }
+    const Pyramid pyramid(o);  // no bits yet: only its level sizes
     o.bits.assign(static_cast<std::size_t>(cells), 0);
-    std::uint8_t byte = 0;
-    for (std::size_t i = 0; i < o.bits.size(); ++i) {
-        if (i % 8 == 0) byte = in.u8();
-        o.bits[i] = (byte >> (i % 8)) & 1;
+    std::vector<Node> nodes{{0, 0, 0}};
+    for (int level = 0; level < pyramid.depth; ++level) {
+        std::vector<Node> next;
+        for (const Node& n : nodes) {
+            const std::uint8_t mask = in.u8();
+            for (int c = 0; c < 8; ++c) {
+                if (!((mask >> c) & 1)) continue;
+                const Node child = child_of(n, c);
+                if (!pyramid.inside(level + 1, child)) in.fail("occupancy octree node outside the grid");
+                next.push_back(child);
+            }
+        }
+        nodes = std::move(next);
     }
-    if (byte >> ((o.bits.size() - 1) % 8 + 1)) in.fail("occupancy padding bits are set");
+    for (const Node& n : nodes) o.bits[static_cast<std::size_t>((n[0] * o.size[1] + n[1]) * o.size[2] + n[2])] = 1;
     return o;
 }
 

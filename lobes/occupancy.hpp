@@ -40,8 +40,8 @@ std::size_t occupancy_cell_count(std::span<const Eigen::Vector3f> points, float 
 // above kMaxOccupancyCells.
 Occupancy occupancy_of(std::span<const Eigen::Vector3f> points, float cell);
 
-// Coding (docs/tlobe.md): uvar cell / quantum (0 = none), svar first, uvar size, then the bits
-// packed 8 per byte. `cell` must be a multiple of `quantum`.
+// Coding (docs/tlobe.md): uvar cell / quantum (0 = none), svar first, uvar size, then an octree
+// of 8-bit child masks, breadth first, for the occupied nodes only. `cell` must be a multiple of `quantum`.
 void encode_occupancy(const Occupancy& occupancy, double quantum, ByteWriter& out);
 Occupancy decode_occupancy(ByteReader& in, double quantum);
 

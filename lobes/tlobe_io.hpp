@@ -17,7 +17,7 @@
 
 namespace treelobes::lobes {
 
-inline constexpr std::uint8_t kTlobeMajorVersion = 2;
+inline constexpr std::uint8_t kTlobeMajorVersion = 3;
 inline constexpr std::uint8_t kTlobeMinorVersion = 0;
 
 struct TlobeOptions {

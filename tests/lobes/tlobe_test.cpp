@@ -156,16 +156,21 @@ TEST(Occupancy, GridHoldsEveryPointAndOnlyTheirCells) {
     ByteReader r(w.bytes(), "test");
     EXPECT_EQ(decode_occupancy(r, 0.005), o);
     EXPECT_TRUE(r.at_end());
-    // Truncated bits and set padding bits are invalid input.
+    // Truncated masks and a mask with a child outside the grid are invalid input.
     ByteReader short_reader(std::string_view(w.bytes()).substr(0, w.bytes().size() - 1), "test");
     EXPECT_EQ(error_code_of([&] { decode_occupancy(short_reader, 0.005); }), ExitCode::InvalidInput);
-    const Occupancy three = occupancy_of(std::vector<Eigen::Vector3f>{{0, 0, 0}, {0.12f, 0, 0}}, 0.05f);  // 3 cells, 5 padding bits
+    // 3 x 1 x 1 cells padded to a cube of depth 2: three masks (root, then the two occupied
+    // level-1 nodes), so the root mask is the 3rd to last byte;
+    // its children with y = 1 (bit 2) lie outside the grid.
+    const Occupancy three = occupancy_of(std::vector<Eigen::Vector3f>{{0, 0, 0}, {0.12f, 0, 0}}, 0.05f);
     ByteWriter pw;
     encode_occupancy(three, 0.005, pw);
-    std::string padded = pw.bytes();
-    padded.back() = static_cast<char>(padded.back() | 0x80);
-    ByteReader padded_reader(padded, "test");
-    EXPECT_EQ(error_code_of([&] { decode_occupancy(padded_reader, 0.005); }), ExitCode::InvalidInput);
+    ByteReader good_reader(pw.bytes(), "test");
+    EXPECT_EQ(decode_occupancy(good_reader, 0.005), three);
+    std::string outside = pw.bytes();
+    outside[outside.size() - 3] = static_cast<char>(outside[outside.size() - 3] | 0x04);
+    ByteReader outside_reader(outside, "test");
+    EXPECT_EQ(error_code_of([&] { decode_occupancy(outside_reader, 0.005); }), ExitCode::InvalidInput);
 }
 
 TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
