@@ -3,12 +3,12 @@
 // alpha complex of squared radius alpha when its circumsphere's squared radius is at most alpha
 // (the interior cells of CGAL::Alpha_shape_3 at that alpha); all finite cells make the convex hull.
 #include "classify/feature_groups.hpp"
+#include "core/grid_thinning.hpp"
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <cmath>
-#include <unordered_set>
 
 namespace treelobes::classify::detail {
 
@@ -23,14 +23,8 @@ constexpr int kAlphaDivisors[] = {10, 20, 40};  // alpha radius = H / divisor
 
 // One point per cell of size `cell` (the first one met), as CGAL points.
 std::vector<Point> thin_to_grid(const std::vector<Eigen::Vector3f>& pts, float cell) {
-    std::unordered_set<long long> seen;
     std::vector<Point> out;
-    for (const auto& p : pts) {
-        const long long x = static_cast<long long>(std::floor(p.x() / cell)) & 0x1fffff;
-        const long long y = static_cast<long long>(std::floor(p.y() / cell)) & 0x1fffff;
-        const long long z = static_cast<long long>(std::floor(p.z() / cell)) & 0x1fffff;
-        if (seen.insert((x << 42) | (y << 21) | z).second) out.emplace_back(p.x(), p.y(), p.z());
-    }
+    for (const std::size_t i : first_point_per_cell(pts, cell)) out.emplace_back(pts[i].x(), pts[i].y(), pts[i].z());
     return out;
 }
 

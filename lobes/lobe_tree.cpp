@@ -1,6 +1,7 @@
 #include "lobes/lobe_tree.hpp"
 
 #include "core/error.hpp"
+#include "core/grid_thinning.hpp"
 #include "lobes/lobe_split.hpp"
 #include "reconstruct/skeleton.hpp"
 
@@ -10,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <unordered_set>
 
 namespace treelobes::lobes {
 
@@ -54,13 +54,8 @@ std::vector<Eigen::Vector3f> thinned(std::vector<Eigen::Vector3f> points, std::s
     const Eigen::Vector3f extent = (hi - lo).cwiseMax(Eigen::Vector3f::Constant(1e-3f));
     float cell = std::cbrt(extent.prod() / static_cast<float>(max_points));
     for (;;) {
-        std::unordered_set<std::uint64_t> seen;
         std::vector<Eigen::Vector3f> kept;
-        for (const auto& p : points) {
-            const Eigen::Vector3f q = (p - lo) / cell;
-            const auto key = (static_cast<std::uint64_t>(q.x()) << 42) ^ (static_cast<std::uint64_t>(q.y()) << 21) ^ static_cast<std::uint64_t>(q.z());
-            if (seen.insert(key).second) kept.push_back(p);
-        }
+        for (const std::size_t i : first_point_per_cell(points, cell, lo)) kept.push_back(points[i]);
         if (kept.size() <= max_points) return kept;
         cell *= 1.25f;
     }

@@ -1,13 +1,13 @@
 #include "synth/scan_stats.hpp"
 
 #include "core/error.hpp"
+#include "core/grid_thinning.hpp"
 
 #include <Eigen/Dense>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_set>
 
 namespace treelobes::synth {
 
@@ -53,15 +53,9 @@ bool kasa(const std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& c, double& r
 
 PointCloud voxel_thin(const PointCloud& cloud, double voxel) {
     if (!(voxel > 0)) throw Error::usage("voxel size must be positive");
-    std::unordered_set<std::uint64_t> seen;
-    std::vector<std::size_t> keep;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const Eigen::Vector3d p = cloud.global(i) / voxel;
-        // 21 bits per axis: +-10 km at 1 cm, ample for one tree or tile.
-        const auto cell = [](double v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v)) & 0x1FFFFF); };
-        const std::uint64_t key = cell(p.x()) | cell(p.y()) << 21 | cell(p.z()) << 42;
-        if (seen.insert(key).second) keep.push_back(i);
-    }
+    std::vector<Eigen::Vector3d> global(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) global[i] = cloud.global(i);
+    const std::vector<std::size_t> keep = first_point_per_cell(global, voxel);
     return cloud.subset(keep);
 }
 
