@@ -1,11 +1,15 @@
-// Throughput of DBF6 encoding, decoding and LOD reduction (seed 000 §3.1-3.2) on a
+// Throughput of DBF6 encoding, decoding and LOD reduction (seed 000 §3.1-3.2), and of the range
+// decoder's binary decisions (issue 7), on a
 // deterministic random tree (about 1,000 internodes) from tests/encode/random_tree.hpp (switch to synth/
 // species trees once they land). Run: bench_encode [--benchmark_filter=...]
 #include "encode/lod.hpp"
+#include "encode/range_coder.hpp"
 #include "encode/tree_code.hpp"
 #include "tests/encode/random_tree.hpp"
 
 #include <benchmark/benchmark.h>
+
+#include <random>
 
 using namespace treelobes;
 using namespace treelobes::encode;
@@ -56,6 +60,33 @@ void BM_LodChain(benchmark::State& state) {
     state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(encoded.code.radii.size()));
 }
 BENCHMARK(BM_LodChain)->Unit(benchmark::kMillisecond);
+
+// Raw cost of one adaptive binary decision of the `best` coders' range decoder: 1 M decisions
+// over 64 models with probabilities from 0.1 to 0.86 (0.85 bits each), decoded in a loop that
+// does nothing else. The floor under the decisions the forest decoder makes (docs/forest.md).
+void BM_RangeDecoderDecisions(benchmark::State& state) {
+    constexpr int kDecisions = 1'000'000, kModels = 64;
+    std::mt19937 random(1);
+    std::vector<std::uint8_t> context(kDecisions);
+    std::vector<bool> bits(kDecisions);
+    for (int i = 0; i < kDecisions; ++i) {
+        context[i] = static_cast<std::uint8_t>(random() % kModels);
+        bits[i] = static_cast<int>(random() % 1000) < 100 + 12 * context[i];
+    }
+    RangeEncoder encoder;
+    std::vector<BitModel> models(kModels);
+    for (int i = 0; i < kDecisions; ++i) encoder.encode(models[context[i]], bits[i]);
+    const std::vector<std::uint8_t> bytes = encoder.finish();
+    for (auto _ : state) {
+        std::vector<BitModel> decoding(kModels);
+        RangeDecoder decoder(bytes, "bench");
+        int ones = 0;
+        for (int i = 0; i < kDecisions; ++i) ones += decoder.decode(decoding[context[i]]);
+        benchmark::DoNotOptimize(ones);
+    }
+    state.SetItemsProcessed(state.iterations() * kDecisions);
+}
+BENCHMARK(BM_RangeDecoderDecisions)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

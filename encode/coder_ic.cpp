@@ -43,18 +43,34 @@ std::size_t internode_count(const std::string& symbols) {
 
 }  // namespace
 
-std::vector<std::uint8_t> ic_encode_symbols(const std::string& symbols) {
+namespace {
+
+std::vector<std::uint8_t> write_symbols_with(const std::string& symbols, const BwtResult& bwt, MtfRule rule) {
     BitWriter out;
     write_count(out, symbols.size());
-    if (symbols.empty()) return out.take();
-    std::vector<std::uint8_t> text(symbols.size());
-    for (std::size_t i = 0; i < symbols.size(); ++i) text[i] = static_cast<std::uint8_t>(symbols[i] - '0');
-    const BwtResult bwt = bwt_forward(text, kAlphabet);
     write_centred_minimal_binary(out, bwt.primary_index, symbols.size() + 1);
-    const std::vector<std::uint8_t> mtf = mtf_encode(bwt.last_column, kAlphabet);
+    out.write_bit(rule == MtfRule::Mtf2);
+    const std::vector<std::uint8_t> mtf = mtf_encode(bwt.last_column, kAlphabet, rule);
     const std::vector<std::uint64_t> values(mtf.begin(), mtf.end());
     write_interpolative(out, cumulative_sum(values), {.max_gap = kMaxMtfPosition});
     return out.take();
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> ic_encode_symbols(const std::string& symbols) {
+    if (symbols.empty()) {
+        BitWriter out;
+        write_count(out, 0);
+        return out.take();
+    }
+    std::vector<std::uint8_t> text(symbols.size());
+    for (std::size_t i = 0; i < symbols.size(); ++i) text[i] = static_cast<std::uint8_t>(symbols[i] - '0');
+    const BwtResult bwt = bwt_forward(text, kAlphabet);
+    // MTF as printed, or MTF-2 when that is smaller (it is on every tree of docs/dbf6.md).
+    std::vector<std::uint8_t> printed = write_symbols_with(symbols, bwt, MtfRule::ToFront);
+    std::vector<std::uint8_t> mtf2 = write_symbols_with(symbols, bwt, MtfRule::Mtf2);
+    return mtf2.size() < printed.size() ? mtf2 : printed;
 }
 
 std::string ic_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context) {
@@ -63,10 +79,11 @@ std::string ic_decode_symbols(std::span<const std::uint8_t> bytes, const std::st
     if (n > kMaxCodeSymbols) in.fail("code length " + std::to_string(n) + " exceeds the decoder limit");
     if (n == 0) return {};
     const std::uint64_t primary = read_centred_minimal_binary(in, n + 1);
+    const MtfRule rule = in.read_bit() ? MtfRule::Mtf2 : MtfRule::ToFront;
     const std::vector<std::uint64_t> sums = read_interpolative(in, n, {.max_gap = kMaxMtfPosition});
     const std::vector<std::uint64_t> values = differences(sums, kMaxMtfPosition, context);
     const std::vector<std::uint8_t> mtf(values.begin(), values.end());
-    const std::vector<std::uint8_t> text = bwt_inverse(mtf_decode(mtf, kAlphabet, context), primary, kAlphabet, context);
+    const std::vector<std::uint8_t> text = bwt_inverse(mtf_decode(mtf, kAlphabet, context, rule), primary, kAlphabet, context);
     std::string symbols(text.size(), '0');
     for (std::size_t i = 0; i < text.size(); ++i) symbols[i] = static_cast<char>('0' + text[i]);
     return symbols;

@@ -27,7 +27,7 @@
 
 namespace treelobes::encode {
 
-inline constexpr std::uint8_t kForestFileVersion = 2;  // 2: `best` contexts of fork spacing
+inline constexpr std::uint8_t kForestFileVersion = 3;  // 2: `best` contexts of fork spacing; 3: MTF-2 in `ic`
 inline constexpr std::uint32_t kMaxForestTrees = 1u << 24;
 
 // A tree to place: its skeleton in its own frame, rotated by `azimuth` about +z and then moved

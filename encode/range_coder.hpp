@@ -102,16 +102,13 @@ public:
         for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
     }
     bool decode(BitModel& model) {
+        // Branch-free: the bits of a well-modelled stream are close to random, so a branch on
+        // them mispredicts about as often as the stream carries information.
         const std::uint32_t bound = (range_ >> 16) * model.p0;
-        bool bit;
-        if (code_ < bound) {
-            range_ = bound;
-            bit = false;
-        } else {
-            code_ -= bound;
-            range_ -= bound;
-            bit = true;
-        }
+        const bool bit = code_ >= bound;
+        const std::uint32_t mask = 0u - static_cast<std::uint32_t>(bit);
+        code_ -= bound & mask;
+        range_ = (bound & ~mask) | ((range_ - bound) & mask);
         model.update(bit);
         normalize();
         return bit;

@@ -15,31 +15,43 @@ std::vector<std::uint8_t> natural_table(unsigned alphabet_size) {
     return table;
 }
 
+// Moves the symbol at `position` up by `rule`; `previous` is the position coded before it.
+void move_up(std::vector<std::uint8_t>& table, std::size_t position, std::size_t previous, MtfRule rule) {
+    std::size_t target = 0;
+    if (rule == MtfRule::Mtf2 && position > 0) target = position == 1 ? (previous != 0 ? 0 : 1) : 1;
+    const auto it = table.begin() + static_cast<std::ptrdiff_t>(position);
+    std::rotate(table.begin() + static_cast<std::ptrdiff_t>(target), it, it + 1);
+}
+
 }  // namespace
 
-std::vector<std::uint8_t> mtf_encode(std::span<const std::uint8_t> symbols, unsigned alphabet_size) {
+std::vector<std::uint8_t> mtf_encode(std::span<const std::uint8_t> symbols, unsigned alphabet_size, MtfRule rule) {
     std::vector<std::uint8_t> table = natural_table(alphabet_size);
     std::vector<std::uint8_t> out;
     out.reserve(symbols.size());
+    std::size_t previous = 0;
     for (std::uint8_t s : symbols) {
         const auto it = std::find(table.begin(), table.end(), s);
         if (it == table.end()) throw Error(ExitCode::Internal, "MTF symbol outside the alphabet");
-        out.push_back(static_cast<std::uint8_t>(it - table.begin()));
-        std::rotate(table.begin(), it, it + 1);
+        const auto position = static_cast<std::size_t>(it - table.begin());
+        out.push_back(static_cast<std::uint8_t>(position));
+        move_up(table, position, previous, rule);
+        previous = position;
     }
     return out;
 }
 
 std::vector<std::uint8_t> mtf_decode(std::span<const std::uint8_t> positions, unsigned alphabet_size,
-                                     const std::string& context) {
+                                     const std::string& context, MtfRule rule) {
     std::vector<std::uint8_t> table = natural_table(alphabet_size);
     std::vector<std::uint8_t> out;
     out.reserve(positions.size());
+    std::size_t previous = 0;
     for (std::uint8_t p : positions) {
         if (p >= alphabet_size) throw Error::input(context, "move-to-front position " + std::to_string(p) + " outside the table");
-        const auto it = table.begin() + p;
-        out.push_back(*it);
-        std::rotate(table.begin(), it, it + 1);
+        out.push_back(table[p]);
+        move_up(table, p, previous, rule);
+        previous = p;
     }
     return out;
 }

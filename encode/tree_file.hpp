@@ -20,7 +20,7 @@
 
 namespace treelobes::encode {
 
-inline constexpr std::uint8_t kTreeFileVersion = 2;  // 2: `best` contexts of fork spacing
+inline constexpr std::uint8_t kTreeFileVersion = 3;  // 2: `best` contexts of fork spacing; 3: MTF-2 in `ic`
 inline constexpr int kMaxLods = 16;
 
 struct TreeFileOptions {

@@ -172,6 +172,26 @@ TEST(Bwt, BadPrimaryIndexIsRejected) {
     }
 }
 
+TEST(Transforms, Mtf2KeepsTheFrontSymbolAfterOneInterruption) {
+    // Worked by hand, table [0 1 2]: the lone 1 interrupting the run of 0 stays at position 1
+    // (after a 0 it is not moved to the front), so the run of 0 continues as zeros; the 2 found
+    // at position 2 goes to position 1 ([0 2 1]) and reaches the front when seen again after a
+    // non-zero position ([2 0 1]).
+    const std::vector<std::uint8_t> s{0, 0, 1, 0, 0, 2, 2, 2};
+    const auto m = mtf_encode(s, 3, MtfRule::Mtf2);
+    EXPECT_EQ(m, (std::vector<std::uint8_t>{0, 0, 1, 0, 0, 2, 1, 0}));
+    EXPECT_EQ(mtf_encode(s, 3), (std::vector<std::uint8_t>{0, 0, 1, 1, 0, 2, 0, 0}));
+    EXPECT_EQ(mtf_decode(m, 3, "test", MtfRule::Mtf2), s);
+    // Round trip on random strings over the code alphabet.
+    std::mt19937 random(7);
+    for (int trial = 0; trial < 200; ++trial) {
+        std::vector<std::uint8_t> text(random() % 300);
+        for (auto& c : text) c = static_cast<std::uint8_t>(random() % 3 == 0 ? random() % 9 : random() % 2);
+        EXPECT_EQ(mtf_decode(mtf_encode(text, 9, MtfRule::Mtf2), 9, "test", MtfRule::Mtf2), text);
+    }
+    EXPECT_THROW(mtf_decode(std::vector<std::uint8_t>{9}, 9, "test", MtfRule::Mtf2), Error);
+}
+
 TEST(Transforms, MtfAndCumulativeSum) {
     const std::vector<std::uint8_t> s{8, 8, 8, 1, 1, 8, 0, 0, 0};
     const auto m = mtf_encode(s, 9);
