@@ -130,7 +130,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
                       {"low_confidence_edges", report.low_confidence_edges}}},
         {"clusters", {{"found", report.clusters}, {"kept_as_branches_small", report.kept_small},
                       {"kept_as_branches_no_shape", report.kept_no_shape}}},
-        {"points", {{"lobes", report.lobe_points}, {"main", report.main_points}}},
+        {"points", {{"lobes", report.lobe_points}, {"main", report.main_points}, {"dropped_attached_to_lobes", report.dropped_points_attached}}},
         {"lobe_count", tree.lobes.size()},
         {"closed_lobes", closed},
         {"lobe_faces", faces},
@@ -289,7 +289,8 @@ int run_synthesize(const SynthesizeCliOptions& o, const GlobalOptions& global) {
         instances += lobe.instances.size();
         filled += lobe.filled;
         per_lobe.push_back({{"patches", lobe.instances.size()}, {"docks_used", lobe.docks_used}, {"docks_outside", lobe.docks_outside}, {"docks_redundant", lobe.docks_redundant},
-                            {"reseeds", lobe.reseeds}, {"target_cells", lobe.target_cells}, {"filled", rounded(lobe.filled, 3)}});
+                            {"reseeds", lobe.reseeds}, {"target_cells", lobe.target_cells}, {"filled", rounded(lobe.filled, 3)},
+                            {"triangles", lobe.triangles}, {"budget_spent", lobe.budget_spent}});
     }
     nlohmann::json summary = {
         {"treelobes", kVersion},
@@ -306,6 +307,8 @@ int run_synthesize(const SynthesizeCliOptions& o, const GlobalOptions& global) {
         {"leaves", mesh.leaf_count},
         {"leaf_share", rounded(textured.leaf_share, 3)},
         {"triangles", mesh.triangles()},
+        {"max_triangles", o.synthesis.max_triangles},
+        {"patch_budget", textured.patch_budget},
         {"lobe_texturing", per_lobe},
         {"output", o.out}};
     nlohmann::json seconds = {{"read", rounded(read_seconds)}, {"texturing", rounded(texturing_seconds)},
@@ -359,6 +362,8 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
         ->check(CLI::Range(4, 100000))->capture_default_str();
     sub->add_option("--max-shape-points", o->lobes.max_shape_points, "Larger clusters are thinned on a grid before the alpha shape")
         ->check(CLI::Range(100, 10000000))->capture_default_str();
+    sub->add_option("--dropped-point-reach", o->lobes.dropped_point_reach, "Outliers dropped by the reconstruction within this many metres of a lobe's points join its occupancy (0 = off)")
+        ->check(CLI::Range(0.0, 10.0))->capture_default_str();
     sub->add_option("--face-budget", o->lobes.face_budget, "Lobe faces over the whole tree after simplification")
         ->check(CLI::Range(100, 10000000))->capture_default_str();
     sub->add_option("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")
@@ -374,7 +379,7 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     syn->add_option("--library-seed", so->synthesis.library.seed, "Random seed of the species' patch library")->capture_default_str();
     syn->add_option("--lod", so->lod, "Level of detail: fraction of skeleton edges, twigs and leaves kept (0..1]")
         ->check(CLI::Range(0.001, 1.0))->capture_default_str();
-    syn->add_option("--max-triangles", so->synthesis.max_triangles, "Patch budget of the tree in triangles, shared by the lobes by volume; leafy patches are thinned to fit")
+    syn->add_option("--max-triangles", so->synthesis.max_triangles, "Triangles of the synthesized tree at most (a hard bound): the main branches', the rest shared by the lobes by volume; leafy patches are thinned")
         ->check(CLI::Range(1000, 1000000000))->capture_default_str();
     syn->add_option("--max-lobe-patches", so->synthesis.texturing.max_patches_per_lobe, "Patches per lobe at most (a safety bound; --max-triangles governs)")
         ->check(CLI::Range(1, 10000000))->capture_default_str();

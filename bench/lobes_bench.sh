@@ -12,7 +12,7 @@ bin=$build/bin/treelobes
 mkdir -p "$out"
 trees=(adtree/tree1.xyz adtree/tree7.xyz adtree/tree13.xyz adtree/Lille_11.xyz adtree/ahn3_delft.xyz
        archi/tree1_points.las woodske/HS_wood.csv woodske/OR_wood.csv woodske/SW_wood.csv treels/pine.las)
-printf '%-22s %6s %9s %8s %8s %9s %10s %8s %8s %8s\n' tree lobes tlobe_kB recon_s lobes_s texture_s triangles lod50_s med_m p95_m
+printf '%-22s %6s %9s %6s %8s %8s %8s %9s %10s %8s %8s %8s\n' tree lobes tlobe_kB cell_m recon_s lobes_s encode_s texture_s triangles lod50_s med_m p95_m
 for t in "${trees[@]}"; do
   stem=$(basename "${t%.*}")
   "$bin" lobes "$data/$t" --out "$out" --log-level error > /dev/null
@@ -23,8 +23,8 @@ for t in "${trees[@]}"; do
 import json, sys
 s, f, l = (json.load(open(p)) for p in sys.argv[1:4])
 sec = s["seconds"]
-print("%-22s %6d %9.1f %8.2f %8.2f %9.2f %10d %8.3f %8.3f %8.3f" % (sys.argv[4], s["lobe_count"], s["tlobe_bytes"] / 1000,
-      sec["reconstruct"], sec["lobes"], f["seconds"]["texturing"], f["triangles"], l["seconds"]["lod_extraction"],
+print("%-22s %6d %9.1f %6s %8.2f %8.2f %8.2f %9.2f %10d %8.3f %8.3f %8.3f" % (sys.argv[4], s["lobe_count"], s["tlobe_bytes"] / 1000,
+      s.get("occupancy_cell"), sec["reconstruct"], sec["lobes"], sec["encode and verify"], f["seconds"]["texturing"], f["triangles"], l["seconds"]["lod_extraction"],
       f["fidelity"]["median_point_to_mesh"], f["fidelity"]["p95_point_to_mesh"]))
 PY
 done

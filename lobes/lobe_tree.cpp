@@ -8,9 +8,12 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <map>
 
 namespace treelobes::lobes {
 
@@ -66,6 +69,54 @@ std::size_t lobe_face_budget(double area, double total_area, const LobeOptions& 
     const double share = total_area > 0 ? area / total_area : 1.0;
     const auto faces = static_cast<std::size_t>(std::llround(share * static_cast<double>(o.face_budget)));
     return std::clamp(faces, o.min_lobe_faces, o.max_lobe_faces);
+}
+
+// Points the reconstruction dropped as outliers (isolated leaves at the crown's rim, where a
+// scan is sparse) still belong to the tree: each one within `reach` of a lobe's cluster point,
+// not classified ground and not below that cluster's lowest point, is added to the nearest
+// lobe's points for its occupancy, so that texturing covers it. Nearest by a hash grid of `reach` cells.
+std::size_t attach_dropped_points(const PointCloud& cloud, const std::vector<int>& point_internode, std::vector<Lobe>& lobes, float reach) {
+    if (!(reach > 0) || lobes.empty()) return 0;
+    using Key = std::array<std::int64_t, 3>;
+    auto key = [&](const Eigen::Vector3f& p) {
+        return Key{static_cast<std::int64_t>(std::floor(p.x() / reach)), static_cast<std::int64_t>(std::floor(p.y() / reach)),
+                   static_cast<std::int64_t>(std::floor(p.z() / reach))};
+    };
+    std::map<Key, std::vector<std::pair<Eigen::Vector3f, std::size_t>>> grid;
+    std::vector<float> lowest(lobes.size(), std::numeric_limits<float>::max());
+    for (std::size_t l = 0; l < lobes.size(); ++l)
+        for (const auto& p : lobes[l].cluster_points) {
+            grid[key(p)].emplace_back(p, l);
+            lowest[l] = std::min(lowest[l], p.z());
+        }
+    std::vector<std::vector<Eigen::Vector3f>> added(lobes.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (point_internode[i] >= 0 || (!cloud.classification.empty() && cloud.classification[i] == 2)) continue;
+        const Eigen::Vector3f& p = cloud.positions[i];
+        const Key k = key(p);
+        float best = reach * reach;
+        std::size_t nearest = lobes.size();
+        for (std::int64_t dx = -1; dx <= 1; ++dx)
+            for (std::int64_t dy = -1; dy <= 1; ++dy)
+                for (std::int64_t dz = -1; dz <= 1; ++dz) {
+                    const auto it = grid.find({k[0] + dx, k[1] + dy, k[2] + dz});
+                    if (it == grid.end()) continue;
+                    for (const auto& [q, l] : it->second) {
+                        const float d = (q - p).squaredNorm();
+                        if (d < best || (d == best && l < nearest)) {
+                            best = d;
+                            nearest = l;
+                        }
+                    }
+                }
+        if (nearest < lobes.size() && p.z() >= lowest[nearest]) added[nearest].push_back(p);
+    }
+    std::size_t count = 0;
+    for (std::size_t l = 0; l < lobes.size(); ++l) {
+        count += added[l].size();
+        lobes[l].cluster_points.insert(lobes[l].cluster_points.end(), added[l].begin(), added[l].end());
+    }
+    return count;
 }
 
 }  // namespace
@@ -140,6 +191,7 @@ LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, c
         lobe.cluster_points.reserve(cluster.points.size());
         for (int i : cluster.points) lobe.cluster_points.push_back(points[i]);
     });
+    report.dropped_points_attached = attach_dropped_points(cloud, r.point_internode, out.lobes, static_cast<float>(o.dropped_point_reach));
     for (const Lobe& lobe : out.lobes) report.lobe_points += lobe.points;
     for (int u : r.point_internode) report.main_points += u >= 0 ? 1 : 0;
     report.main_points -= report.lobe_points;

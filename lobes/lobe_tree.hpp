@@ -25,8 +25,9 @@ struct Lobe {
     int seed_node = -1;                 // p_i as a node of LobeTree::skeleton
     Eigen::Vector3f seed_direction{0, 0, 1};  // unit vector from p_i toward the cluster's centroid
     std::size_t points = 0;             // points of cluster C_i
-    std::vector<Eigen::Vector3f> cluster_points;  // C_i in the tree's frame; not stored: the .tlobe keeps
-                                                  // their occupancy, on a grid sized to the file budget
+    std::vector<Eigen::Vector3f> cluster_points;  // C_i in the tree's frame, plus the nearby points the
+                                                  // reconstruction dropped as outliers; not stored: the .tlobe
+                                                  // keeps their occupancy, on a grid sized to the file budget
     Occupancy occupancy;                // read from a .tlobe (empty when the file had no room for it)
     double volume() const { return mesh.signed_volume(); }
     double area() const { return mesh.area(); }
@@ -53,6 +54,8 @@ struct LobeOptions {
     std::size_t max_lobe_faces = 600;   // per lobe, at most
     std::size_t min_lobe_faces = 12;    // per lobe, at least (when the alpha shape has more)
     double simplify_tolerance = 0.02;   // metres: collapses below this error always happen
+    double dropped_point_reach = 0.0;   // metres: outliers this close to a cluster join its occupancy (0 = off:
+                                        // the larger occupancy takes coarser cells, docs/lobes.md)
 };
 
 struct LobeReport {
@@ -62,6 +65,7 @@ struct LobeReport {
     std::size_t kept_no_shape = 0;      // clusters without a 3D alpha shape (flat, collinear) kept as branches
     std::size_t lobe_points = 0;        // points inside lobes
     std::size_t main_points = 0;        // points on the main structure
+    std::size_t dropped_points_attached = 0;  // outliers added to lobes' occupancy points
     std::size_t faces_before_simplification = 0;
     std::vector<std::pair<std::string, double>> seconds;
 };

@@ -106,6 +106,14 @@ Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLib
 
 }  // namespace
 
+std::size_t kept_leaves(double fraction, std::size_t leaves) {
+    return std::min(leaves, static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(leaves))));
+}
+
+std::size_t patch_triangles(const Patch& patch, int twig_sides, double leaf_share) {
+    return 2 * static_cast<std::size_t>(twig_sides) * patch.segments.size() + 2 * kept_leaves(leaf_share, patch.leaves.size());
+}
+
 float Patch::length() const {
     float sum = 0;
     for (const auto& s : segments) sum += (s.b - s.a).norm();

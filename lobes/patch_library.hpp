@@ -72,4 +72,11 @@ struct PatchLibrary {
 // Deterministic for (profile, options). Throws Error(Usage) for options out of range.
 PatchLibrary build_patch_library(const SpeciesProfile& profile, const PatchLibraryOptions& options = {});
 
+// Leaves of a patch drawn when a fraction of them is kept (stochastic pruning, LOD): the prefix
+// of ceil(fraction * n) leaves of its shuffled list.
+std::size_t kept_leaves(double fraction, std::size_t leaves);
+// Triangles a placed patch adds to the synthesized mesh (lobes/synthesis.hpp): an open prism of
+// `twig_sides` quads per segment and two per kept leaf. Texturing counts these against its budget.
+std::size_t patch_triangles(const Patch& patch, int twig_sides, double leaf_share);
+
 }  // namespace treelobes::lobes

@@ -16,7 +16,7 @@ namespace treelobes::lobes {
 namespace {
 
 constexpr float kMinTwigRadius = 0.0008f;  // metres: thinner twigs are drawn this thick
-constexpr std::size_t kMinPatchesPerLobe = 20;
+constexpr double kMinPatchesPerLobe = 20;
 constexpr double kCellsPerPatch = 2;
 constexpr double kMinLeafShare = 0.1;  // leaves are thinned at most to this fraction
 
@@ -94,46 +94,62 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
         leaf += 2.0 * static_cast<double>(p.leaves.size());
     }
     out.leaf_share = leaf > wood && leaf > 0 ? std::max(wood / leaf, kMinLeafShare) : 1.0;
-    const double patch_count = static_cast<double>(std::max<std::size_t>(out.library.patches.size(), 1));
-    const double triangles = std::max(1.0, (wood + out.leaf_share * leaf) / patch_count);
-    const double max_patches = static_cast<double>(o.max_triangles) / triangles;
-    // Budget allocation: every lobe first gets its volume share of the tree's patches; the
-    // patches that lobes filled before spending their share are then handed to the lobes that
-    // ran out, again by volume (a lobe's texturing is a sequential process, so the larger
-    // budget extends the same fill - determinism is kept). Without the second round the big
-    // crown lobes stopped half-filled while the triangle budget was far from spent.
-    auto texture = [&](std::size_t i, double patches) {
+    double mean_triangles = 0;  // per patch, as drawn
+    for (const Patch& p : out.library.patches) mean_triangles += static_cast<double>(patch_triangles(p, o.twig_sides, out.leaf_share));
+    mean_triangles = std::max(1.0, mean_triangles / static_cast<double>(std::max<std::size_t>(out.library.patches.size(), 1)));
+    // The budget is a hard bound on the whole mesh: the main skeleton's generalized cylinders
+    // come first, the patches get the rest, counted patch by patch (lobes/texturing.hpp).
+    const std::size_t skeleton_triangles = tree.skeleton.size() >= 2 ? build_branch_mesh(tree.skeleton, o.main_branches).faces.size() : 0;
+    out.patch_budget = o.max_triangles > skeleton_triangles ? o.max_triangles - skeleton_triangles : 0;
+    const double budget = static_cast<double>(out.patch_budget);
+    // Every lobe first gets a floor (kMinPatchesPerLobe patches, less when the budget is short)
+    // and the rest by volume.
+    const double lobes = static_cast<double>(std::max<std::size_t>(tree.lobes.size(), 1));
+    const double floor_triangles = std::floor(std::min(kMinPatchesPerLobe * mean_triangles, budget / lobes));
+    const double shared = std::max(0.0, budget - floor_triangles * lobes);
+    // Budget allocation: every lobe first gets its share of the tree's triangles; the triangles
+    // that lobes filled before spending their share are then handed to the lobes that ran out,
+    // again by volume (a lobe's texturing is a sequential process, so the larger budget extends
+    // the same fill - determinism is kept). Without the second round the big crown lobes
+    // stopped half-filled while the triangle budget was far from spent. Shares are rounded
+    // down, so the lobes' budgets never sum above the tree's.
+    auto texture = [&](std::size_t i, std::size_t triangles) {
         const Lobe& lobe = tree.lobes[i];
         const DockingPoint seed{tree.seed_position(lobe), lobe.seed_direction, std::max(tree.seed_thickness(lobe), 0.002f)};
         TexturingOptions lobe_options = o.texturing;
-        const auto budget = static_cast<std::size_t>(std::llround(patches));
-        lobe_options.max_patches_per_lobe = std::min(o.texturing.max_patches_per_lobe, std::max<std::size_t>(budget, kMinPatchesPerLobe));
+        lobe_options.max_triangles = triangles;
+        lobe_options.twig_sides = o.twig_sides;
+        lobe_options.leaf_share = out.leaf_share;
         // Fill cells scaled to the budget: with fewer patches than cells, the growth from the
         // seed never meets filled cells, so it fills the lobe densely near the seed and stops
         // half-way; with about kCellsPerPatch cells per patch, docking points in filled parts
         // are dropped and the patches spread over the whole lobe (measured: 1 cell per patch
         // leaves budget unspent, 4 leaves small lobes sparse).
-        lobe_options.max_fill_cells = std::min(o.texturing.max_fill_cells, kCellsPerPatch * static_cast<double>(lobe_options.max_patches_per_lobe));
+        const double patches = std::min(static_cast<double>(o.texturing.max_patches_per_lobe), static_cast<double>(triangles) / mean_triangles);
+        lobe_options.max_fill_cells = std::min(o.texturing.max_fill_cells, std::max(1.0, kCellsPerPatch * patches));
         out.lobes[i] = texture_lobe(lobe.mesh, seed, out.library, lobe_options, i, &lobe.occupancy);
-        return lobe_options.max_patches_per_lobe;
     };
-    auto share = [&](std::size_t i, double volume) { return volume > 0 ? fill_volume[i] / volume : 1.0; };
+    auto share = [&](std::size_t i, double volume) { return volume > 0 ? fill_volume[i] / volume : 1.0 / lobes; };
     std::vector<std::size_t> caps(tree.lobes.size());
-    tbb::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { caps[i] = texture(i, share(i, total_volume) * max_patches); });
-    double used = 0, starved_volume = 0;
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i)
+        caps[i] = static_cast<std::size_t>(floor_triangles + std::floor(share(i, total_volume) * shared));
+    tbb::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { texture(i, caps[i]); });
+    // Spare: what the filled lobes left of the budget; the starved lobes keep their caps.
+    double spare = budget, starved_volume = 0;
     std::vector<std::size_t> starved;  // lobes that spent their whole budget below the fill target
     for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
-        used += static_cast<double>(out.lobes[i].instances.size());
-        if (out.lobes[i].instances.size() >= caps[i] && caps[i] < o.texturing.max_patches_per_lobe) {
+        if (out.lobes[i].budget_spent && out.lobes[i].instances.size() < o.texturing.max_patches_per_lobe) {
             starved.push_back(i);
             starved_volume += fill_volume[i];
+            spare -= static_cast<double>(caps[i]);
+        } else {
+            spare -= static_cast<double>(out.lobes[i].triangles);
         }
     }
-    const double spare = max_patches - used;
-    if (spare >= 1 && !starved.empty())
+    if (spare >= mean_triangles && !starved.empty())
         tbb::parallel_for(std::size_t{0}, starved.size(), [&](std::size_t k) {
             const std::size_t i = starved[k];
-            texture(i, static_cast<double>(caps[i]) + share(i, starved_volume) * spare);
+            texture(i, caps[i] + static_cast<std::size_t>(std::floor(share(i, starved_volume) * spare)));
         });
     return out;
 }
@@ -184,7 +200,7 @@ SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textu
                 ++out.twig_segments;
             }
             // Stochastic pruning: a prefix of the shuffled leaves, enlarged to keep the leaf area.
-            const std::size_t kept = prefix(fraction * textured.leaf_share, patch.leaves.size());
+            const std::size_t kept = kept_leaves(fraction * textured.leaf_share, patch.leaves.size());
             const float enlarge = kept > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(kept)) : 1.0f;
             for (std::size_t i = 0; i < kept; ++i) {
                 const PatchLeaf& leaf = patch.leaves[i];

@@ -3,8 +3,9 @@
 //
 // texture_tree() builds the species' patch library and textures every lobe from its seed
 // (lobes/texturing.hpp), each lobe in its own random stream so the result is the same for any
-// thread count. The tree's patch budget (max_triangles over the library's mean triangles per
-// patch) is shared by the lobes in proportion to their volume (at least 20 each); the share that
+// thread count. The tree's triangle budget (max_triangles, a hard bound on the mesh: the main
+// skeleton's cylinders first, then every placed patch counted) is shared by the lobes in
+// proportion to their volume (at least 20 mean patches each when it allows); the share that
 // lobes leave unspent goes to the lobes that spent theirs. Where a species' patches carry more
 // leaf than twig triangles, the leaves are thinned to the twig triangles (leaf_share, enlarged
 // to keep the area), so the budget buys more patches. synthesized_mesh() turns the main skeleton into generalized cylinders
@@ -35,8 +36,8 @@ namespace treelobes::lobes {
 struct SynthesisOptions {
     PatchLibraryOptions library;
     TexturingOptions texturing;
-    std::size_t max_triangles = 2000000;  // patch budget of the tree in triangles (seed 001: 0.5-3 M per tree),
-                                          // shared by the lobes by volume (each within the per-lobe budget)
+    std::size_t max_triangles = 2000000;  // triangles of the whole synthesized mesh at most (seed 001: 0.5-3 M
+                                          // per tree): the main skeleton's, the rest shared by the lobes by volume
     BranchMeshOptions main_branches{8, 2, 0.002f, 1.0f, 0.0f, true};
     int twig_sides = 3;  // prism sides of patch twigs
 };
@@ -45,6 +46,7 @@ struct TexturedTree {
     PatchLibrary library;
     std::vector<LobeTexture> lobes;  // one per LobeTree::lobes entry
     double leaf_share = 1;           // fraction of each patch's leaves drawn (budget thinning, area kept)
+    std::size_t patch_budget = 0;    // triangles left for the patches after the main skeleton
 };
 
 TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, const SynthesisOptions& options = {});

@@ -4,7 +4,10 @@
 #include "lsystem/random.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <limits>
+#include <unordered_map>
 #include <queue>
 #include <numbers>
 #include <numeric>
@@ -17,6 +20,68 @@ constexpr float kMinScale = 0.5f, kMaxScale = 2.0f;  // patches are stretched at
 constexpr float kPatchReach = 40.0f;                 // a patch reaches about this many root thicknesses
 constexpr int kPatchesPerCell = 2;                   // a fill cell takes geometry from this many patches at most
 constexpr std::size_t kFitLeaves = 32;               // leaf tips per patch scored in fitting (a uniform prefix)
+
+// Twig points of the placed patches on a hash grid, for the nearest one to an empty cell when
+// re-seeding (a linear scan over all placed points made re-seeding quadratic in big lobes).
+// Ties go to the earliest added point, as a scan in order would pick it.
+class TwigIndex {
+public:
+    explicit TwigIndex(float cell) : cell_(cell) {}
+    void add(const Eigen::Vector3f& p) {
+        const std::array<std::int64_t, 3> c = index(p);
+        for (int k = 0; k < 3; ++k) {
+            lo_[k] = std::min(lo_[k], c[k]);
+            hi_[k] = std::max(hi_[k], c[k]);
+        }
+        cells_[key(c)].push_back(static_cast<int>(points_.size()));
+        points_.push_back(p);
+    }
+    bool empty() const { return points_.empty(); }
+    // The nearest point to t; the index must not be empty.
+    const Eigen::Vector3f& nearest(const Eigen::Vector3f& t) const {
+        const std::array<std::int64_t, 3> c = index(t);
+        std::int64_t last = 0;  // the ring that holds the farthest occupied cell
+        for (int k = 0; k < 3; ++k) last = std::max({last, std::abs(c[k] - lo_[k]), std::abs(c[k] - hi_[k])});
+        float best = std::numeric_limits<float>::max();
+        int best_index = -1;
+        // Rings of cells at Chebyshev distance r: a point beyond ring r is more than r cells away.
+        for (std::int64_t r = 0; r <= last; ++r) {
+            for (std::int64_t dx = -r; dx <= r; ++dx)
+                for (std::int64_t dy = -r; dy <= r; ++dy)
+                    for (std::int64_t dz = -r; dz <= r; ++dz) {
+                        if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
+                        const auto it = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+                        if (it == cells_.end()) continue;
+                        for (const int i : it->second) {
+                            const float d = (points_[i] - t).squaredNorm();
+                            if (d < best || (d == best && i < best_index)) {
+                                best = d;
+                                best_index = i;
+                            }
+                        }
+                    }
+            const float reach = static_cast<float>(r) * cell_;
+            if (best_index >= 0 && best <= reach * reach) break;
+        }
+        return points_[best_index];
+    }
+
+private:
+    std::array<std::int64_t, 3> index(const Eigen::Vector3f& p) const {
+        return {static_cast<std::int64_t>(std::floor(p.x() / cell_)), static_cast<std::int64_t>(std::floor(p.y() / cell_)),
+                static_cast<std::int64_t>(std::floor(p.z() / cell_))};
+    }
+    static std::int64_t key(const std::array<std::int64_t, 3>& c) {
+        return ((c[0] & 0x1fffff) << 42) | ((c[1] & 0x1fffff) << 21) | (c[2] & 0x1fffff);
+    }
+    float cell_;
+    std::vector<Eigen::Vector3f> points_;
+    std::unordered_map<std::int64_t, std::vector<int>> cells_;
+    std::array<std::int64_t, 3> lo_{std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max(),
+                                    std::numeric_limits<std::int64_t>::max()};
+    std::array<std::int64_t, 3> hi_{std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::min(),
+                                    std::numeric_limits<std::int64_t>::min()};
+};
 
 // Points of a patch used for fitting: segment ends and leaf tips, with the thickness there.
 struct Sample {
@@ -191,7 +256,7 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
         samples[i] = patch_samples(library.patches[i], library.patches[i].leaves.size());
         fit_samples[i] = patch_samples(library.patches[i], kFitLeaves);
     }
-    std::vector<Sample> placed;  // transformed samples of every placed patch (for re-seeding)
+    TwigIndex twigs(static_cast<float>(cell));  // twig points of every placed patch (for re-seeding)
 
     // Empty lobe cells in a fixed random order: the order in which empty regions are re-seeded.
     std::vector<int> fill_order;
@@ -227,24 +292,39 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
     std::priority_queue<Pending, std::vector<Pending>, decltype(later)> queue(later);
     std::size_t created = 0;
     queue.push({seed, true, created++});
-    std::vector<int> order(library.patches.size());
-    auto reaches = [&](int cell) { return cell >= 0 && target[cell] && filled[cell] < kPatchesPerCell; };
-    while (texture.instances.size() < o.max_patches_per_lobe) {
+    std::vector<int> order;
+    order.reserve(library.patches.size());
+    int layer = 1;                                    // patches a cell takes in the current pass
+    std::vector<Pending> deferred;                    // docks dropped as redundant in an earlier pass
+    auto reaches = [&](int cell) { return cell >= 0 && target[cell] && filled[cell] < layer; };
+    // Triangles each patch adds to the mesh: the budget is a hard bound on their sum.
+    std::vector<std::size_t> cost(library.patches.size());
+    for (std::size_t i = 0; i < library.patches.size(); ++i) cost[i] = patch_triangles(library.patches[i], o.twig_sides, o.leaf_share);
+    const std::size_t min_cost = *std::min_element(cost.begin(), cost.end());
+    auto affordable = [&] { return texture.instances.size() < o.max_patches_per_lobe && texture.triangles + min_cost <= o.max_triangles; };
+    while (affordable()) {
         if (queue.empty()) {
-            if (static_cast<double>(filled_count) / fill_total >= o.fill_target ||
-                texture.reseeds >= static_cast<std::size_t>(o.max_reseeds_per_cell * fill_total) || placed.empty())
-                break;
-            while (fill_cursor < fill_order.size() && filled[fill_order[fill_cursor]]) ++fill_cursor;
-            if (fill_cursor == fill_order.size()) break;
+            // Spread first: cells take one patch until the lobe is filled (or cannot be filled
+            // further); then the docks that were dropped for it are taken up again, for a second
+            // patch per cell. With a tight budget (big crowns) the patches reach more of the
+            // lobe before it runs out; with a loose one the lobe ends as dense as before.
+            const bool filled_enough = static_cast<double>(filled_count) / fill_total >= o.fill_target ||
+                                       texture.reseeds >= static_cast<std::size_t>(o.max_reseeds_per_cell * fill_total) || twigs.empty();
+            while (!filled_enough && fill_cursor < fill_order.size() && filled[fill_order[fill_cursor]]) ++fill_cursor;
+            if (filled_enough || fill_cursor == fill_order.size()) {
+                if (layer >= kPatchesPerCell || deferred.empty()) break;
+                ++layer;
+                for (auto& pending : deferred) queue.push(std::move(pending));
+                deferred.clear();
+                continue;
+            }
             const Eigen::Vector3f target = fill_grid.cell_centre(fill_order[fill_cursor++]);
-            const Sample* from = &placed[0];
-            for (const auto& s : placed)
-                if (s.thickness > 0 && (s.position - target).squaredNorm() < (from->position - target).squaredNorm()) from = &s;
-            const Eigen::Vector3f dir = target - from->position;
+            const Eigen::Vector3f from = twigs.nearest(target);
+            const Eigen::Vector3f dir = target - from;
             if (dir.norm() < 1e-5f) continue;
             // As thick as a twig must be to reach the empty cell, never thicker than the seed.
             const float thickness = std::clamp(dir.norm() / kPatchReach, 0.002f, std::max(seed.thickness, 0.002f));
-            queue.push({{from->position, dir.normalized(), thickness}, true, created++});
+            queue.push({{from, dir.normalized(), thickness}, true, created++});
             ++texture.reseeds;
         }
         const Pending pending = queue.top();
@@ -254,8 +334,11 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
             ++texture.docks_outside;
             continue;
         }
-        // Patch selection: the candidates with the smallest thickness/orientation mismatch.
-        std::iota(order.begin(), order.end(), 0);
+        // Patch selection: of the patches that fit the remaining budget, the candidates with the
+        // smallest thickness/orientation mismatch.
+        order.clear();
+        for (std::size_t i = 0; i < library.patches.size(); ++i)
+            if (texture.triangles + cost[i] <= o.max_triangles) order.push_back(static_cast<int>(i));
         const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(o.candidates), order.size());
         std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(), [&](int a, int b) {
             const float ca = mismatch(library.patches[a], d), cb = mismatch(library.patches[b], d);
@@ -284,21 +367,24 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
         }
         if (!pending.forced && best_reached == 0) {  // this part of the lobe is filled already
             ++texture.docks_redundant;
+            if (layer < kPatchesPerCell) deferred.push_back(pending);
             continue;
         }
         texture.instances.push_back(best);
+        texture.triangles += cost[best.patch];
         ++texture.docks_used;
         const Patch& patch = library.patches[best.patch];
         for (const auto& sample : samples[best.patch]) {
             const Eigen::Vector3f p = best.apply(sample.position);
             const int cell = fill_grid.cell(p);
             if (reaches(cell) && filled[cell]++ == 0) ++filled_count;
-            placed.push_back({p, sample.thickness * best.scale});
+            if (sample.thickness > 0) twigs.add(p);
         }
         for (const auto& dock : patch.docks)
             queue.push({{best.apply(dock.position), best.rotation * dock.direction, dock.thickness * best.scale}, false, created++});
     }
     texture.filled = static_cast<double>(filled_count) / fill_total;
+    texture.budget_spent = !affordable();
     return texture;
 }
 

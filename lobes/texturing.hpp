@@ -12,8 +12,10 @@
 //     of its geometry lies inside the lobe and how many empty lobe cells it reaches; the best
 //     one is added, and those of its docking points that lie inside the lobe join the queue.
 // Docking points are taken thickest first, so the large structure is laid before twigs fill
-// in; a docking point whose best patch only reaches lobe cells that already hold geometry from
-// 2 patches is not used (that part of the lobe is filled).
+// in; a docking point whose best patch only reaches lobe cells that already hold geometry is
+// set aside (that part of the lobe is filled), so the patches spread over the whole lobe first;
+// once the lobe is filled the set-aside docks are taken up for a second patch per cell.
+// The triangle budget is a hard bound: a patch is placed only when its triangles fit.
 // Patches without docking points end a path. When the queue runs dry while part of the lobe is
 // still empty, a new docking point is taken on the placed twig nearest to the empty region
 // (pointing into it; empty cells on the lobe surface first), until the lobe is filled (`fill_target`) or the patch budget is spent.
@@ -33,6 +35,7 @@
 #include <Eigen/Geometry>
 
 #include <cstdint>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -66,7 +69,11 @@ private:
 struct TexturingOptions {
     std::uint64_t seed = 1;
     int candidates = 8;                 // patches fitted per docking point
-    std::size_t max_patches_per_lobe = 100000;  // a safety bound; the tree's triangle budget governs
+    std::size_t max_patches_per_lobe = 100000;  // a safety bound; the triangle budget governs
+    std::size_t max_triangles = SIZE_MAX;  // a hard bound: patches are placed only while their triangles
+                                           // (patch_triangles with the two values below) fit
+    int twig_sides = 3;                    // as the synthesized mesh draws the patches
+    double leaf_share = 1;
     double fill_cell = 0.04;            // metres: edge of the fill cells at least ...
     double max_fill_cells = 20000;      // ... enlarged so that a lobe has at most about this many
                                         // (texture_tree sets it to 2 per budgeted patch)
@@ -89,6 +96,8 @@ struct LobeTexture {
     std::size_t docks_redundant = 0;   // docking points whose best patch reaches no cell short of patches
     std::size_t reseeds = 0;
     double filled = 0;                 // fraction of lobe cells (occupied ones, with an occupancy) reached
+    std::size_t triangles = 0;         // of the placed patches (patch_triangles), <= max_triangles
+    bool budget_spent = false;         // stopped by max_triangles or max_patches_per_lobe, not by the fill
     std::size_t target_cells = 0;      // fill cells to be reached
 };
 

@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 using namespace treelobes;
@@ -90,4 +91,38 @@ TEST(LobeTree, RejectsAReconstructionOfAnotherCloud) {
     PointCloud other = cloud;
     other.positions.pop_back();
     EXPECT_THROW(build_lobe_tree(other, r, ro, ""), Error);
+}
+
+TEST(LobeTree, DroppedPointsNearTheCrownJoinTheLobeOccupancy) {
+    // Isolated points 0.3 m outside the crown ball are dropped as outliers by the reconstruction;
+    // with a reach they join the lobe's occupancy points, a point 3 m away and ground do not.
+    PointCloud cloud = trunk_and_crown();
+    const std::size_t base = cloud.size();
+    for (int k = 0; k < 6; ++k) {
+        const float a = static_cast<float>(k) * 1.047f;
+        cloud.positions.emplace_back(1.2f * std::cos(a), 1.2f * std::sin(a), 3.8f);
+    }
+    cloud.positions.emplace_back(4.0f, 0.0f, 3.8f);
+    cloud.classification.assign(cloud.size(), 1);
+    cloud.positions.emplace_back(0.0f, 1.2f, 3.8f);
+    cloud.classification.push_back(2);  // ground class: never attached
+    ReconstructOptions ro;
+    const TreeReconstruction r = reconstruct_tree(cloud, ro, "outliers");
+    std::size_t dropped = 0;
+    for (std::size_t i = base; i < cloud.size(); ++i) dropped += r.point_internode[i] < 0 ? 1 : 0;
+    ASSERT_EQ(dropped, cloud.size() - base);  // the isolated points were all dropped
+    LobeReport off, on;
+    const LobeTree without = build_lobe_tree(cloud, r, ro, "", {}, &off);
+    LobeOptions o;
+    o.dropped_point_reach = 0.5;
+    const LobeTree with = build_lobe_tree(cloud, r, ro, "", o, &on);
+    EXPECT_EQ(off.dropped_points_attached, 0u);
+    std::size_t extra = 0;
+    ASSERT_EQ(with.lobes.size(), without.lobes.size());
+    for (std::size_t l = 0; l < with.lobes.size(); ++l) {
+        EXPECT_EQ(with.lobes[l].points, without.lobes[l].points);  // the cluster itself is unchanged
+        extra += with.lobes[l].cluster_points.size() - without.lobes[l].cluster_points.size();
+    }
+    EXPECT_EQ(extra, on.dropped_points_attached);
+    EXPECT_EQ(on.dropped_points_attached, 6u);
 }

@@ -69,6 +69,7 @@ TEST(LobesReal, CliWritesTlobeMeshesAndSummary) {
     const auto f = nlohmann::json::parse(read_file(dir / "full.json"));
     EXPECT_EQ(f["species"], "lagerstroemia");
     EXPECT_GT(f["triangles"].get<std::size_t>(), 10000u);
+    EXPECT_LE(f["triangles"].get<std::size_t>(), 1000000u);  // --max-triangles is a hard bound
     EXPECT_GT(f["patch_instances"].get<std::size_t>(), summary["lobe_count"].get<std::size_t>());
     EXPECT_LT(f["fidelity"]["median_point_to_mesh"].get<double>(), 0.4);  // covers the scan (measured 0.18 m)
     EXPECT_TRUE(std::filesystem::exists(dir / "full.png"));
