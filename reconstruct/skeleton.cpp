@@ -7,6 +7,7 @@
 #include "reconstruct/shortest_paths.hpp"
 #include "reconstruct/union_find.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <tbb/parallel_invoke.h>
 
@@ -31,6 +32,8 @@ void check_options(const SkeletonOptions& o) {
     non_negative(o.min_twig_length, "minimum twig length");
     non_negative(o.merge_distance, "merge distance");
     non_negative(o.max_edge_length, "maximum edge length");
+    if (!(o.fine_bin_factor > 0.0f && o.fine_bin_factor <= 1.0f)) throw Error::usage("skeleton: fine bin factor must be in (0, 1]");
+    non_negative(o.thick_slice, "thick slice");
     if (o.smoothing_iterations < 0 || o.smoothing_iterations > 100) throw Error::usage("skeleton: smoothing iterations must be in 0..100");
 }
 
@@ -131,26 +134,75 @@ std::vector<int> cluster_parents(const Clusters& c, const std::vector<int>& firs
     return parent;
 }
 
+// Thickness of each cluster's slice: the square root of the middle eigenvalue of its
+// covariance, r / sqrt(2) for a ring of radius r (and for an arc of it) whatever the bin width,
+// which only shows in the largest (thin branch) or smallest (thick stem) eigenvalue.
+std::vector<float> slice_thickness(std::span<const Eigen::Vector3f> points, const Clusters& c) {
+    std::vector<Eigen::Matrix3d> second(c.size(), Eigen::Matrix3d::Zero());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const Eigen::Vector3d d = points[i].cast<double>() - c.centroid(c.of_point[i]);
+        second[c.of_point[i]] += d * d.transpose();
+    }
+    std::vector<float> thickness(c.size());
+    for (std::size_t k = 0; k < c.size(); ++k) {
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(second[k] / static_cast<double>(c.count[k]), Eigen::EigenvaluesOnly);
+        thickness[k] = static_cast<float>(std::sqrt(std::max(0.0, solver.eigenvalues()[1])));
+    }
+    return thickness;
+}
+
+// The geodesic distance counted in bins: with one width everywhere, length / width; with a
+// width per point, the path length from the base where each step counts in the width of the
+// point it reaches (accumulated along the geodesic tree, parents first), so thin branches are cut
+// into finer slices than thick stems. The width changes only from one slice to the next, so
+// every level set stays a cross-section.
+std::vector<float> bin_levels(const NeighbourGraph& graph, const ShortestPaths& sp, float width,
+                              const std::vector<float>& point_width, int smoothing) {
+    if (point_width.empty()) {
+        std::vector<float> level = smoothed_lengths(graph, sp.length, smoothing);
+        for (float& l : level) l /= width;
+        return level;
+    }
+    std::vector<float> warped(sp.length.size(), 0.0f);
+    for (int v : sp.order) {
+        const int u = sp.parent[v];
+        warped[v] = u < 0 ? sp.length[v] / point_width[v] : warped[u] + (sp.length[v] - sp.length[u]) / point_width[v];
+    }
+    return smoothed_lengths(graph, warped, smoothing);
+}
+
+// `point_width` (empty: `width` everywhere) gives each point its own bin width.
 Clusters cluster_bins(std::span<const Eigen::Vector3f> points, const NeighbourGraph& graph, const KnnTable& near,
-                      const ShortestPaths& sp, const ShortestPaths& weighted, float width, float join, int smoothing) {
+                      const ShortestPaths& sp, const ShortestPaths& weighted, float width, const std::vector<float>& point_width,
+                      float join, int smoothing) {
     const int n = static_cast<int>(points.size());
-    const std::vector<float> level = smoothed_lengths(graph, sp.length, smoothing);
+    const std::vector<float> level = bin_levels(graph, sp, width, point_width, smoothing);
     std::vector<int> bin(points.size());
-    for (int i = 0; i < n; ++i) bin[i] = static_cast<int>(std::floor(level[i] / width));
+    for (int i = 0; i < n; ++i) bin[i] = static_cast<int>(std::floor(level[i]));
+    // Same-bin points belong together when they are at most `join` apart (scaled like the bin
+    // width on thin branches), with or without a graph edge: on sparse bark a bin's band is only
+    // two or three samples tall and its kNN edges leave gaps. Graph edges join same-bin points of
+    // thick slices whatever their length (a sparse ring needs them), but not of thin ones: there
+    // the longer edges (up to the gap length) would tie neighbouring twigs into one cluster whose
+    // centroid floats between them.
+    auto joined = [&](int i, int j, float d2) {
+        if (bin[i] != bin[j]) return false;
+        const float limit = point_width.empty() ? join : join * std::min(point_width[i], point_width[j]) / width;
+        return d2 <= limit * limit;
+    };
+    auto thick_point = [&](int i) { return point_width.empty() || point_width[i] >= width; };
     UnionFind sets(points.size());
     for (int i = 0; i < n; ++i)
         for (std::uint32_t e = graph.offsets[i]; e < graph.offsets[i + 1]; ++e) {
             const int j = graph.targets[e];
-            if (j > i && bin[i] == bin[j]) sets.unite(i, j);
+            if (j <= i || bin[i] != bin[j]) continue;
+            if (thick_point(i) || thick_point(j) || joined(i, j, graph.lengths[e] * graph.lengths[e])) sets.unite(i, j);
         }
-    // Same-bin points up to `join` apart belong together even without a graph edge: on sparse
-    // bark a bin's band is only two or three samples tall and its kNN edges leave gaps.
-    const float join2 = join * join;
     for (int i = 0; i < n; ++i) {
         const int* row = near.row(i);
         const float* d2 = near.row_distances(i);
         for (int j = 0; j < near.k; ++j)
-            if (row[j] >= 0 && d2[j] <= join2 && bin[row[j]] == bin[i]) sets.unite(i, row[j]);
+            if (row[j] >= 0 && joined(i, row[j], d2[j])) sets.unite(i, row[j]);
     }
     // Clusters are numbered in the order their first point was settled, so clusters of lower
     // bins mostly have smaller numbers.
@@ -570,8 +622,31 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
                          [&] { sp = shortest_paths(graph, r.base.sources, EdgeCost::Length); });
     lap("base and shortest paths");
     const float root_spread = r.base.circle_fitted ? r.base.foot_radius : 0.0f;
-    const Clusters clusters =
-        merge_fragments(points, cluster_bins(points, graph, near, sp, weighted, r.bin_width, r.bin_width, o.geodesic_smoothing), merge, root_spread);
+    // First slicing at the full width measures how thick the branch is around every point; thin
+    // branches are then sliced again at a finer width (their axis bends within a wide bin, and
+    // nearby twigs share one), thick stems keep the wide bins that hold their rings together.
+    std::vector<float> point_width;
+    if (o.fine_bin_factor < 1.0f) {
+        const float fine = o.fine_bin_factor * r.bin_width;
+        const Clusters coarse = merge_fragments(
+            points, cluster_bins(points, graph, near, sp, weighted, r.bin_width, {}, r.bin_width, o.geodesic_smoothing), merge, root_spread);
+        const std::vector<float> thickness = slice_thickness(points, coarse);
+        point_width.resize(points.size());
+        const float thick = o.thick_slice * r.bin_width;
+        // A slice counts as thin only above two thin slices: a ring cut at two widths falls
+        // apart, so the first slices of a branch leaving a thick stem keep the stem's width, and
+        // so do crumbs at the ragged edge of a one-sided ring.
+        auto thin = [&](int k) { return k >= 0 && thickness[k] < thick; };
+        for (std::size_t i = 0; i < points.size(); ++i) {
+            const int k = coarse.of_point[i], up = coarse.parent[k];
+            point_width[i] = thin(k) && thin(up) && thin(coarse.parent[up]) ? fine : r.bin_width;
+        }
+        log_debug("skeleton: " + std::to_string(std::count(point_width.begin(), point_width.end(), r.bin_width)) + " of " +
+                  std::to_string(points.size()) + " points on thick slices (full bin width)");
+    }
+    const Clusters clusters = merge_fragments(
+        points, cluster_bins(points, graph, near, sp, weighted, r.bin_width, point_width, r.bin_width, o.geodesic_smoothing), merge,
+        root_spread);
     r.clusters = clusters.size();
     lap("bins");
 

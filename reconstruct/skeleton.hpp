@@ -5,7 +5,8 @@
 //      points: one over the weights ||u-v||^beta (the shortest-path tree of the paper) and one
 //      over Euclidean lengths (the geodesic distance, a smooth field: paths of the weighted
 //      tree zigzag, and their lengths would cut one cross-section into several bins);
-//   3. points are cut into geodesic bins of width w and each bin into connected clusters; a
+//   3. points are cut into geodesic bins of width w (a finer width on thin branches, measured
+//      from a first slicing at w) and each bin into connected clusters of nearby points; a
 //      cluster hangs from the lower-bin cluster that most weighted-tree edges enter it from, so
 //      the clusters form one rooted tree shaped by beta; fragments of one cross-section merge;
 //      wide slices are centred on a fitted circle (one-sided scans);
@@ -36,6 +37,9 @@ struct SkeletonOptions {
     double beta = 1.5;              // edge weight exponent (species library; 1.5 without species)
     float max_edge_length = 0.0f;   // metres; longer kNN edges are replaced by bridges (0 = 10 x spacing)
     float bin_width = 0.0f;         // metres; geodesic bin width (0 = 2.5 x the sampling distance)
+    float fine_bin_factor = 0.64f;  // thin branches are binned at this fraction of the bin width (1 = one width everywhere)
+    float thick_slice = 0.55f;      // bin widths; a slice at least this thick (sqrt of its middle covariance
+                                    // eigenvalue) keeps the full bin width, and so do the two slices above it
     float internode_length = 0.0f;  // metres; output internode length (0 = from point spacing)
     float min_twig_length = 0.0f;   // metres; leaf chains shorter than this are pruned (0 = 2 bins)
     float merge_distance = 0.0f;    // metres; sibling clusters of one bin closer than this merge (0 = 1 bin)
