@@ -9,6 +9,8 @@
 #include <cmath>
 #include <deque>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 namespace treelobes::lobes {
 
@@ -44,6 +46,51 @@ struct Seed {
     Eigen::Vector3f direction;
     float thickness;
 };
+
+// Douglas-Peucker on a chain's axis: the vertices that stay within `tolerance` of the chord of
+// their span are dropped, the kept ones keep their thickness. The grown chain bends only by
+// tropism and a little jitter, so most of its #ChainPts segments are nearly collinear and a
+// patch needs a third or less of its prisms (the budget then buys more patches, lobes/synthesis.hpp).
+std::vector<PatchSegment> simplify_axis(const std::vector<PatchSegment>& segments, float tolerance) {
+    if (segments.size() < 2 || !(tolerance > 0)) return segments;
+    std::vector<Eigen::Vector3f> points{segments.front().a};
+    std::vector<float> thickness{segments.front().thickness_a};
+    for (const auto& s : segments) {
+        points.push_back(s.b);
+        thickness.push_back(s.thickness_b);
+    }
+    std::vector<char> keep(points.size(), 0);
+    keep.front() = keep.back() = 1;
+    std::vector<std::pair<std::size_t, std::size_t>> spans{{0, points.size() - 1}};
+    while (!spans.empty()) {
+        const auto [i, j] = spans.back();
+        spans.pop_back();
+        const Eigen::Vector3f chord = points[j] - points[i];
+        float worst = 0;
+        std::size_t at = i;
+        for (std::size_t k = i + 1; k < j; ++k) {
+            const Eigen::Vector3f d = points[k] - points[i];
+            const float along = std::clamp(d.dot(chord) / std::max(chord.squaredNorm(), 1e-12f), 0.0f, 1.0f);
+            const float off = (d - along * chord).norm();
+            if (off > worst) {
+                worst = off;
+                at = k;
+            }
+        }
+        if (worst <= tolerance) continue;
+        keep[at] = 1;
+        spans.push_back({at, j});
+        spans.push_back({i, at});
+    }
+    std::vector<PatchSegment> out;
+    std::size_t last = 0;
+    for (std::size_t k = 1; k < points.size(); ++k)
+        if (keep[k]) {
+            out.push_back({points[last], points[k], thickness[last], thickness[k]});
+            last = k;
+        }
+    return out;
+}
 
 // Seed(t, v): one chain of #ChainPts segments with its leaves and new seeds (docking points).
 Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLibraryOptions& o, Random& rng,
@@ -99,6 +146,8 @@ Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLib
         }
         p = b;
     }
+    patch.step = step;
+    patch.segments = simplify_axis(patch.segments, static_cast<float>(o.simplify_tolerance) * seed.thickness);
     // Random leaf order: a prefix of any length is an unbiased subsample (stochastic pruning).
     for (std::size_t i = patch.leaves.size(); i > 1; --i) std::swap(patch.leaves[i - 1], patch.leaves[rng.next() % i]);
     return patch;
@@ -123,8 +172,8 @@ float Patch::length() const {
 PatchLibrary build_patch_library(const SpeciesProfile& profile, const PatchLibraryOptions& o) {
     if (o.branchlets < 1 || o.branchlets > 1000) throw Error::usage("patch library: branchlets must be 1..1000");
     if (!(o.min_root_thickness > 0 && o.max_root_thickness >= o.min_root_thickness && o.min_twig_thickness > 0 &&
-          o.segment_length > 0))
-        throw Error::usage("patch library: thicknesses and segment length must be positive (min <= max)");
+          o.segment_length > 0 && o.simplify_tolerance >= 0))
+        throw Error::usage("patch library: thicknesses and segment length must be positive (min <= max), the simplify tolerance >= 0");
     PatchLibrary library;
     library.species = profile.entry.name;
     library.leaf_shape = profile.growth.leaves.shape;

@@ -49,6 +49,7 @@ struct Patch {
     std::vector<PatchLeaf> leaves;            // shuffled: any prefix is a uniform subsample (LOD)
     std::vector<DockingPoint> docks;
     int branchlet = 0;                        // the complete branchlet it was cut from
+    float step = 0;                           // segment length it was grown with (before simplifying)
     float length() const;                     // along its segments
 };
 
@@ -58,6 +59,10 @@ struct PatchLibraryOptions {
     double max_root_thickness = 0.08;
     double min_twig_thickness = 0.002; // no seeds (docking points) thinner than this
     double segment_length = 4.0;       // segment length per unit root thickness of its chain
+    // Douglas-Peucker tolerance of a chain's axis, per unit root thickness of the chain: nearly
+    // collinear segments are merged once, so a patch draws fewer twig prisms (0 = off). Leaves and
+    // docking points keep their grown positions, within this distance of the simplified axis.
+    double simplify_tolerance = 1.0;
     std::uint64_t seed = 1;
 };
 

@@ -93,7 +93,16 @@ struct Sample {
 // (needle patches carry hundreds; scoring them all made fitting dominate the texturing time).
 std::vector<Sample> patch_samples(const Patch& patch, std::size_t max_leaves) {
     std::vector<Sample> samples;
-    for (const auto& s : patch.segments) samples.push_back({s.b, s.thickness_b});
+    // Points along each segment at most the grown segment length apart: a simplified axis has
+    // long segments, and their ends alone would miss the cells they pass through.
+    for (const auto& s : patch.segments) {
+        const float length = (s.b - s.a).norm();
+        const int n = patch.step > 0 ? std::max(1, static_cast<int>(std::ceil(length / patch.step - 1e-3f))) : 1;
+        for (int k = 1; k <= n; ++k) {
+            const float f = static_cast<float>(k) / static_cast<float>(n);
+            samples.push_back({s.a + f * (s.b - s.a), s.thickness_a + f * (s.thickness_b - s.thickness_a)});
+        }
+    }
     for (std::size_t i = 0; i < std::min(max_leaves, patch.leaves.size()); ++i) {
         const auto& l = patch.leaves[i];
         samples.push_back({l.base + l.length * l.direction, 0.0f});

@@ -75,7 +75,7 @@ struct TexturingOptions {
     int twig_sides = 3;                    // as the synthesized mesh draws the patches
     double leaf_share = 1;
     double fill_cell = 0.04;            // metres: edge of the fill cells at least ...
-    double max_fill_cells = 20000;      // ... enlarged so that a lobe has at most about this many
+    double max_fill_cells = 60000;      // ... enlarged so that a lobe has at most about this many
                                         // (texture_tree sets it to 2 per budgeted patch)
     double fill_target = 0.95;          // fraction of lobe cells reached by twigs or leaves
     double max_reseeds_per_cell = 2.0;  // extra docking points for empty regions, per lobe cell

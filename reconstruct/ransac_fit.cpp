@@ -1,5 +1,6 @@
 #include "reconstruct/ransac_fit.hpp"
 
+#include <Eigen/QR>
 #include <pcl/console/print.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
@@ -140,6 +141,27 @@ CircleFit fit_circle(std::span<const Eigen::Vector2f> points, float threshold, f
     fit.rms = static_cast<float>(std::sqrt(sum / static_cast<double>(count)));
     fit.coverage = static_cast<float>(std::count(sector.begin(), sector.end(), true)) / 36.0f;
     return fit;
+}
+
+std::optional<Circle2d> fit_circle_least_squares(std::span<const Eigen::Vector2d> points) {
+    if (points.size() < 3) return std::nullopt;
+    const auto n = static_cast<Eigen::Index>(points.size());
+    Eigen::MatrixXd a(n, 3);
+    Eigen::VectorXd b(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Vector2d& p = points[static_cast<std::size_t>(i)];
+        a.row(i) << p.x(), p.y(), 1.0;
+        b(i) = -p.squaredNorm();
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+    if (qr.rank() < 3) return std::nullopt;  // coincident or collinear points: any circle would be a guess
+    const Eigen::Vector3d s = qr.solve(b);
+    Circle2d circle;
+    circle.centre = Eigen::Vector2d(-0.5 * s(0), -0.5 * s(1));
+    const double r2 = circle.centre.squaredNorm() - s(2);
+    if (!(r2 > 0) || !circle.centre.allFinite()) return std::nullopt;
+    circle.radius = std::sqrt(r2);
+    return circle;
 }
 
 }  // namespace treelobes

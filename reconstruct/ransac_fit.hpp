@@ -1,10 +1,12 @@
 // Robust plane and circle fits (PCL sample consensus, kept in ransac_fit.cpp). Used for ground
 // planes, the "not a tree" check (large planar surfaces) and stem circles. Deterministic: PCL's
-// samplers use a fixed seed.
+// samplers use a fixed seed. Also the closed-form least-squares circle that cheap stem
+// estimates use (classification's DBH feature, the scan statistics of synthetic trees).
 #pragma once
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -37,5 +39,15 @@ struct CircleFit {
 // squares on its inliers. ok = false with fewer than 5 points or when no circle fits.
 CircleFit fit_circle(std::span<const Eigen::Vector2f> points, float threshold, float min_radius, float max_radius,
                      int max_iterations = 500);
+
+struct Circle2d {
+    Eigen::Vector2d centre{0, 0};
+    double radius = 0;
+};
+
+// Kasa's algebraic least-squares circle x^2 + y^2 + D x + E y + F = 0 through all points: one
+// linear solve, no outlier rejection, so only for slices known to be mostly stem. nullopt with
+// fewer than 3 points, coincident or collinear points, or when the points admit no real circle.
+std::optional<Circle2d> fit_circle_least_squares(std::span<const Eigen::Vector2d> points);
 
 }  // namespace treelobes

@@ -2,8 +2,9 @@
 
 #include "core/error.hpp"
 #include "core/grid_thinning.hpp"
+#include "reconstruct/ransac_fit.hpp"
 
-#include <Eigen/Dense>
+#include <Eigen/Core>
 
 #include <algorithm>
 #include <cmath>
@@ -30,23 +31,6 @@ double base_of(const PointCloud& cloud, const std::vector<std::size_t>& idx) {
     const std::size_t k = z.size() / 200;
     std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(k), z.end());
     return z[k];
-}
-
-// Kasa's algebraic circle fit: x^2 + y^2 + D x + E y + F = 0 in least squares.
-bool kasa(const std::vector<Eigen::Vector2d>& pts, Eigen::Vector2d& c, double& r) {
-    if (pts.size() < 3) return false;
-    Eigen::MatrixXd a(pts.size(), 3);
-    Eigen::VectorXd b(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-        a.row(static_cast<Eigen::Index>(i)) << pts[i].x(), pts[i].y(), 1.0;
-        b(static_cast<Eigen::Index>(i)) = -pts[i].squaredNorm();
-    }
-    const Eigen::Vector3d s = a.colPivHouseholderQr().solve(b);
-    c = Eigen::Vector2d(-0.5 * s(0), -0.5 * s(1));
-    const double r2 = c.squaredNorm() - s(2);
-    if (!(r2 > 0)) return false;
-    r = std::sqrt(r2);
-    return true;
 }
 
 }  // namespace
@@ -94,14 +78,16 @@ StemFit fit_stem(const PointCloud& cloud, const Eigen::Vector2d& centre, double 
         if (p.z() >= base + z_lo && p.z() < base + z_hi) slice.push_back(p.head<2>());
     }
     StemFit fit;
-    Eigen::Vector2d c;
-    double r = 0;
-    if (!kasa(slice, c, r)) throw Error::usage("cannot fit a stem circle: too few points in the slice");
+    const std::optional<Circle2d> first = fit_circle_least_squares(slice);
+    if (!first) throw Error::usage("cannot fit a stem circle: too few points in the slice");
     // Refit on the points near the first circle: branches and leaves in the slice are not stem.
     std::vector<Eigen::Vector2d> near;
     for (const auto& p : slice)
-        if (std::abs((p - c).norm() - r) < 0.1) near.push_back(p);
-    if (!kasa(near, c, r)) throw Error::usage("cannot fit a stem circle");
+        if (std::abs((p - first->centre).norm() - first->radius) < 0.1) near.push_back(p);
+    const std::optional<Circle2d> refit = fit_circle_least_squares(near);
+    if (!refit) throw Error::usage("cannot fit a stem circle");
+    const Eigen::Vector2d c = refit->centre;
+    const double r = refit->radius;
     double sum2 = 0;
     std::size_t n = 0;
     for (const auto& p : near) {

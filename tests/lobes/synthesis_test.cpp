@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 
 using namespace treelobes;
@@ -82,6 +84,46 @@ TEST(PatchLibrary, BranchletsArePartitionedIntoPatchesWithDockingPoints) {
     EXPECT_EQ(error_code_of([&] { build_patch_library(species("pine"), o); }), ExitCode::Usage);
 }
 
+// Douglas-Peucker on the chain axes: fewer twig segments, every grown node (leaf base, docking
+// point, segment end) within the tolerance of the simplified axis, same root and tip.
+TEST(PatchLibrary, SimplifiedAxesStayWithinTheTolerance) {
+    PatchLibraryOptions grown;
+    grown.simplify_tolerance = 0;
+    PatchLibraryOptions simplified;
+    simplified.simplify_tolerance = 1.0;
+    const PatchLibrary a = build_patch_library(species("ficus_virens"), grown);
+    const PatchLibrary b = build_patch_library(species("ficus_virens"), simplified);
+    ASSERT_EQ(a.patches.size(), b.patches.size());
+    std::size_t before = 0, after = 0;
+    for (std::size_t i = 0; i < a.patches.size(); ++i) {
+        const Patch &p = a.patches[i], &q = b.patches[i];
+        before += p.segments.size();
+        after += q.segments.size();
+        ASSERT_FALSE(q.segments.empty());
+        EXPECT_EQ(q.segments.front().a, p.segments.front().a);
+        EXPECT_EQ(q.segments.back().b, p.segments.back().b);
+        EXPECT_EQ(q.segments.front().thickness_a, p.segments.front().thickness_a);
+        ASSERT_EQ(q.docks.size(), p.docks.size());
+        ASSERT_EQ(q.leaves.size(), p.leaves.size());
+        auto distance_to_axis = [&](const Eigen::Vector3f& x) {
+            float best = std::numeric_limits<float>::max();
+            for (const auto& s : q.segments) {
+                const Eigen::Vector3f d = s.b - s.a;
+                const float t = std::clamp((x - s.a).dot(d) / std::max(d.squaredNorm(), 1e-12f), 0.0f, 1.0f);
+                best = std::min(best, (x - s.a - t * d).norm());
+            }
+            return best;
+        };
+        const float tolerance = 1.0f * p.root_thickness + 1e-5f;
+        for (const auto& s : p.segments) EXPECT_LE(distance_to_axis(s.b), tolerance);
+        for (const auto& d : q.docks) EXPECT_LE(distance_to_axis(d.position), tolerance);
+        for (std::size_t k = 0; k + 1 < q.segments.size(); ++k) EXPECT_EQ(q.segments[k].b, q.segments[k + 1].a);  // connected
+    }
+    EXPECT_LT(after, before / 2);  // a ficus chain of 12 segments bends little
+    simplified.simplify_tolerance = -1;
+    EXPECT_EQ(error_code_of([&] { build_patch_library(species("ficus_virens"), simplified); }), ExitCode::Usage);
+}
+
 TEST(LobeVolume, InsideTestMatchesABox) {
     const LobeVolume v(box({0, 0, 0}, {2, 1, 1}), 20);
     EXPECT_TRUE(v.inside({1, 0.5f, 0.5f}));
@@ -140,12 +182,17 @@ TEST(Texturing, FillPrefersOccupiedCells) {
     // box's 6 m^3 on 0.144 m cells (2,000 cells).
     EXPECT_LT(guided.target_cells, uniform.target_cells / 3);
     EXPECT_GE(guided.filled, o.fill_target);
-    // Share of twig ends in occupied cells, and the median distance from the points to the
-    // nearest twig end.
+    // Share of twig points in occupied cells, and the median distance from the points to the
+    // nearest twig point (points along the twig axes, at most the grown segment length apart).
     auto fit = [&](const LobeTexture& t) {
         std::vector<Eigen::Vector3f> ends;
-        for (const auto& inst : t.instances)
-            for (const auto& s : lib.patches[inst.patch].segments) ends.push_back(inst.apply(s.b));
+        for (const auto& inst : t.instances) {
+            const Patch& patch = lib.patches[inst.patch];
+            for (const auto& s : patch.segments) {
+                const int n = std::max(1, static_cast<int>(std::ceil((s.b - s.a).norm() / patch.step - 1e-3f)));
+                for (int k = 1; k <= n; ++k) ends.push_back(inst.apply(s.a + (static_cast<float>(k) / n) * (s.b - s.a)));
+            }
+        }
         std::size_t in = 0;
         for (const auto& e : ends) in += occupancy.occupied(e) ? 1 : 0;
         std::vector<float> d;
@@ -160,7 +207,9 @@ TEST(Texturing, FillPrefersOccupiedCells) {
     const auto [uniform_share, uniform_median] = fit(uniform);
     const auto [guided_share, guided_median] = fit(guided);
     EXPECT_GT(guided_share, 2 * uniform_share) << uniform_share << " -> " << guided_share;
-    EXPECT_LT(guided_median, 0.5f * uniform_median) << uniform_median << " -> " << guided_median;
+    // The guided lobe stops at the fill target with about half the patches of the uniform one
+    // (220 against 400): its points are still nearly twice as close to a twig.
+    EXPECT_LT(guided_median, 0.6f * uniform_median) << uniform_median << " -> " << guided_median;
     const LobeTexture again = texture_lobe(tree.lobes[0].mesh, seed, lib, o, 0, &occupancy);
     ASSERT_EQ(again.instances.size(), guided.instances.size());
     EXPECT_EQ(again.instances.back().translation, guided.instances.back().translation);
@@ -191,8 +240,12 @@ TEST(Synthesis, LeafyPatchesAreThinnedToTheTriangleBudget) {
     const LobeTree tree = boxed_tree();
     SynthesisOptions o;
     o.max_triangles = 150000;
-    // Lagerstroemia patches carry fewer leaf than twig triangles: no thinning.
-    EXPECT_DOUBLE_EQ(texture_tree(tree, species("lagerstroemia"), o).leaf_share, 1.0);
+    // Lagerstroemia patches with their grown (unsimplified) axes carry fewer leaf than twig
+    // triangles: no thinning. Simplified, their twigs are cheaper than their leaves: thinning.
+    SynthesisOptions grown = o;
+    grown.library.simplify_tolerance = 0;
+    EXPECT_DOUBLE_EQ(texture_tree(tree, species("lagerstroemia"), grown).leaf_share, 1.0);
+    EXPECT_LT(texture_tree(tree, species("lagerstroemia"), o).leaf_share, 1.0);
     // Mahogany's compound leaves outweigh its twigs: leaves are thinned and the budget holds.
     const TexturedTree textured = texture_tree(tree, species("mahogany"), o);
     EXPECT_LT(textured.leaf_share, 1.0);
