@@ -134,12 +134,12 @@ int run_train(const TrainCommand& c, const GlobalOptions& global) {
     const double accuracy = static_cast<double>(correct) / static_cast<double>(table.rows());
     const json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"trees", table.rows()},
                           {"features", table.cols()},    {"classes", set.classes}, {"rounds", report.rounds},
-                          {"rounds_tried", report.rounds_tried}, {"training_accuracy", accuracy}, {"seconds", seconds},
+                          {"rounds_tried", report.rounds_tried}, {"temperature", report.temperature}, {"training_accuracy", accuracy}, {"seconds", seconds},
                           {"out", c.out}};
     print(summary, global,
           "JointBoost: " + std::to_string(table.rows()) + " trees, " + std::to_string(set.classes.size()) + " species, " +
               std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " stumps (early stop after " +
-              std::to_string(report.rounds_tried) + "), training accuracy " + format("%.1f %%", 100 * accuracy) + " -> " + c.out +
+              std::to_string(report.rounds_tried) + format(", temperature %.2f", report.temperature) + "), training accuracy " + format("%.1f %%", 100 * accuracy) + " -> " + c.out +
               format(" (%.2f s)\n", seconds));
     return 0;
 }
@@ -382,10 +382,12 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     t->add_option("--labels", train->labels, "CSV with id and species columns")->required();
     t->add_option("--out,-o", train->out, "Model file")->required();
     t->add_option("--max-rounds", train->options.max_rounds, "Maximum boosting rounds")->check(CLI::Range(1, 100000))->capture_default_str();
-    t->add_option("--validation", train->options.validation_fraction, "Held-out fraction for early stopping (0 = off)")
-        ->check(CLI::Range(0.0, 0.9))->capture_default_str();
+    t->add_option("--folds", train->options.folds, "Cross-validation folds for early stopping and calibration (0 = off)")
+        ->check(CLI::Range(0, 20))->capture_default_str();
     t->add_option("--patience", train->options.patience, "Rounds without improvement before stopping")->check(CLI::NonNegativeNumber)->capture_default_str();
-    t->add_option("--seed", train->options.seed, "Seed of the validation split")->capture_default_str();
+    t->add_option("--seed", train->options.seed, "Seed of the cross-validation folds")->capture_default_str();
+    t->add_flag("--no-calibration{false}", train->options.calibrate,
+                "Keep the probability temperature at 1 instead of fitting it out of fold");
     t->callback([train, &global, &job] { job = [train, &global] { return run_train(*train, global); }; });
 
     auto predict = std::make_shared<PredictCommand>();
@@ -412,6 +414,13 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
         ->check(CLI::Range(1.0, 100.0))->capture_default_str();
     e->add_option("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(CLI::NonNegativeNumber)->capture_default_str();
     e->add_option("--max-rounds", evaluate->jointboost.max_rounds, "JointBoost maximum rounds")->check(CLI::Range(1, 100000))->capture_default_str();
+    e->add_option("--folds", evaluate->jointboost.folds,
+                  "JointBoost: cross-validation folds on the training half for early stopping and calibration (0 = off)")
+        ->check(CLI::Range(0, 20))->capture_default_str();
+    e->add_option("--patience", evaluate->jointboost.patience, "JointBoost: rounds without improvement before stopping")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
+    e->add_flag("--no-calibration{false}", evaluate->jointboost.calibrate,
+                "JointBoost: keep the probability temperature at 1 instead of fitting it out of fold");
     e->add_option("--layout", evaluate->layout,
                   "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
                   "replaces the dataset's positions")

@@ -59,14 +59,15 @@ int argmax(const std::vector<double>& p) { return static_cast<int>(std::max_elem
 // Accumulates the scores of one classifier over experiments.
 class ScoreAccumulator {
 public:
-    explicit ScoreAccumulator(int classes)
+    ScoreAccumulator(int classes, std::size_t rows)
         : classes_(classes), rate_sum_(classes, 0), rate_count_(classes, 0), voted_sum_(classes, 0),
-          confusion_(classes, std::vector<double>(classes, 0)) {}
+          confusion_(classes, std::vector<double>(classes, 0)), row_predictions_(rows, std::vector<int>(classes, 0)) {}
 
-    void add(const std::vector<int>& truth, const std::vector<int>& predicted, const std::vector<bool>& confident,
-             const std::vector<int>* voted, const ClassifierRun& run) {
+    void add(const std::vector<std::size_t>& rows, const std::vector<int>& truth, const std::vector<int>& predicted,
+             const std::vector<bool>& confident, const std::vector<int>* voted, const ClassifierRun& run) {
         std::vector<int> total(classes_, 0), correct(classes_, 0), voted_correct(classes_, 0);
         for (std::size_t i = 0; i < truth.size(); ++i) {
+            ++row_predictions_[rows[i]][predicted[i]];
             ++total[truth[i]];
             const bool ok = predicted[i] == truth[i];
             correct[truth[i]] += ok;
@@ -95,6 +96,7 @@ public:
         Scores s;
         s.experiments = experiments_;
         s.confusion = confusion_;
+        s.row_predictions = row_predictions_;
         s.species_trees.assign(classes_, 0);
         for (int y : labels) ++s.species_trees[y];
         s.species_train = train_counts;
@@ -129,6 +131,7 @@ private:
     std::vector<int> rate_count_;
     std::vector<double> voted_sum_;
     std::vector<std::vector<double>> confusion_;
+    std::vector<std::vector<int>> row_predictions_;
     double tree_correct_ = 0, tree_total_ = 0, confident_correct_ = 0, confident_total_ = 0, unconfident_correct_ = 0;
     double voted_tree_correct_ = 0, train_seconds_ = 0, predict_seconds_ = 0, rounds_ = 0;
     int experiments_ = 0;
@@ -168,11 +171,11 @@ void score_experiment(const LabelledSet& set, const std::vector<std::size_t>& te
         if (!set.positions.empty()) positions.push_back(set.positions[test[i]]);
     }
     if (set.positions.empty()) {
-        acc.add(truth, predicted, confident, nullptr, run);
+        acc.add(test, truth, predicted, confident, nullptr, run);
         return;
     }
     const VotingResult vote = spatial_vote(run.probabilities, positions, options.voting);
-    acc.add(truth, predicted, confident, &vote.species, run);
+    acc.add(test, truth, predicted, confident, &vote.species, run);
 }
 
 }  // namespace
@@ -192,7 +195,10 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
 
     EvaluationReport report;
     report.classes = set.classes;
-    std::vector<ScoreAccumulator> random_acc(classifiers.size(), ScoreAccumulator(classes));
+    report.tree_ids = set.features.ids;
+    report.tree_labels = set.labels;
+    report.tree_groups = set.groups;
+    std::vector<ScoreAccumulator> random_acc(classifiers.size(), ScoreAccumulator(classes, set.labels.size()));
     std::vector<int> train_counts(classes, 0);
     Progress progress("classify evaluate: random splits", static_cast<std::size_t>(options.splits));
     for (int s = 0; s < options.splits; ++s) {
@@ -212,7 +218,7 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
         std::set<std::string> distinct(set.groups.begin(), set.groups.end());
         groups.assign(distinct.begin(), distinct.end());
     }
-    std::vector<ScoreAccumulator> site_acc(classifiers.size(), ScoreAccumulator(classes));
+    std::vector<ScoreAccumulator> site_acc(classifiers.size(), ScoreAccumulator(classes, set.labels.size()));
     if (groups.size() >= 2) {
         report.site_groups = groups;
         Progress site_progress("classify evaluate: site split", groups.size());

@@ -80,6 +80,8 @@ struct Scores {
     double train_seconds = 0, predict_seconds = 0;  // totals over the splits
     double mean_rounds = 0;
     int experiments = 0;                       // splits (or groups) evaluated
+    // Per row of the set: [row][predicted class] = how often it was predicted so when tested.
+    std::vector<std::vector<int>> row_predictions;
 };
 
 struct ClassifierReport {
@@ -90,6 +92,9 @@ struct ClassifierReport {
 
 struct EvaluationReport {
     std::vector<std::string> classes;
+    std::vector<std::string> tree_ids;     // per row of the set
+    std::vector<int> tree_labels;          // per row
+    std::vector<std::string> tree_groups;  // per row, or empty
     std::vector<ClassifierReport> classifiers;
     std::vector<std::string> site_groups;
     double seconds = 0;
@@ -98,8 +103,10 @@ struct EvaluationReport {
 // Throws Error::input when a species has fewer than 2 trees (it cannot be both trained and tested).
 EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassifier>& classifiers, const EvaluationOptions& options);
 
-// Writes report/: summary.json, per_species.csv, confusion_<name>.csv and .png (row-normalised
-// percentages as seed 001 Fig. 7), site_confusion_<name>.csv when a site split ran, report.md.
+// Writes report/: summary.json (with the random-split accuracy per group, e.g. per scanner, when
+// the set has groups), per_species.csv, confusion_<name>.csv and .png (row-normalised percentages
+// as seed 001 Fig. 7), per_tree_<name>.csv (how often each tree was tested, right, and its most
+// frequent wrong species), site_confusion_<name>.csv when a site split ran, report.md.
 void write_report(const EvaluationReport& report, const EvaluationOptions& options, const std::string& directory,
                   const std::string& extra_json = "{}");
 

@@ -77,6 +77,8 @@ void compute_hull(const TreeFrame& frame, FeatureSink& out);
 void describe_skeleton(Catalogue& c);
 void compute_skeleton(const TreeFrame& frame, FeatureSink& out);
 void skip_skeleton(FeatureSink& out);  // zeros for every skeleton feature
+void describe_envelope(Catalogue& c);
+void compute_envelope(const TreeFrame& frame, FeatureSink& out);
 
 // Small statistics shared by the groups.
 float quantile(std::vector<float> values, double q);  // 0 for an empty vector

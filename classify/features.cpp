@@ -80,6 +80,7 @@ std::vector<FeatureInfo> build_catalogue() {
         {"radial", detail::describe_radial},       {"horizontal", detail::describe_horizontal},
         {"structure", detail::describe_structure}, {"normals", detail::describe_normals},
         {"hull", detail::describe_hull},           {"skeleton", detail::describe_skeleton},
+        {"envelope", detail::describe_envelope},
     };
     for (const auto& [group, describe] : groups) {
         detail::Catalogue catalogue(list, group);
@@ -265,6 +266,9 @@ std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptio
     if (options.skeleton) detail::compute_skeleton(frame, out);
     else detail::skip_skeleton(out);
     t.skeleton = seconds_since(start);
+    start = Clock::now();
+    detail::compute_envelope(frame, out);
+    t.points += seconds_since(start);
     if (values.size() != feature_catalogue().size())
         throw Error(ExitCode::Internal, "feature extraction produced " + std::to_string(values.size()) + " of " +
                                             std::to_string(feature_catalogue().size()) + " features");

@@ -30,7 +30,7 @@ struct FeatureOptions {
 
 struct FeatureInfo {
     std::string name;
-    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton
+    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton, envelope
     std::string unit;         // "m", "deg", "1" (dimensionless), "count", "1/m"
     std::string description;  // how it is computed
 };

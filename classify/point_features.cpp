@@ -2,6 +2,7 @@
 // vertical distribution, radial crown profile, horizontal shape, structure (occupancy,
 // inhomogeneity, box counting). See docs/features.md for the list.
 #include "classify/feature_groups.hpp"
+#include "reconstruct/ransac_fit.hpp"
 #include "reconstruct/union_find.hpp"
 
 #include <Eigen/Dense>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <optional>
 #include <unordered_map>
 
 namespace treelobes::classify::detail {
@@ -76,16 +78,10 @@ float trunk_diameter(const TreeFrame& f) {
     for (const auto& p : f.raw)
         if (p.z() >= lo && p.z() < hi && p.head<2>().norm() < reach) pts.push_back(p.head<2>());
     if (pts.size() < 8) return 0.0f;
-    Eigen::MatrixXd a(pts.size(), 3);
-    Eigen::VectorXd b(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-        a.row(i) << pts[i].x(), pts[i].y(), 1.0;
-        b(i) = -(double(pts[i].x()) * pts[i].x() + double(pts[i].y()) * pts[i].y());
-    }
-    const Eigen::Vector3d s = a.colPivHouseholderQr().solve(b);
-    const Eigen::Vector2d centre(-s(0) / 2, -s(1) / 2);
-    const double r2 = centre.squaredNorm() - s(2);
-    if (r2 > 0 && std::sqrt(r2) < reach && centre.norm() < reach) return static_cast<float>(2 * std::sqrt(r2));
+    std::vector<Eigen::Vector2d> slice(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) slice[i] = pts[i].cast<double>();
+    const std::optional<Circle2d> circle = fit_circle_least_squares(slice);
+    if (circle && circle->radius < reach && circle->centre.norm() < reach) return static_cast<float>(2 * circle->radius);
     Eigen::Vector2f mean = Eigen::Vector2f::Zero();
     for (const auto& p : pts) mean += p;
     mean /= static_cast<float>(pts.size());

@@ -157,6 +157,45 @@ std::string safe_name(std::string name) {
 
 }  // namespace
 
+namespace {
+
+// Random-split accuracy of the test predictions of each group's trees (e.g. per scanner).
+json group_accuracy(const EvaluationReport& report, const Scores& scores) {
+    std::map<std::string, std::pair<double, double>> counts;  // group -> (correct, tested)
+    for (std::size_t r = 0; r < report.tree_groups.size() && r < scores.row_predictions.size(); ++r) {
+        auto& [correct, tested] = counts[report.tree_groups[r]];
+        for (std::size_t c = 0; c < scores.row_predictions[r].size(); ++c) {
+            tested += scores.row_predictions[r][c];
+            if (static_cast<int>(c) == report.tree_labels[r]) correct += scores.row_predictions[r][c];
+        }
+    }
+    json out = json::object();
+    for (const auto& [group, n] : counts) out[group] = n.second > 0 ? n.first / n.second : 0.0;
+    return out;
+}
+
+// One line per tree: how often it was tested and predicted right, and its most frequent error.
+void write_per_tree_csv(const EvaluationReport& report, const Scores& scores, const std::filesystem::path& path) {
+    std::ostringstream csv;
+    csv << "id,species,group,tested,correct,rate,most_frequent_error\n";
+    for (std::size_t r = 0; r < report.tree_ids.size() && r < scores.row_predictions.size(); ++r) {
+        const auto& counts = scores.row_predictions[r];
+        const int truth = report.tree_labels[r];
+        int tested = 0, wrong_best = -1;
+        for (std::size_t c = 0; c < counts.size(); ++c) {
+            tested += counts[c];
+            if (static_cast<int>(c) != truth && counts[c] > 0 && (wrong_best < 0 || counts[c] > counts[wrong_best]))
+                wrong_best = static_cast<int>(c);
+        }
+        csv << report.tree_ids[r] << ',' << report.classes[truth] << ',' << (report.tree_groups.empty() ? "" : report.tree_groups[r])
+            << ',' << tested << ',' << counts[truth] << ',' << (tested > 0 ? percent(counts[truth] / static_cast<double>(tested)) : "")
+            << ',' << (wrong_best < 0 ? "" : report.classes[wrong_best]) << '\n';
+    }
+    write_file_atomically(path, csv.str());
+}
+
+}  // namespace
+
 void write_report(const EvaluationReport& report, const EvaluationOptions& options, const std::string& directory,
                   const std::string& extra_json) {
     const std::filesystem::path dir(directory);
@@ -174,6 +213,7 @@ void write_report(const EvaluationReport& report, const EvaluationOptions& optio
     summary["seconds"] = report.seconds;
     for (const auto& c : report.classifiers) {
         json entry = {{"random_splits", scores_json(c.random_splits, report.classes)}};
+        if (!report.tree_groups.empty()) entry["random_splits"]["group_accuracy"] = group_accuracy(report, c.random_splits);
         if (c.site_split.experiments > 0) entry["site_split"] = scores_json(c.site_split, report.classes);
         summary["classifiers"][c.name] = entry;
         const std::string stem = safe_name(c.name);
@@ -183,6 +223,7 @@ void write_report(const EvaluationReport& report, const EvaluationOptions& optio
                       dir / ("confusion_" + stem + ".png"));
         if (c.site_split.experiments > 0)
             write_confusion_csv(c.site_split.confusion, report.classes, dir / ("site_confusion_" + stem + ".csv"));
+        write_per_tree_csv(report, c.random_splits, dir / ("per_tree_" + stem + ".csv"));
     }
     write_file_atomically(dir / "summary.json", summary.dump(2) + "\n");
 

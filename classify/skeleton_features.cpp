@@ -185,7 +185,7 @@ void describe_skeleton(Catalogue& c) {
 
 void skip_skeleton(FeatureSink& out) {
     const auto& catalogue = feature_catalogue();
-    for (std::size_t i = out.size(); i < catalogue.size(); ++i) out.add(catalogue[i].name, 0.0);
+    for (std::size_t i = out.size(); i < catalogue.size() && catalogue[i].group == "skeleton"; ++i) out.add(catalogue[i].name, 0.0);
 }
 
 void compute_skeleton(const TreeFrame& f, FeatureSink& out) {

@@ -15,4 +15,9 @@ namespace treelobes::classify {
 void stratified_split(const std::vector<int>& labels, int classes, double fraction, std::uint64_t seed, bool single_to_first,
                       std::vector<std::size_t>& first, std::vector<std::size_t>& second);
 
+// Stratified K-fold assignment: per class, the trees in a seeded random order are dealt to folds
+// 0, 1, ..., folds-1, 0, 1, ... (so fold sizes per class differ by at most one). Returns the fold
+// of each row; deterministic for (labels, folds, seed).
+std::vector<int> stratified_folds(const std::vector<int>& labels, int classes, int folds, std::uint64_t seed);
+
 }  // namespace treelobes::classify

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdlib>
 #include <sstream>
 
 using namespace treelobes;
@@ -15,7 +16,11 @@ using treelobes::test::TempDir;
 
 namespace {
 
-std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+// XGBoost's OpenMP threads (inside the CLI runs below) spin while waiting by default, which on a
+// shared, busy machine costs ten times the work; the children inherit passive waiting.
+const int kPassiveOpenMp = setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
+
+using test::quoted;
 
 std::vector<std::string> lines_of(const std::string& text) {
     std::vector<std::string> lines;
@@ -34,7 +39,7 @@ protected:
         ASSERT_EQ(r.exit_code, 0) << r.err;
         std::string files;
         for (const auto& line : lines_of(read_file(dataset() / "labels.csv")))
-            if (line.rfind("file,", 0) != 0) files += " " + quoted(dataset() / line.substr(0, line.find(',')));
+            if (line.rfind("file,", 0) != 0) (files += ' ') += quoted(dataset() / line.substr(0, line.find(',')));
         features_run_ = new test::CommandResult(
             run_cli("classify features" + files + " --relative-to " + quoted(dataset()) + " --out " + quoted(features()) + " --json"));
     }
@@ -69,7 +74,7 @@ TEST_F(ClassifyCli, FeaturesWritesOneRowPerTreeWithLabelIds) {
     TempDir other;
     std::string files;
     for (const auto& line : lines_of(read_file(labels())))
-        if (line.rfind("file,", 0) != 0) files += " " + quoted(dataset() / line.substr(0, line.find(',')));
+        if (line.rfind("file,", 0) != 0) (files += ' ') += quoted(dataset() / line.substr(0, line.find(',')));
     const auto again = run_cli("--threads 1 classify features" + files + " --relative-to " + quoted(dataset()) + " --out " +
                                quoted(other / "f.csv"));
     ASSERT_EQ(again.exit_code, 0) << again.err;
@@ -80,7 +85,7 @@ TEST_F(ClassifyCli, TrainPredictAndVote) {
     ASSERT_EQ(features_run_->exit_code, 0);
     TempDir dir;
     const auto train = run_cli("classify train " + quoted(features()) + " --labels " + quoted(labels()) + " --out " +
-                               quoted(dir / "model.jb") + " --validation 0 --max-rounds 60 --json");
+                               quoted(dir / "model.jb") + " --folds 0 --max-rounds 60 --json");
     ASSERT_EQ(train.exit_code, 0) << train.err;
     const auto summary = nlohmann::json::parse(train.out);
     EXPECT_EQ(summary["rounds"], 60);
@@ -134,7 +139,29 @@ TEST_F(ClassifyCli, EvaluateWritesTheReport) {
     for (const char* name : {"summary.json", "per_species.csv", "report.md", "confusion_JointBoost.csv", "confusion_JointBoost.png",
                              "confusion_XGBoost.png"})
         EXPECT_TRUE(std::filesystem::exists(dir / "report" / name)) << name;
-    EXPECT_EQ(lines_of(read_file(dir / "report" / "per_species.csv")).size(), 4u);
+    const auto species = lines_of(read_file(dir / "report" / "per_species.csv"));
+    EXPECT_EQ(species.size(), 4u);
+    // Per tree: every test prediction of the 5 splits is counted once, and never more right than tested.
+    int test_trees = 0;
+    for (std::size_t k = 1; k < species.size(); ++k) {
+        std::stringstream row(species[k]);
+        std::string name, trees, train;
+        std::getline(row, name, ','), std::getline(row, trees, ','), std::getline(row, train, ',');
+        test_trees += std::stoi(trees) - std::stoi(train);
+    }
+    const auto per_tree = lines_of(read_file(dir / "report" / "per_tree_JointBoost.csv"));
+    ASSERT_GE(per_tree.size(), 2u);
+    EXPECT_EQ(per_tree.front(), "id,species,group,tested,correct,rate,most_frequent_error");
+    int tested_total = 0;
+    for (std::size_t k = 1; k < per_tree.size(); ++k) {
+        std::stringstream row(per_tree[k]);
+        std::string id, name, group, tested, correct;
+        std::getline(row, id, ','), std::getline(row, name, ','), std::getline(row, group, ',');
+        std::getline(row, tested, ','), std::getline(row, correct, ',');
+        EXPECT_LE(std::stoi(correct), std::stoi(tested)) << per_tree[k];
+        tested_total += std::stoi(tested);
+    }
+    EXPECT_EQ(tested_total, 5 * test_trees);
 }
 
 TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
@@ -152,7 +179,7 @@ TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
     test::write_text(dir / "small.csv", "id,height\na,1\nb,2\n");
     test::write_text(dir / "small_labels.csv", "id,species\na,x\nb,y\n");
     ASSERT_EQ(run_cli("classify train " + quoted(dir / "small.csv") + " --labels " + quoted(dir / "small_labels.csv") + " --out " +
-                      quoted(dir / "small.jb") + " --validation 0 --max-rounds 2").exit_code, 0);
+                      quoted(dir / "small.jb") + " --folds 0 --max-rounds 2").exit_code, 0);
     test::write_text(dir / "other.csv", "id,width\na,1\n");
     r = run_cli("classify predict " + quoted(dir / "small.jb") + " " + quoted(dir / "other.csv"));
     EXPECT_EQ(r.exit_code, 2);

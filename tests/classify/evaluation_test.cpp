@@ -35,7 +35,7 @@ LabelledSet clustered_set(int classes, int per_class, double sigma, bool grouped
     for (int i = 0; i < per_class; ++i)
         for (int c = 0; c < classes; ++c) {
             const double row[2] = {3.0 * c + rng.normal(0, sigma), rng.normal()};
-            set.features.add_row("t" + std::to_string(set.features.rows()), row);
+            set.features.add_row(test::numbered("t", static_cast<std::size_t>(set.features.rows())), row);
             set.labels.push_back(c);
             const double x = grouped ? 300.0 * c + 8.0 * i : rng.uniform(0, 300.0 * classes);
             set.positions.emplace_back(x, grouped ? 0.0 : rng.uniform(0, 100));
@@ -76,6 +76,23 @@ NamedClassifier always_first() {
 }
 
 }  // namespace
+
+TEST(ClassifySplits, StratifiedFoldsAreBalancedAndSeeded) {
+    std::vector<int> labels;
+    for (int i = 0; i < 41; ++i) labels.push_back(i % 3);  // 14, 14, 13 trees
+    const auto folds = stratified_folds(labels, 3, 3, 5);
+    ASSERT_EQ(folds.size(), labels.size());
+    std::vector<std::vector<int>> count(3, std::vector<int>(3, 0));  // [class][fold]
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        ASSERT_GE(folds[i], 0);
+        ASSERT_LT(folds[i], 3);
+        ++count[labels[i]][folds[i]];
+    }
+    for (const auto& per_fold : count)
+        EXPECT_LE(*std::max_element(per_fold.begin(), per_fold.end()) - *std::min_element(per_fold.begin(), per_fold.end()), 1);
+    EXPECT_EQ(stratified_folds(labels, 3, 3, 5), folds);
+    EXPECT_NE(stratified_folds(labels, 3, 3, 6), folds);
+}
 
 TEST(ClassifySplits, StratifiedHalvesAreDisjointCompleteAndSeeded) {
     std::vector<int> labels;
@@ -130,7 +147,7 @@ TEST(ClassifyEvaluation, AverageRateIsTheMeanOfSpeciesRatesNotTreeAccuracy) {
     set.classes = {"a", "b"};
     for (int i = 0; i < 24; ++i) {
         const double v = i;
-        set.features.add_row("t" + std::to_string(i), {&v, 1});
+        set.features.add_row(test::numbered("t", static_cast<std::size_t>(i)), {&v, 1});
         set.labels.push_back(i < 20 ? 0 : 1);
     }
     EvaluationOptions options;

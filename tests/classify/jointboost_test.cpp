@@ -28,7 +28,7 @@ std::vector<std::string> class_names(int n) {
 
 FeatureTable empty_table(int features) {
     FeatureTable t;
-    for (int f = 0; f < features; ++f) t.feature_names.push_back("f" + std::to_string(f));
+    for (int f = 0; f < features; ++f) t.feature_names.push_back(test::numbered("f", static_cast<std::size_t>(f)));
     return t;
 }
 
@@ -42,7 +42,7 @@ void gaussian_clusters(int classes, int dims, int per_class, std::uint64_t seed,
         for (int c = 0; c < classes; ++c) {
             for (int d = 0; d <= dims; ++d) row[d] = rng.normal();
             row[c % dims] += (c / dims) % 2 == 0 ? 5.0 : -5.0;
-            table.add_row("t" + std::to_string(table.rows()), row);
+            table.add_row(test::numbered("t", static_cast<std::size_t>(table.rows())), row);
             y.push_back(c);
         }
 }
@@ -155,7 +155,7 @@ TEST(JointBoost, FirstRoundsMatchNaiveReference) {
         const int c = i % 4;
         const double row[3] = {std::floor(rng.uniform(0, 6)) + (c == 1 ? 2 : 0), rng.normal() + 0.8 * c,
                                rng.normal() - (c >= 2 ? 1.5 : 0.0)};
-        t.add_row("t" + std::to_string(i), row);
+        t.add_row(test::numbered("t", static_cast<std::size_t>(i)), row);
         y.push_back(c);
     }
     const int rounds = 4;
@@ -192,7 +192,7 @@ TEST(JointBoost, ClassesWithACommonFeatureShareTheFirstStump) {
             double row[4] = {rng.normal(0, 0.3), rng.normal(0, 0.3), rng.normal(0, 0.3), rng.normal(0, 0.3)};
             if (c <= 1) row[0] += 5;
             if (c >= 1 && c <= 3) row[c] += 0.6;  // weak single-class cues (2 sigma)
-            t.add_row("t" + std::to_string(t.rows()), row);
+            t.add_row(test::numbered("t", static_cast<std::size_t>(t.rows())), row);
             y.push_back(c);
         }
     const auto model = fit_jointboost_rounds(t, y, class_names(5), 30);
@@ -226,7 +226,7 @@ TEST(JointBoost, EarlyStoppingOnNoise) {
     for (int i = 0; i < 120; ++i) {
         double row[5];
         for (double& v : row) v = rng.normal();
-        t.add_row("t" + std::to_string(i), row);
+        t.add_row(test::numbered("t", static_cast<std::size_t>(i)), row);
         y.push_back(static_cast<int>(rng.below(3)));
     }
     JointBoostOptions options;
@@ -254,6 +254,25 @@ TEST(JointBoost, ProbabilitiesAreTheNormalisedLogisticOf2H) {
     EXPECT_GT(p[0], p[1]);
 }
 
+TEST(JointBoost, TemperatureSoftensOverconfidentScoresAndSharpensTimidOnes) {
+    // Three classes; the scores always favour class 0 by a margin, the labels agree with them on
+    // 7 of 10 trees (overconfident at a margin of 3) or on all trees (timid at a margin of 0.1).
+    std::vector<std::vector<double>> bold, timid;
+    std::vector<int> noisy, exact;
+    for (int i = 0; i < 10; ++i) {
+        bold.push_back({3.0, -3.0, -3.0});
+        noisy.push_back(i < 7 ? 0 : 1 + i % 2);
+        timid.push_back({0.1, -0.1, -0.1});
+        exact.push_back(0);
+    }
+    const double soft = fit_temperature(bold, noisy), sharp = fit_temperature(timid, exact);
+    EXPECT_GT(soft, 2.0);
+    EXPECT_LT(sharp, 0.5);
+    // The fitted temperature gives the held-out trees about their observed accuracy.
+    EXPECT_NEAR(probabilities_from_scores(bold.front(), soft)[0], 0.7, 0.05);
+    EXPECT_EQ(probabilities_from_scores({0.5, -0.2}, 1.0), probabilities_from_scores({0.5, -0.2}));
+}
+
 TEST(JointBoost, ModelFileRoundTripsAndRejectsBadFiles) {
     FeatureTable t;
     std::vector<int> y;
@@ -265,16 +284,23 @@ TEST(JointBoost, ModelFileRoundTripsAndRejectsBadFiles) {
     EXPECT_EQ(loaded.feature_names, t.feature_names);
     ASSERT_EQ(loaded.stumps.size(), model.stumps.size());
     for (std::size_t r = 0; r < t.rows(); ++r) EXPECT_EQ(loaded.scores(t.row(r)), model.scores(t.row(r)));
+    EXPECT_EQ(loaded.temperature, model.temperature);
+    for (std::size_t r = 0; r < t.rows(); ++r) EXPECT_EQ(loaded.probabilities(t.row(r)), model.probabilities(t.row(r)));
 
     std::string text = read_file(dir / "m.jb");
-    test::write_text(dir / "v2.jb", std::string(text).replace(text.find("\"version\": 1"), 12, "\"version\": 2"));
+    test::write_text(dir / "v3.jb", std::string(text).replace(text.find("\"version\": 2"), 12, "\"version\": 3"));
     try {
-        load_jointboost(dir / "v2.jb");
-        FAIL() << "version 2 accepted";
+        load_jointboost(dir / "v3.jb");
+        FAIL() << "version 3 accepted";
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), ExitCode::InvalidInput);
-        EXPECT_NE(std::string(e.what()).find("version 2"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("version 3"), std::string::npos);
     }
+    // Version 1 files (before the temperature) still load, with T = 1.
+    std::string v1 = std::string(text).replace(text.find("\"version\": 2"), 12, "\"version\": 1");
+    v1.replace(v1.find("\"temperature\": "), 15, "\"old_temperature\": ");
+    test::write_text(dir / "v1.jb", v1);
+    EXPECT_EQ(load_jointboost(dir / "v1.jb").temperature, 1.0);
     test::write_text(dir / "junk.jb", "{\"format\": \"treelobes-jointboost\", \"version\": 1, \"classes\": [\"a\"");
     EXPECT_THROW(load_jointboost(dir / "junk.jb"), Error);
     test::write_text(dir / "bad_index.jb", std::string(text).replace(text.find("\"feature\": "), 12, "\"feature\": 9"));

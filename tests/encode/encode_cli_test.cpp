@@ -14,12 +14,7 @@ using treelobes::test::TempDir;
 
 namespace {
 
-std::string quoted(const std::filesystem::path& path) {
-    std::string out(1, '\'');
-    out += path.string();
-    out += '\'';
-    return out;
-}
+using treelobes::test::quoted;
 
 std::vector<std::string> lines(const std::string& text) {
     std::vector<std::string> out;

@@ -16,7 +16,7 @@ using treelobes::test::TempDir;
 
 namespace {
 
-std::string quoted(const std::filesystem::path& path) { return "'" + path.string() + "'"; }
+using treelobes::test::quoted;
 
 treelobes::TreeGraph cli_tree(std::uint32_t seed) {
     treelobes::test::RandomTreeProfile profile;
@@ -54,7 +54,7 @@ TEST(FileCli, EncodeDecodeDbf6WithLodsAndStats) {
         EXPECT_GT(json["lods"][0]["internodes"].get<int>(), json["lods"][2]["internodes"].get<int>());
 
         for (int lod : {0, 2}) {
-            const auto out = dir / ("d" + std::to_string(lod) + ".ply");
+            const auto out = dir / (treelobes::test::numbered("d", static_cast<std::size_t>(lod)) + ".ply");
             const auto decoded = run_cli("--json decode " + quoted(dir / ("t_" + coder + ".dbf6")) + " --lod " +
                                          std::to_string(lod) + " --out " + quoted(out));
             ASSERT_EQ(decoded.exit_code, 0) << decoded.err;

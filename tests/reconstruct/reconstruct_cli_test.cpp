@@ -25,7 +25,7 @@ std::string slurp(const std::filesystem::path& p) {
     return s.str();
 }
 
-std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+using test::quoted;
 
 void write_y_tree(const std::filesystem::path& path) {
     write_point_cloud(test::cloud_from(test::y_tree(), 2500), path);

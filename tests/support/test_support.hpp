@@ -52,6 +52,21 @@ ExitCode error_code_of(Action&& action) {
     return ExitCode::Ok;
 }
 
+// prefix + decimal i, e.g. numbered("t", 3) == "t3". Built by appending: GCC 12 warns falsely
+// (-Wrestrict) on "t" + std::to_string(i) once it is inlined.
+inline std::string numbered(std::string prefix, std::size_t i) {
+    prefix += std::to_string(i);
+    return prefix;
+}
+
+// A path in single quotes for run_cli's shell command line (paths of the tests have no quotes).
+inline std::string quoted(const std::filesystem::path& path) {
+    std::string text(1, '\'');
+    text += path.string();
+    text += '\'';
+    return text;
+}
+
 // Writes text to a file (test fixtures).
 void write_text(const std::filesystem::path& path, const std::string& text);
 

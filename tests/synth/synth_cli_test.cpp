@@ -15,7 +15,7 @@ using treelobes::test::TempDir;
 
 namespace {
 
-std::string quoted(const std::filesystem::path& p) { return "'" + p.string() + "'"; }
+using test::quoted;
 
 const char* kFastTree = " --angular-step 0.4 --max-leaves 5000 --height 6";
 
