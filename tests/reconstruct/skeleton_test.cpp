@@ -72,6 +72,27 @@ TEST(Skeleton, YShapeHasOneForkMainBranchFirstAndAssignedPoints) {
     }
 }
 
+TEST(Skeleton, NarrowForkOfThinTwigsKeepsBothTwigsOnTheirAxes) {
+    // Two sparsely scanned thin twigs (r 1 cm) leaving the top of a stem in a narrow V (12 cm
+    // apart at their tips). Binned at the stem's width, the twigs' slices were joined into one
+    // cluster centred in the empty space between them: one tip, nodes 5 cm off both axes. Thin
+    // slices are now cut finer and joined only across short edges, so each twig keeps its chain.
+    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 2}, 0.08f},
+                                     {{0, 0, 2}, {0.06f, 0, 3.2f}, 0.01f},
+                                     {{0, 0, 2}, {-0.06f, 0, 3.2f}, 0.01f}};
+    const PointCloud cloud = test::cloud_from(truth, 2000);
+    const TreeGraph tree = reconstruct_skeleton(cloud.positions, {}).tree;
+    tree.validate("narrow fork");
+    EXPECT_EQ(tree.tip_count(), 2u);
+    EXPECT_LT(max_axis_error(tree, truth), 0.03f);
+
+    // The same cloud binned at one width everywhere shows the merge this test is about.
+    SkeletonOptions one_width;
+    one_width.fine_bin_factor = 1.0f;
+    const TreeGraph merged = reconstruct_skeleton(cloud.positions, one_width).tree;
+    EXPECT_TRUE(merged.tip_count() < 2 || max_axis_error(merged, truth) > 0.03f);
+}
+
 TEST(Skeleton, OneSidedThickStemStaysOnItsAxis) {
     // Only the +x half of a 0.3 m stem is scanned: centroids would sit 0.19 m off the axis.
     const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 4}, 0.3f}};
