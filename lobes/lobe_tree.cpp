@@ -3,17 +3,16 @@
 #include "core/error.hpp"
 #include "core/grid_thinning.hpp"
 #include "lobes/lobe_split.hpp"
+#include "reconstruct/kd_tree.hpp"
 #include "reconstruct/skeleton.hpp"
 
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <map>
 
 namespace treelobes::lobes {
 
@@ -72,44 +71,31 @@ std::size_t lobe_face_budget(double area, double total_area, const LobeOptions& 
 }
 
 // Points the reconstruction dropped as outliers (isolated leaves at the crown's rim, where a
-// scan is sparse) still belong to the tree: each one within `reach` of a lobe's cluster point,
-// not classified ground and not below that cluster's lowest point, is added to the nearest
-// lobe's points for its occupancy, so that texturing covers it. Nearest by a hash grid of `reach` cells.
+// scan is sparse) still belong to the tree: each one closer than `reach` to a lobe's cluster
+// point, not classified ground and not below that cluster's lowest point, is added to the
+// nearest lobe's points for its occupancy, so that texturing covers it.
 std::size_t attach_dropped_points(const PointCloud& cloud, const std::vector<int>& point_internode, std::vector<Lobe>& lobes, float reach) {
     if (!(reach > 0) || lobes.empty()) return 0;
-    using Key = std::array<std::int64_t, 3>;
-    auto key = [&](const Eigen::Vector3f& p) {
-        return Key{static_cast<std::int64_t>(std::floor(p.x() / reach)), static_cast<std::int64_t>(std::floor(p.y() / reach)),
-                   static_cast<std::int64_t>(std::floor(p.z() / reach))};
-    };
-    std::map<Key, std::vector<std::pair<Eigen::Vector3f, std::size_t>>> grid;
+    std::vector<Eigen::Vector3f> cluster_points;
+    std::vector<std::size_t> owner;  // lobe of each indexed point
     std::vector<float> lowest(lobes.size(), std::numeric_limits<float>::max());
     for (std::size_t l = 0; l < lobes.size(); ++l)
         for (const auto& p : lobes[l].cluster_points) {
-            grid[key(p)].emplace_back(p, l);
+            cluster_points.push_back(p);
+            owner.push_back(l);
             lowest[l] = std::min(lowest[l], p.z());
         }
+    if (cluster_points.empty()) return 0;
+    const KdTree index(cluster_points);
     std::vector<std::vector<Eigen::Vector3f>> added(lobes.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         if (point_internode[i] >= 0 || (!cloud.classification.empty() && cloud.classification[i] == 2)) continue;
         const Eigen::Vector3f& p = cloud.positions[i];
-        const Key k = key(p);
-        float best = reach * reach;
-        std::size_t nearest = lobes.size();
-        for (std::int64_t dx = -1; dx <= 1; ++dx)
-            for (std::int64_t dy = -1; dy <= 1; ++dy)
-                for (std::int64_t dz = -1; dz <= 1; ++dz) {
-                    const auto it = grid.find({k[0] + dx, k[1] + dy, k[2] + dz});
-                    if (it == grid.end()) continue;
-                    for (const auto& [q, l] : it->second) {
-                        const float d = (q - p).squaredNorm();
-                        if (d < best || (d == best && l < nearest)) {
-                            best = d;
-                            nearest = l;
-                        }
-                    }
-                }
-        if (nearest < lobes.size() && p.z() >= lowest[nearest]) added[nearest].push_back(p);
+        float squared_distance = 0;
+        const int nearest = index.nearest(p, &squared_distance);
+        if (nearest < 0 || !(squared_distance < reach * reach)) continue;
+        const std::size_t lobe = owner[static_cast<std::size_t>(nearest)];
+        if (p.z() >= lowest[lobe]) added[lobe].push_back(p);
     }
     std::size_t count = 0;
     for (std::size_t l = 0; l < lobes.size(); ++l) {
