@@ -2,12 +2,10 @@
 
 #include "core/error.hpp"
 #include "lsystem/random.hpp"
+#include "reconstruct/kd_tree.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <limits>
-#include <unordered_map>
 #include <queue>
 #include <numbers>
 #include <numeric>
@@ -20,68 +18,6 @@ constexpr float kMinScale = 0.5f, kMaxScale = 2.0f;  // patches are stretched at
 constexpr float kPatchReach = 40.0f;                 // a patch reaches about this many root thicknesses
 constexpr int kPatchesPerCell = 2;                   // a fill cell takes geometry from this many patches at most
 constexpr std::size_t kFitLeaves = 32;               // leaf tips per patch scored in fitting (a uniform prefix)
-
-// Twig points of the placed patches on a hash grid, for the nearest one to an empty cell when
-// re-seeding (a linear scan over all placed points made re-seeding quadratic in big lobes).
-// Ties go to the earliest added point, as a scan in order would pick it.
-class TwigIndex {
-public:
-    explicit TwigIndex(float cell) : cell_(cell) {}
-    void add(const Eigen::Vector3f& p) {
-        const std::array<std::int64_t, 3> c = index(p);
-        for (int k = 0; k < 3; ++k) {
-            lo_[k] = std::min(lo_[k], c[k]);
-            hi_[k] = std::max(hi_[k], c[k]);
-        }
-        cells_[key(c)].push_back(static_cast<int>(points_.size()));
-        points_.push_back(p);
-    }
-    bool empty() const { return points_.empty(); }
-    // The nearest point to t; the index must not be empty.
-    const Eigen::Vector3f& nearest(const Eigen::Vector3f& t) const {
-        const std::array<std::int64_t, 3> c = index(t);
-        std::int64_t last = 0;  // the ring that holds the farthest occupied cell
-        for (int k = 0; k < 3; ++k) last = std::max({last, std::abs(c[k] - lo_[k]), std::abs(c[k] - hi_[k])});
-        float best = std::numeric_limits<float>::max();
-        int best_index = -1;
-        // Rings of cells at Chebyshev distance r: a point beyond ring r is more than r cells away.
-        for (std::int64_t r = 0; r <= last; ++r) {
-            for (std::int64_t dx = -r; dx <= r; ++dx)
-                for (std::int64_t dy = -r; dy <= r; ++dy)
-                    for (std::int64_t dz = -r; dz <= r; ++dz) {
-                        if (std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != r) continue;
-                        const auto it = cells_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
-                        if (it == cells_.end()) continue;
-                        for (const int i : it->second) {
-                            const float d = (points_[i] - t).squaredNorm();
-                            if (d < best || (d == best && i < best_index)) {
-                                best = d;
-                                best_index = i;
-                            }
-                        }
-                    }
-            const float reach = static_cast<float>(r) * cell_;
-            if (best_index >= 0 && best <= reach * reach) break;
-        }
-        return points_[best_index];
-    }
-
-private:
-    std::array<std::int64_t, 3> index(const Eigen::Vector3f& p) const {
-        return {static_cast<std::int64_t>(std::floor(p.x() / cell_)), static_cast<std::int64_t>(std::floor(p.y() / cell_)),
-                static_cast<std::int64_t>(std::floor(p.z() / cell_))};
-    }
-    static std::int64_t key(const std::array<std::int64_t, 3>& c) {
-        return ((c[0] & 0x1fffff) << 42) | ((c[1] & 0x1fffff) << 21) | (c[2] & 0x1fffff);
-    }
-    float cell_;
-    std::vector<Eigen::Vector3f> points_;
-    std::unordered_map<std::int64_t, std::vector<int>> cells_;
-    std::array<std::int64_t, 3> lo_{std::numeric_limits<std::int64_t>::max(), std::numeric_limits<std::int64_t>::max(),
-                                    std::numeric_limits<std::int64_t>::max()};
-    std::array<std::int64_t, 3> hi_{std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::min(),
-                                    std::numeric_limits<std::int64_t>::min()};
-};
 
 // Points of a patch used for fitting: segment ends and leaf tips, with the thickness there.
 struct Sample {
@@ -265,7 +201,9 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
         samples[i] = patch_samples(library.patches[i], library.patches[i].leaves.size());
         fit_samples[i] = patch_samples(library.patches[i], kFitLeaves);
     }
-    TwigIndex twigs(static_cast<float>(cell));  // twig points of every placed patch (for re-seeding)
+    // Twig points of every placed patch: re-seeding grows from the nearest one to an empty cell
+    // (a scan over all placed points made re-seeding quadratic in big lobes).
+    GrowingKdTree twigs;
 
     // Empty lobe cells in a fixed random order: the order in which empty regions are re-seeded.
     std::vector<int> fill_order;
@@ -328,7 +266,7 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
                 continue;
             }
             const Eigen::Vector3f target = fill_grid.cell_centre(fill_order[fill_cursor++]);
-            const Eigen::Vector3f from = twigs.nearest(target);
+            const Eigen::Vector3f from = twigs.point(twigs.nearest(target));
             const Eigen::Vector3f dir = target - from;
             if (dir.norm() < 1e-5f) continue;
             // As thick as a twig must be to reach the empty cell, never thicker than the seed.

@@ -82,6 +82,40 @@ int KdTree::nearest(const Eigen::Vector3f& query, float* squared_distance) const
     return static_cast<int>(index);
 }
 
+namespace {
+constexpr std::size_t kUnindexedTail = 32;  // newest points scanned directly: cheaper than a tiny index
+}
+
+void GrowingKdTree::add(const Eigen::Vector3f& point) {
+    points_.push_back(point);
+    if (points_.size() - indexed_ < kUnindexedTail) return;
+    // The tail becomes the newest block; blocks no bigger than it merge into it.
+    std::size_t first = indexed_;
+    while (!blocks_.empty() && blocks_.back().tree.size() <= points_.size() - first) {
+        first = blocks_.back().first;
+        blocks_.pop_back();
+    }
+    const std::span<const Eigen::Vector3f> range(points_.data() + first, points_.size() - first);
+    blocks_.push_back({first, KdTree(range)});
+    indexed_ = points_.size();
+}
+
+int GrowingKdTree::nearest(const Eigen::Vector3f& query) const {
+    int best = -1;
+    float best_d2 = std::numeric_limits<float>::infinity();
+    // Candidates arrive in order of addition, so a strict comparison keeps the earliest of ties.
+    auto consider = [&](std::size_t i) {
+        const float d2 = (points_[i] - query).squaredNorm();
+        if (d2 < best_d2) {
+            best_d2 = d2;
+            best = static_cast<int>(i);
+        }
+    };
+    for (const Block& block : blocks_) consider(block.first + static_cast<std::size_t>(block.tree.nearest(query)));
+    for (std::size_t i = indexed_; i < points_.size(); ++i) consider(i);
+    return best;
+}
+
 KnnTable knn_of_all_points(const KdTree& tree, int k) {
     KnnTable table;
     table.k = k;

@@ -40,6 +40,31 @@ private:
     std::unique_ptr<Impl> impl_;
 };
 
+// A nearest-point index that grows while it is queried (e.g. geometry placed step by step).
+// Bentley & Saxe's logarithmic method over static KdTrees: the points form blocks of
+// contiguous insertion ranges whose sizes halve from the oldest to the newest, merged like a
+// binary counter, so each point is re-indexed O(log n) times and a query visits O(log n)
+// blocks; the newest few points are scanned directly.
+class GrowingKdTree {
+public:
+    void add(const Eigen::Vector3f& point);
+    std::size_t size() const { return points_.size(); }
+    bool empty() const { return points_.empty(); }
+    const Eigen::Vector3f& point(int index) const { return points_[static_cast<std::size_t>(index)]; }
+    // Index (in order of addition) of the nearest point, -1 when empty. Of points at the same
+    // distance in different blocks the earliest added wins.
+    int nearest(const Eigen::Vector3f& query) const;
+
+private:
+    struct Block {
+        std::size_t first;  // insertion index of the block's first point
+        KdTree tree;
+    };
+    std::vector<Eigen::Vector3f> points_;
+    std::vector<Block> blocks_;  // oldest (largest) first
+    std::size_t indexed_ = 0;    // points_[0, indexed_) are in blocks
+};
+
 // k nearest neighbours of every indexed point, the point itself excluded, in rows of k
 // (row i = neighbours of point i, nearest first; -1 / +inf pad rows when fewer points exist).
 // Runs in parallel (TBB); the result does not depend on the number of threads.

@@ -64,6 +64,31 @@ TEST(KdTree, KnnTableExcludesThePointItselfAndPadsSmallClouds) {
     EXPECT_EQ(empty.nearest({0, 0, 0}), -1);
 }
 
+TEST(GrowingKdTree, NearestMatchesBruteForceWhileGrowing) {
+    // Points arrive in batches with queries in between, across several block merges; a
+    // duplicate of an early point must resolve to the early one.
+    const auto points = random_points(700, 4);
+    const auto queries = random_points(20, 5);
+    GrowingKdTree tree;
+    EXPECT_EQ(tree.nearest({0, 0, 0}), -1);
+    std::vector<Eigen::Vector3f> added;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        tree.add(points[i]);
+        added.push_back(points[i]);
+        if (i % 37 != 0) continue;
+        for (const auto& q : queries) {
+            int brute = 0;
+            for (std::size_t j = 1; j < added.size(); ++j)
+                if ((added[j] - q).squaredNorm() < (added[brute] - q).squaredNorm()) brute = static_cast<int>(j);
+            ASSERT_EQ(tree.nearest(q), brute) << "after " << added.size() << " points";
+        }
+    }
+    tree.add(points[3]);
+    EXPECT_EQ(tree.nearest(points[3]), 3);
+    EXPECT_EQ(tree.size(), 701u);
+    EXPECT_EQ(tree.point(3), points[3]);
+}
+
 TEST(NeighbourGraph, SymmetricSortedRowsWithPowerWeights) {
     const auto points = random_points(500, 3);
     NeighbourGraphOptions options;
