@@ -79,7 +79,8 @@ void BM_RangeDecoderDecisions(benchmark::State& state) {
     const std::vector<std::uint8_t> bytes = encoder.finish();
     for (auto _ : state) {
         std::vector<BitModel> decoding(kModels);
-        RangeDecoder decoder(bytes, "bench");
+        const std::string name = "bench";
+        RangeDecoder decoder(bytes, name);
         int ones = 0;
         for (int i = 0; i < kDecisions; ++i) ones += decoder.decode(decoding[context[i]]);
         benchmark::DoNotOptimize(ones);

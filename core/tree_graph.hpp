@@ -4,17 +4,46 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <boost/container/small_vector.hpp>
+
+#include <algorithm>
+#include <initializer_list>
 
 #include <string>
 #include <vector>
 
 namespace treelobes {
 
+// A node's children: room for two in the node itself (a branch's next vertex and one lateral:
+// nearly every vertex of a skeleton), so building a tree allocates only at multi-way forks; a
+// heap-allocated std::vector per node made allocation a third of decoding a skeleton. Converts
+// to, compares with and is assignable from std::vector<int>, which the modules pass around.
+class ChildList : public boost::container::small_vector<int, 2> {
+    using Base = boost::container::small_vector<int, 2>;
+
+public:
+    using Base::Base;
+    ChildList() = default;
+    ChildList(std::initializer_list<int> children) : Base(children) {}
+    ChildList(const std::vector<int>& children) : Base(children.begin(), children.end()) {}
+    ChildList& operator=(const std::vector<int>& children) {
+        assign(children.begin(), children.end());
+        return *this;
+    }
+    ChildList& operator=(std::initializer_list<int> children) {
+        assign(children.begin(), children.end());
+        return *this;
+    }
+    operator std::vector<int>() const { return std::vector<int>(begin(), end()); }
+    friend bool operator==(const ChildList& a, const ChildList& b) { return std::equal(a.begin(), a.end(), b.begin(), b.end()); }
+    friend bool operator==(const ChildList& a, const std::vector<int>& b) { return std::equal(a.begin(), a.end(), b.begin(), b.end()); }
+};
+
 struct TreeNode {
     Eigen::Vector3f position{0, 0, 0};  // local coordinates (metres)
     float radius = 0.0f;                // metres
     int parent = -1;                    // -1 for the root only
-    std::vector<int> children;          // main child first
+    ChildList children;                 // main child first
 };
 
 class TreeGraph {

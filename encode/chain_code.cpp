@@ -137,6 +137,35 @@ std::vector<Internode> read_internodes(const ChainCode& code, const std::string&
     return internodes;
 }
 
+InternodeVectors internode_vectors(const ChainCode& code, const std::string& context) {
+    const std::size_t count = check_symbols(code.symbols, context);
+    InternodeVectors out;
+    out.kind = code.kind;
+    out.radii = code.radii;
+    out.vectors.reserve(count);
+    out.terminators.reserve(count);
+    Voxel delta = Voxel::Zero();
+    for (const char symbol : code.symbols) {
+        if (is_move(symbol)) {
+            add_move(symbol, delta);
+            continue;
+        }
+        out.vectors.push_back(delta);
+        out.terminators.push_back(symbol);
+        delta.setZero();
+    }
+    return out;
+}
+
+std::string symbol_text(const InternodeVectors& code) {
+    std::string symbols;
+    for (std::size_t i = 0; i < code.terminators.size(); ++i) {
+        append_moves(code.vectors[i], symbols);
+        symbols += code.terminators[i];
+    }
+    return symbols;
+}
+
 std::vector<bool> contracted_internodes(const std::vector<Internode>& internodes) {
     std::vector<bool> contracted(internodes.size(), false);
     bool branch_start = true;

@@ -47,6 +47,16 @@ struct ChainCode {
     std::vector<int> radii;  // one per internode, i.e. per 6, 7 or 8 in `symbols`
 };
 
+// A chain code as a stream decoder produces it before it would become text: per internode the
+// vector its moves add up to (for DBF6 the correction wherever the code has one), its
+// terminator and its radius. Decoding a forest builds skeletons from this form directly.
+struct InternodeVectors {
+    CodeKind kind = CodeKind::DBF6;
+    std::vector<Voxel> vectors;
+    std::vector<char> terminators;  // kFork, kTip or kEndOfInternode
+    std::vector<int> radii;
+};
+
 // Appends the moves of `delta` in ascending symbol order, e.g. (2, 1, -3) -> "001555",
 // (-1, 2, 0) -> "113" (§3.1: clustering equal moves helps the later compression).
 void append_moves(const Voxel& delta, std::string& out);
@@ -64,6 +74,10 @@ std::size_t check_symbols(const std::string& symbols, const std::string& context
 // Error(InvalidInput) for any defect of check_symbols, a radius list whose length differs from
 // the internode count, negative radii, or moves beyond kMaxVoxelCoordinate.
 std::vector<Internode> read_internodes(const ChainCode& code, const std::string& context);
+
+// A checked code (check_symbols) in internode form, and back.
+InternodeVectors internode_vectors(const ChainCode& code, const std::string& context);
+std::string symbol_text(const InternodeVectors& code);
 
 // Which internodes the decoder contracts into the vertex their branch starts from: leading
 // internodes of a branch (the trunk or a lateral) with a zero move that do not end the branch.

@@ -53,4 +53,13 @@ ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const 
     return code;
 }
 
+InternodeVectors decode_stream_internodes(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii,
+                                          Coder coder, CodeKind kind, const std::string& context, const BestPrior* prior) {
+    InternodeVectors code = coder == Coder::Best
+                                ? best_decode_internodes(symbols, radii, context + " (symbols)", context + " (radii)", prior)
+                                : internode_vectors(decode_streams(symbols, radii, coder, kind, context, prior), context);
+    code.kind = kind;
+    return code;
+}
+
 }  // namespace treelobes::encode

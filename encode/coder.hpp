@@ -45,4 +45,9 @@ CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::strin
 ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
                          CodeKind kind, const std::string& context = "chain code", const BestPrior* prior = nullptr);
 
+// decode_streams in internode form (chain_code.hpp), for decoders that build skeletons.
+InternodeVectors decode_stream_internodes(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii,
+                                          Coder coder, CodeKind kind, const std::string& context = "chain code",
+                                          const BestPrior* prior = nullptr);
+
 }  // namespace treelobes::encode

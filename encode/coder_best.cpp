@@ -11,7 +11,6 @@
 #include <array>
 #include <cmath>
 #include <cstring>
-#include <deque>
 #include <memory>
 
 namespace treelobes::encode {
@@ -32,15 +31,15 @@ struct Encoding {
         rc.encode_direct(v, n);
         return v;
     }
-    [[noreturn]] void fail(const std::string& what) { throw Error(ExitCode::Internal, what); }
+    [[noreturn]] void fail(const char* what) { throw Error(ExitCode::Internal, what); }
 };
 
 struct Decoding {
     static constexpr bool kEncoding = false;
     RangeDecoder rc;
-    bool bit(BitModel& m, bool) { return rc.decode(m); }
+    [[gnu::always_inline]] bool bit(BitModel& m, bool) { return rc.decode(m); }
     std::uint64_t direct(std::uint64_t, unsigned n) { return rc.decode_direct(n); }
-    [[noreturn]] void fail(const std::string& what) { rc.fail(what); }
+    [[noreturn]] void fail(const char* what) { rc.fail(what); }
 };
 
 // Adaptive Exp-Golomb: the bit width k of v in unary (k = 0 is v = 0, so the first decision is
@@ -55,7 +54,7 @@ struct UIntModel {
 constexpr unsigned kMaxWidth = 62;
 
 template <class IO>
-std::uint64_t code_uint(IO& io, UIntModel& m, std::uint64_t v) {
+[[gnu::always_inline]] inline std::uint64_t code_uint(IO& io, UIntModel& m, std::uint64_t v) {
     const unsigned width = IO::kEncoding ? bit_width64(v) : 0;
     if (IO::kEncoding && width > kMaxWidth) io.fail("value too large for the arithmetic coder");
     unsigned k = 0;
@@ -131,8 +130,7 @@ public:
     void advance(const Voxel& vector, char terminator) {
         const Voxel move = start ? vector : Voxel(chain_direction + vector);
         if (!start) {
-            for (int a = 0; a < 3; ++a)
-                if (vector[a] != 0) last_sign[a] = sign_of(vector[a]);
+            for (int a = 0; a < 3; ++a) last_sign[a] = vector[a] != 0 ? sign_of(vector[a]) : last_sign[a];  // cmov
             recent_corrections = ((recent_corrections << 1) | (vector.isZero() ? 0u : 1u)) & 3u;
         }
         // Zero-length internodes at a branch start code further laterals of the same fork.
@@ -162,17 +160,18 @@ private:
         chain_direction = Voxel::Zero();
         parent_direction = Voxel::Zero();
         order = 0;
-        if (queue_.empty()) return;  // only at the end of a valid code
-        parent_direction = queue_.front().direction;
-        order = queue_.front().order;
-        queue_.pop_front();
+        if (next_ == queue_.size()) return;  // only at the end of a valid code
+        parent_direction = queue_[next_].direction;
+        order = queue_[next_].order;
+        ++next_;
     }
-    std::deque<Fork> queue_;
+    std::vector<Fork> queue_;  // a FIFO: queue_[next_..] wait for their lateral
+    std::size_t next_ = 0;
 };
 
 // Codes the vector of one internode; `budget` caps the moves a decoder may produce.
 template <class IO>
-Voxel code_vector(IO& io, SymbolModels& m, const ChainWalker& w, Voxel v, std::uint64_t budget) {
+[[gnu::always_inline]] inline Voxel code_vector(IO& io, SymbolModels& m, const ChainWalker& w, Voxel v, std::uint64_t budget) {
     std::uint64_t used = 0;
     auto spend = [&](std::uint64_t magnitude) {
         used += magnitude;
@@ -215,7 +214,7 @@ Voxel code_vector(IO& io, SymbolModels& m, const ChainWalker& w, Voxel v, std::u
 }
 
 template <class IO>
-char code_terminator(IO& io, SymbolModels& m, const ChainWalker& w, bool moved, char terminator) {
+[[gnu::always_inline]] inline char code_terminator(IO& io, SymbolModels& m, const ChainWalker& w, bool moved, char terminator) {
     // Forks come at fairly regular spacings along a branch: the distance to the last one matters.
     const int ctx = (((int(w.start) * 4 + std::min(w.since_start, 3)) * 8 + std::min(w.since_fork, 7)) * 4 + std::min(w.order, 3)) * 2 +
                     int(moved);
@@ -270,29 +269,38 @@ struct Topology {
     std::vector<char> terminator;
 };
 
-// The topology from the terminators of the internodes in code order.
+// The topology from the terminators of the internodes in code order. Without branches on the
+// terminators (forks and tips are as unpredictable as the code): every index is written to the
+// fork queue and kept by advancing its end only at a fork.
 Topology topology_of(std::span<const char> terminators) {
+    const std::size_t n = terminators.size();
     Topology t;
-    t.parent.reserve(terminators.size());
-    t.start.reserve(terminators.size());
+    t.parent.resize(n);
+    t.start.resize(n);
     t.terminator.assign(terminators.begin(), terminators.end());
-    std::vector<int> forks;  // a FIFO queue: forks[next_fork..] are still waiting for their lateral
-    std::size_t next_fork = 0;
+    std::vector<int> forks(n + 1);  // a FIFO queue: forks[next_fork..queued) wait for their lateral
+    std::size_t queued = 0, next_fork = 0;
     bool start = true;
-    for (std::size_t i = 0; i < terminators.size(); ++i) {
+    for (std::size_t i = 0; i < n; ++i) {
         const char c = terminators[i];
         const int index = static_cast<int>(i);
-        int parent = index - 1;
-        if (start && index > 0) parent = next_fork < forks.size() ? forks[next_fork++] : -1;
-        t.parent.push_back(index == 0 ? -1 : parent);
-        t.start.push_back(start);
-        if (c == kFork) forks.push_back(index);
+        // A branch start takes the next queued fork (-1 when none is left: a corrupt code, or
+        // the first internode).
+        const bool takes_fork = start && index > 0;
+        const bool available = next_fork < queued;
+        const int lateral_parent = available ? forks[next_fork] : -1;
+        t.parent[i] = takes_fork ? lateral_parent : index - 1;
+        next_fork += std::size_t{takes_fork && available};
+        t.start[i] = start;
+        forks[queued] = index;
+        queued += std::size_t{c == kFork};
         start = c == kTip;
     }
-    t.tips.assign(t.parent.size(), 0);
-    for (std::size_t i = t.parent.size(); i-- > 0;) {  // parents precede their children
-        if (t.terminator[i] == kTip) ++t.tips[i];
-        if (t.parent[i] >= 0) t.tips[t.parent[i]] += t.tips[i];
+    t.tips.assign(n, 0);
+    for (std::size_t i = n; i-- > 0;) {  // parents precede their children
+        t.tips[i] += std::uint32_t{t.terminator[i] == kTip};
+        const int parent = t.parent[i];
+        if (parent >= 0) t.tips[static_cast<std::size_t>(parent)] += t.tips[i];
     }
     return t;
 }
@@ -324,7 +332,11 @@ std::int64_t predict_radius(const Topology& t, std::span<const int> radii, std::
     const std::int64_t reference = radii[parent];
     if (predictor == kParentRadius || reference <= 0 || t.tips[parent] == 0 || t.tips[i] >= t.tips[parent]) return reference;
     const auto square = static_cast<unsigned __int128>(reference) * static_cast<unsigned __int128>(reference) * 4u;
-    const auto x = static_cast<std::uint64_t>(square * t.tips[i] / t.tips[parent]);  // < 4 r^2 < 2^64
+    const unsigned __int128 scaled = square * t.tips[i];
+    // < 4 r^2 < 2^64; a 64-bit division when the product fits (always for real radii), as the
+    // 128-bit one is a slow library call.
+    const auto x = (scaled >> 64) == 0 ? static_cast<std::uint64_t>(scaled) / t.tips[parent]
+                                       : static_cast<std::uint64_t>(scaled / t.tips[parent]);
     return static_cast<std::int64_t>((isqrt(x) + 1) / 2);
 }
 
@@ -335,8 +347,10 @@ struct RadiusModels {
     std::array<BitModel, 2 * kPredictedBuckets * 3> sign;
 };
 
-int terminator_index(char c) { return c == kEndOfInternode ? 0 : c == kFork ? 1 : 2; }
-int residual_bucket(std::int64_t e) { return e == 0 ? 0 : (std::abs(e) <= 2 ? 1 : 2); }
+// 8 -> 0, 6 -> 1, 7 -> 2; and 0, |e| <= 2, larger -> 0, 1, 2: context indices computed without
+// branches, as the decoded values they depend on are unpredictable.
+int terminator_index(char c) { return (c - kFork + 1) % 3; }
+int residual_bucket(std::int64_t e) { return int(e != 0) + int(std::abs(e) > 2); }
 
 template <class IO>
 void code_radii(IO& io, const Topology& t, std::span<int> radii, RadiusPredictor predictor, RadiusModels* models) {
@@ -533,41 +547,67 @@ char* write_moves(const Voxel& v, char* out) {
     return out;
 }
 
+// The internodes of a canonical stream of `n` symbols: emit(vector, terminator) for each.
+template <class Emit>
+void decode_canonical(Decoding& io, SymbolModels& models, std::uint64_t n, Emit emit) {
+    ChainWalker walker;
+    std::uint64_t remaining = n;
+    while (remaining > 0) {
+        // The budget leaves room for the moves and the terminator among the n symbols.
+        const Voxel vector = code_vector(io, models, walker, Voxel::Zero(), remaining - 1);
+        const char terminator = code_terminator(io, models, walker, !vector.isZero(), kTip);
+        remaining -= static_cast<std::uint64_t>(vector.cwiseAbs().sum()) + 1;
+        emit(vector, terminator);
+        walker.advance(vector, terminator);
+    }
+}
+
+struct SymbolHeader {
+    std::uint64_t count = 0;  // symbols of the code
+    std::uint8_t mode = kCanonical;
+    std::span<const std::uint8_t> payload;
+};
+
+SymbolHeader read_symbol_header(std::span<const std::uint8_t> bytes, const std::string& context) {
+    std::size_t position = 0;
+    SymbolHeader header;
+    header.count = read_varint(bytes, position, context);
+    if (header.count > kMaxCodeSymbols)
+        throw Error::input(context, "code length " + std::to_string(header.count) + " exceeds the decoder limit");
+    if (position >= bytes.size()) throw Error::input(context, "truncated stream header");
+    header.mode = bytes[position++];
+    if (header.mode != kInterpolativeSymbols && header.mode != kCanonical && header.mode != kGeneric)
+        throw Error::input(context, "unknown symbol model " + std::to_string(header.mode));
+    header.payload = bytes.subspan(position);
+    return header;
+}
+
 // best_decode_symbols, also returning the terminators of the internodes (the radii decoder's
 // topology) without a second scan of the symbol string.
 std::string decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context, const BestPrior* prior,
                            std::vector<char>& terminators) {
-    std::size_t position = 0;
-    const std::uint64_t n = read_varint(bytes, position, context);
-    if (n > kMaxCodeSymbols) throw Error::input(context, "code length " + std::to_string(n) + " exceeds the decoder limit");
-    if (position >= bytes.size()) throw Error::input(context, "truncated stream header");
-    const std::uint8_t mode = bytes[position++];
+    const SymbolHeader header = read_symbol_header(bytes, context);
+    const std::uint64_t n = header.count;
+    const std::uint8_t mode = header.mode;
+    const std::size_t position = static_cast<std::size_t>(header.payload.data() - bytes.data());
     if (mode == kInterpolativeSymbols) {
         std::string symbols = ic_decode_symbols(bytes.subspan(position), context);
         if (symbols.size() != n) throw Error::input(context, "symbol count disagrees with the stream header");
         terminators = terminators_of(symbols);
         return symbols;
     }
-    if (mode != kCanonical && mode != kGeneric) throw Error::input(context, "unknown symbol model " + std::to_string(mode));
     Decoding io{RangeDecoder(bytes.subspan(position), context)};
     std::string symbols;
     symbols.reserve(n);
     if (mode == kCanonical) {
-        SymbolModels& models = scratch_models(prior ? &prior->state().symbols : nullptr);
-        ChainWalker walker;
         terminators.reserve(n / 2);  // codes average about two symbols per internode
         symbols.resize(n + kMoveSlack);
         char* out = symbols.data();
-        const char* const end = out + n;
-        while (out < end) {
-            // The budget leaves room for the moves and the terminator in `symbols`.
-            const Voxel vector = code_vector(io, models, walker, Voxel::Zero(), static_cast<std::uint64_t>(end - out - 1));
-            const char terminator = code_terminator(io, models, walker, !vector.isZero(), kTip);
+        decode_canonical(io, scratch_models(prior ? &prior->state().symbols : nullptr), n, [&](const Voxel& vector, char terminator) {
             out = write_moves(vector, out);
             *out++ = terminator;
             terminators.push_back(terminator);
-            walker.advance(vector, terminator);
-        }
+        });
         symbols.resize(n);
     } else {
         auto models = std::make_unique<GenericModels>();
@@ -608,7 +648,9 @@ std::vector<std::uint8_t> best_encode_radii(const std::string& symbols, std::spa
 
 namespace {
 
-std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols, const Topology& topology,
+// `symbols()` gives the code's symbol string, which only the `ic` fallback stream needs.
+template <class Symbols>
+std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, Symbols symbols, const Topology& topology,
                               const std::string& context, const BestPrior* prior) {
     std::vector<int> radii(topology.parent.size(), 0);
     if (radii.empty()) {
@@ -617,7 +659,7 @@ std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, const std::st
     }
     if (bytes.empty()) throw Error::input(context, "empty radii stream");
     const std::uint8_t predictor = bytes[0];
-    if (predictor == kInterpolativeRadii) return ic_decode_radii(bytes.subspan(1), symbols, context);
+    if (predictor == kInterpolativeRadii) return ic_decode_radii(bytes.subspan(1), symbols(), context);
     if (predictor != kParentRadius && predictor != kPipeModel)
         throw Error::input(context, "unknown radius predictor " + std::to_string(predictor));
     Decoding io{RangeDecoder(bytes.subspan(1), context)};
@@ -631,7 +673,7 @@ std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, const std::st
 
 std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
                                    const std::string& context, const BestPrior* prior) {
-    return decode_radii(bytes, symbols, parse_topology(symbols), context, prior);
+    return decode_radii(bytes, [&]() -> const std::string& { return symbols; }, parse_topology(symbols), context, prior);
 }
 
 ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
@@ -639,7 +681,31 @@ ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span
     ChainCode code;
     std::vector<char> terminators;
     code.symbols = decode_symbols(symbol_bytes, symbols_context, prior, terminators);
-    code.radii = decode_radii(radii_bytes, code.symbols, topology_of(terminators), radii_context, prior);
+    code.radii = decode_radii(radii_bytes, [&]() -> const std::string& { return code.symbols; }, topology_of(terminators),
+                              radii_context, prior);
+    return code;
+}
+
+InternodeVectors best_decode_internodes(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
+                                        const std::string& symbols_context, const std::string& radii_context,
+                                        const BestPrior* prior) {
+    const SymbolHeader header = read_symbol_header(symbol_bytes, symbols_context);
+    if (header.mode != kCanonical)
+        return internode_vectors(best_decode_code(symbol_bytes, radii_bytes, symbols_context, radii_context, prior), symbols_context);
+    InternodeVectors code;
+    code.vectors.reserve(header.count / 2);  // codes average about two symbols per internode
+    code.terminators.reserve(header.count / 2);
+    Decoding io{RangeDecoder(header.payload, symbols_context)};
+    decode_canonical(io, scratch_models(prior ? &prior->state().symbols : nullptr), header.count,
+                     [&](const Voxel& vector, char terminator) {
+                         code.vectors.push_back(vector);
+                         code.terminators.push_back(terminator);
+                     });
+    if (!io.rc.at_end()) throw Error::input(symbols_context, "trailing bytes after the symbol stream");
+    std::string symbols;
+    code.radii = decode_radii(
+        radii_bytes, [&]() -> const std::string& { return symbols = symbol_text(code); }, topology_of(code.terminators),
+        radii_context, prior);
     return code;
 }
 

@@ -68,4 +68,10 @@ ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span
                            const std::string& symbols_context, const std::string& radii_context,
                            const BestPrior* prior = nullptr);
 
+// best_decode_code in internode form (chain_code.hpp), for decoders that build skeletons: a
+// canonical symbol stream then never becomes text. Same checks and errors.
+InternodeVectors best_decode_internodes(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
+                                        const std::string& symbols_context, const std::string& radii_context,
+                                        const BestPrior* prior = nullptr);
+
 }  // namespace treelobes::encode

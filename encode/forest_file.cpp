@@ -232,8 +232,12 @@ StoredTree ForestReader::read(std::size_t i, int lod, std::vector<StreamSizes>* 
 }
 
 TreeGraph ForestReader::decode(std::size_t i, int lod) {
-    const StoredTree tree = read(i, lod);
-    return place_tree(decode_stored_tree(tree, lod, context_ + ": tree " + std::to_string(i)), entry(i));
+    const std::vector<std::uint8_t> bytes = record_bytes(i);
+    std::size_t position = 0;
+    const std::string context = context_ + ": tree " + std::to_string(i);
+    TreeGraph skeleton = decode_tree_record(bytes, position, lod, context, prior_.get());
+    if (position != bytes.size()) throw Error::input(context, "unexpected bytes after the tree record");
+    return place_tree(std::move(skeleton), entry(i));
 }
 
 }  // namespace treelobes::encode

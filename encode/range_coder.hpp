@@ -23,7 +23,7 @@ struct BitModel {
     std::uint8_t seen = 0;
 
     static constexpr int kLimit = 60;  // then a fixed rate of 1/61: slow drift, little noise
-    void update(bool bit) {
+    [[gnu::always_inline]] void update(bool bit) {
         // Rate 1/(seen + 1.5): the first updates are (nearly) frequency counts.
         static constexpr auto rates = [] {
             std::array<std::uint32_t, kLimit + 1> r{};
@@ -36,7 +36,7 @@ struct BitModel {
         int p = p0 + delta;
         p = p < 64 ? 64 : (p > 65535 - 64 ? 65535 - 64 : p);
         p0 = static_cast<std::uint16_t>(p);
-        if (seen < kLimit) ++seen;
+        seen = static_cast<std::uint8_t>(seen + (seen < kLimit));  // no branch: models of mixed ages alternate
     }
 };
 
@@ -96,12 +96,25 @@ private:
     std::vector<std::uint8_t> out_;
 };
 
+// Thrown by the decoder; out of line so that the decoding loops stay small.
+[[noreturn, gnu::cold, gnu::noinline]] inline void fail_decoding(const std::string* context, const char* what) {
+    throw Error::input(*context, what);
+}
+
+// The decoder's whole state is four plain values and a pointer to the caller's context string:
+// a decoder that is a local of a loop whose calls are all inlined lives in registers (with an
+// owned string, or methods that pass `this` to an error path, it was loaded from and stored to
+// memory around every decision).
 class RangeDecoder {
 public:
-    RangeDecoder(std::span<const std::uint8_t> bytes, std::string context) : bytes_(bytes), context_(std::move(context)) {
+    // `context` names the stream in errors and must outlive the decoder.
+    RangeDecoder(std::span<const std::uint8_t> bytes, const std::string& context)
+        : next_(bytes.data()), end_(bytes.data() + bytes.size()), context_(&context) {
         for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
     }
-    bool decode(BitModel& model) {
+    RangeDecoder(std::span<const std::uint8_t>, std::string&&) = delete;  // would dangle
+
+    [[gnu::always_inline]] bool decode(BitModel& model) {
         // Branch-free: the bits of a well-modelled stream are close to random, so a branch on
         // them mispredicts about as often as the stream carries information.
         const std::uint32_t bound = (range_ >> 16) * model.p0;
@@ -117,34 +130,34 @@ public:
         std::uint64_t value = 0;
         while (count-- > 0) {
             range_ >>= 1;
-            const bool bit = code_ >= range_;
-            if (bit) code_ -= range_;
-            value = (value << 1) | (bit ? 1u : 0u);
+            const std::uint32_t mask = 0u - static_cast<std::uint32_t>(code_ >= range_);  // equiprobable: no branch
+            code_ -= range_ & mask;
+            value = (value << 1) | (mask & 1u);
             normalize();
         }
         return value;
     }
     // True when every byte was consumed (a valid stream ends exactly there).
-    bool at_end() const { return position_ == bytes_.size(); }
-    [[noreturn]] void fail(const std::string& what) const { throw Error::input(context_, what); }
+    bool at_end() const { return next_ == end_; }
+    [[noreturn]] void fail(const char* what) const { fail_decoding(context_, what); }
 
 private:
-    void normalize() {
+    [[gnu::always_inline]] void normalize() {
         while (range_ < (1u << 24)) {
             range_ <<= 8;
             code_ = (code_ << 8) | next_byte();
         }
     }
-    std::uint32_t next_byte() {
-        if (position_ >= bytes_.size()) fail("truncated arithmetic-coded stream");
-        return bytes_[position_++];
+    [[gnu::always_inline]] std::uint32_t next_byte() {
+        if (next_ == end_) [[unlikely]] fail_decoding(context_, "truncated arithmetic-coded stream");
+        return *next_++;
     }
 
-    std::span<const std::uint8_t> bytes_;
-    std::size_t position_ = 0;
+    const std::uint8_t* next_;
+    const std::uint8_t* end_;
     std::uint32_t range_ = 0xFFFFFFFFu;
     std::uint32_t code_ = 0;
-    std::string context_;
+    const std::string* context_;
 };
 
 }  // namespace treelobes::encode

@@ -159,20 +159,82 @@ std::vector<int> decoded_sources(const std::vector<Internode>& stream, const std
     return decoded;
 }
 
-// TreeGraph::add_node for a valid parent, giving a new child list room for two children at once:
-// a fork's second child then does not reallocate the list (a fifth of all vertices are forks,
-// and the allocator is a third of the decoding's skeleton step). Same bytes of memory per list.
-int add_decoded_node(TreeGraph& tree, const Eigen::Vector3f& position, float radius, int parent) {
-    const int index = static_cast<int>(tree.nodes.size());
-    TreeNode& node = tree.nodes.emplace_back();
-    node.position = position;
-    node.radius = radius;
-    node.parent = parent;
-    std::vector<int>& siblings = tree.nodes[static_cast<std::size_t>(parent)].children;
-    if (siblings.capacity() == 0) siblings.reserve(2);
-    siblings.push_back(index);
-    return index;
-}
+// Pseudocode 1 backwards, one internode at a time: the tree building shared by decode_tree
+// (internodes parsed from the symbol text) and decode_internodes (internodes straight from a
+// stream decoder). Checks every value a corrupt code could make unsafe; the caller checks the
+// structure (check_symbols, or the queue at every tip).
+class TreeBuilder {
+public:
+    TreeBuilder(const CodeGeometry& geometry, CodeKind kind, std::size_t internodes, const std::string& context)
+        : geometry_(geometry), root_(geometry.root_position.cast<double>()), kind_(kind), context_(context) {
+        check_positive(geometry.voxel_size, "voxel size");
+        check_positive(geometry.radius_unit, "radius unit");
+        if (geometry.root_radius < 0) throw Error::input(context, "root radius is negative");
+        tree_.origin = geometry.origin;
+        tree_.nodes.reserve(internodes + 1);
+        tree_.add_node(geometry.root_position, static_cast<float>(geometry.root_radius * geometry.radius_unit), -1);
+        voxels_.reserve(internodes + 1);
+        voxels_.push_back(Voxel::Zero());
+    }
+
+    // Adds internode `index` (0-based) with the vector its moves add up to; `describe` names it
+    // in the error for a move beyond kMaxVoxelCoordinate.
+    template <class Describe>
+    void add(std::size_t index, const Voxel& vector, char terminator, int radius, Describe describe) {
+        const Voxel move = differential_base_ ? Voxel(previous_ + vector) : vector;
+        if (radius < 0)
+            throw Error::input(context_, "radius " + std::to_string(index + 1) + " is negative (" + std::to_string(radius) + ")");
+        if (move.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
+            throw Error::input(context_, describe() + " moves more than 2^40 voxels (corrupt code)");
+        // contracted_internodes: a leading zero move of a branch that does not end it.
+        const bool contracted = branch_start_ && move.isZero() && terminator != kTip;
+        if (!contracted) {
+            const Voxel voxel = voxels_[static_cast<std::size_t>(attach_)] + move;
+            if (voxel.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
+                throw Error::input(context_, "internode " + std::to_string(index + 1) +
+                                                 " ends more than 2^40 voxels from the root (corrupt code)");
+            const Eigen::Vector3d position = root_ + voxel.cast<double>() * geometry_.voxel_size;
+            attach_ = add_child(position.cast<float>(), static_cast<float>(radius * geometry_.radius_unit));
+            voxels_.push_back(voxel);
+            branch_start_ = terminator == kTip;
+        }
+        if (terminator == kFork) queued_forks_.push_back(attach_);
+        if (terminator == kTip && next_fork_ < queued_forks_.size()) attach_ = queued_forks_[next_fork_++];
+        previous_ = move;
+        differential_base_ = kind_ == CodeKind::DBF6 && terminator != kTip;
+    }
+
+    // Laterals announced by a 6 and not started yet.
+    std::size_t open_forks() const { return queued_forks_.size() - next_fork_; }
+    TreeGraph take() { return std::move(tree_); }
+
+private:
+    // TreeGraph::add_node for the valid parent attach_ (node indices follow the code order).
+    int add_child(const Eigen::Vector3f& position, float radius) {
+        const int index = static_cast<int>(tree_.nodes.size());
+        TreeNode& node = tree_.nodes.emplace_back();
+        node.position = position;
+        node.radius = radius;
+        node.parent = attach_;
+        auto& siblings = tree_.nodes[static_cast<std::size_t>(attach_)].children;
+        if (siblings.capacity() == 0) siblings.reserve(2);  // a fork's second child needs no regrowth
+        siblings.push_back(index);
+        return index;
+    }
+
+    const CodeGeometry& geometry_;
+    const Eigen::Vector3d root_;
+    const CodeKind kind_;
+    const std::string& context_;
+    TreeGraph tree_;
+    std::vector<Voxel> voxels_;     // voxel of every vertex added so far
+    std::vector<int> queued_forks_;  // FIFO: vertices whose next lateral is still to come
+    std::size_t next_fork_ = 0;
+    int attach_ = 0;                 // vertex the next internode starts from
+    Voxel previous_ = Voxel::Zero();
+    bool differential_base_ = false;  // DBF6: the internode codes a correction of `previous_`
+    bool branch_start_ = true;        // no vertex of the current branch decoded yet
+};
 
 }  // namespace
 
@@ -229,28 +291,15 @@ EncodedTree encode_tree(const TreeGraph& tree, const EncodeOptions& options, con
 TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const std::string& context) {
     check_positive(geometry.voxel_size, "voxel size");
     check_positive(geometry.radius_unit, "radius unit");
-    if (geometry.root_radius < 0) throw Error::input(context, "root radius is negative");
     const std::size_t count = check_symbols(code.symbols, context);
     if (code.radii.size() != count)  // read_internodes's checks and messages, inlined below
         throw Error::input(context, "radius list has " + std::to_string(code.radii.size()) + " values but the " +
                                         code_kind_name(code.kind) + " code has " + std::to_string(count) +
                                         " internodes (one radius per 6, 7 or 8)");
-
-    TreeGraph tree;
-    tree.origin = geometry.origin;
-    const Eigen::Vector3d root = geometry.root_position.cast<double>();
-    tree.nodes.reserve(count + 1);
-    tree.add_node(geometry.root_position, static_cast<float>(geometry.root_radius * geometry.radius_unit), -1);
     // One pass over the symbols, without an intermediate internode stream (read_internodes and
-    // contracted_internodes do the same in two more passes): decoding is on the forest's hot path.
-    std::vector<Voxel> voxels{Voxel::Zero()};
-    voxels.reserve(count + 1);
-    std::vector<int> queued_forks;  // FIFO: vertices whose next lateral is still to come
-    std::size_t next_fork = 0;
-    int attach = 0;                // vertex the next internode starts from
-    Voxel delta = Voxel::Zero(), previous = Voxel::Zero();
-    bool differential_base = false;  // DBF6: the internode codes a correction of `previous`
-    bool branch_start = true;        // no vertex of the current branch decoded yet
+    // contracted_internodes do the same in two more passes).
+    TreeBuilder builder(geometry, code.kind, count, context);
+    Voxel delta = Voxel::Zero();
     std::size_t index = 0;
     for (std::size_t s = 0; s < code.symbols.size(); ++s) {
         const char symbol = code.symbols[s];
@@ -258,32 +307,38 @@ TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const
             delta[(symbol - '0') % 3] += symbol < '3' ? 1 : -1;
             continue;
         }
-        const Voxel move = differential_base ? Voxel(previous + delta) : delta;
-        const int radius = code.radii[index];
-        if (radius < 0)
-            throw Error::input(context, "radius " + std::to_string(index + 1) + " is negative (" + std::to_string(radius) + ")");
-        if (move.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
-            throw Error::input(context, "internode ending at character " + std::to_string(s + 1) +
-                                            " moves more than 2^40 voxels (corrupt code)");
-        // contracted_internodes: a leading zero move of a branch that does not end it.
-        const bool contracted = branch_start && move.isZero() && symbol != kTip;
-        if (!contracted) {
-            const Voxel voxel = voxels[attach] + move;
-            if (voxel.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
-                throw Error::input(context, "internode " + std::to_string(index + 1) + " ends more than 2^40 voxels from the root (corrupt code)");
-            const Eigen::Vector3d position = root + voxel.cast<double>() * geometry.voxel_size;
-            attach = add_decoded_node(tree, position.cast<float>(), static_cast<float>(radius * geometry.radius_unit), attach);
-            voxels.push_back(voxel);
-            branch_start = symbol == kTip;
-        }
-        if (symbol == kFork) queued_forks.push_back(attach);
-        if (symbol == kTip && next_fork < queued_forks.size()) attach = queued_forks[next_fork++];
-        previous = move;
-        differential_base = code.kind == CodeKind::DBF6 && symbol != kTip;
+        builder.add(index, delta, symbol, code.radii[index],
+                    [&] { return "internode ending at character " + std::to_string(s + 1); });
         delta.setZero();
         ++index;
     }
-    return tree;
+    return builder.take();
+}
+
+TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& geometry, const std::string& context) {
+    const std::size_t count = code.terminators.size();
+    if (code.vectors.size() != count || code.radii.size() != count)
+        throw Error::input(context, "radius list has " + std::to_string(code.radii.size()) + " values but the " +
+                                        code_kind_name(code.kind) + " code has " + std::to_string(count) +
+                                        " internodes (one radius per 6, 7 or 8)");
+    if (count == 0 || code.terminators.back() != kTip)
+        throw Error::input(context, "chain code ends without the final branch tip 7");
+    TreeBuilder builder(geometry, code.kind, count, context);
+    for (std::size_t i = 0; i < count; ++i) {
+        const char terminator = code.terminators[i];
+        if (terminator != kFork && terminator != kTip && terminator != kEndOfInternode)
+            throw Error::input(context, "internode " + std::to_string(i + 1) + " has no valid terminator");
+        // check_symbols's rules: every 7 but the last returns to a queued lateral, and the last
+        // one leaves none.
+        if (terminator == kTip && i + 1 < count && builder.open_forks() == 0)
+            throw Error::input(context, "tip 7 of internode " + std::to_string(i + 1) +
+                                            " ends the last open branch but the code goes on (a fork 6 is missing)");
+        if (i + 1 == count && builder.open_forks() > 0)
+            throw Error::input(context, std::to_string(builder.open_forks()) +
+                                            " fork(s) 6 without a lateral branch: the code ends before every queued lateral was coded");
+        builder.add(i, code.vectors[i], terminator, code.radii[i], [&] { return "internode " + std::to_string(i + 1); });
+    }
+    return builder.take();
 }
 
 }  // namespace treelobes::encode

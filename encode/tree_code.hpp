@@ -61,6 +61,11 @@ EncodedTree encode_tree(const TreeGraph& tree, const EncodeOptions& options, con
 // for a corrupt code or radius list, Error(Usage) for a non-positive voxel size or radius unit.
 TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const std::string& context = "chain code");
 
+// decode_tree for a code in internode form (same tree, same checks of the structure and of
+// every value; errors name internodes instead of characters).
+TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& geometry,
+                            const std::string& context = "chain code");
+
 // Median length of the non-zero edges: the internode length l of a resampled skeleton.
 // Throws Error(InvalidInput) when the tree has no edge of positive length.
 double median_internode_length(const TreeGraph& tree, const std::string& context = "tree");

@@ -146,8 +146,11 @@ std::vector<std::uint8_t> write_tree_record(const StoredTree& tree, std::vector<
     return out;
 }
 
-StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod,
-                            const std::string& context, std::vector<StreamSizes>* sizes, const BestPrior* prior) {
+namespace {
+
+// read_tree_record; with `internodes`, LOD `lod` is decoded into it instead of tree.lods[lod].
+StoredTree parse_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod, const std::string& context,
+                             std::vector<StreamSizes>* sizes, const BestPrior* prior, InternodeVectors* internodes) {
     ByteReader in(bytes, position, context);
     StoredTree tree;
     const std::uint8_t kind = in.u8();
@@ -191,7 +194,10 @@ StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& po
         const auto symbols = in.take(symbol_bytes);
         const auto radii = in.take(radii_bytes);
         tree.lods[k].kind = tree.kind;
-        if (lod < 0 || static_cast<int>(k) == lod) {
+        if (internodes && static_cast<int>(k) == lod) {
+            *internodes = decode_stream_internodes(symbols, radii, tree.coder, tree.kind, context + ": LOD " + std::to_string(k),
+                                                   (flags & kUsesPrior) ? prior : nullptr);
+        } else if (lod < 0 || static_cast<int>(k) == lod) {
             tree.lods[k] = decode_streams(symbols, radii, tree.coder, tree.kind, context + ": LOD " + std::to_string(k),
                                           (flags & kUsesPrior) ? prior : nullptr);
             if (sizes)
@@ -202,6 +208,21 @@ StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& po
     }
     position = in.position();
     return tree;
+}
+
+}  // namespace
+
+StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod,
+                            const std::string& context, std::vector<StreamSizes>* sizes, const BestPrior* prior) {
+    return parse_tree_record(bytes, position, lod, context, sizes, prior, nullptr);
+}
+
+TreeGraph decode_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod, const std::string& context,
+                             const BestPrior* prior) {
+    if (lod < 0) throw Error::usage(context + ": LOD " + std::to_string(lod) + " does not exist");
+    InternodeVectors code;
+    const StoredTree tree = parse_tree_record(bytes, position, lod, context, nullptr, prior, &code);
+    return decode_internodes(code, tree.geometry(), context + ": LOD " + std::to_string(lod));
 }
 
 std::vector<std::uint8_t> write_tree_file_bytes(const StoredTree& tree, std::vector<StreamSizes>* sizes) {

@@ -66,6 +66,11 @@ StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& po
                             const std::string& context, std::vector<StreamSizes>* sizes = nullptr,
                             const BestPrior* prior = nullptr);
 
+// LOD `lod` of a tree record straight to its skeleton: read_tree_record then decode_stored_tree,
+// without the chain code's symbol text. Same checks and errors.
+TreeGraph decode_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod, const std::string& context,
+                             const BestPrior* prior = nullptr);
+
 // Whole .dbf6 files.
 std::vector<std::uint8_t> write_tree_file_bytes(const StoredTree& tree, std::vector<StreamSizes>* sizes = nullptr);
 StoredTree read_tree_file_bytes(std::span<const std::uint8_t> bytes, int lod, const std::string& context,

@@ -304,7 +304,8 @@ TEST(RangeCoder, AdaptiveBitsRoundTripAndTruncationFails) {
     enc.encode_direct(0x2A5, 10);
     const auto bytes = enc.finish();
     EXPECT_LT(bytes.size(), bits.size() / 8);  // H(0.2) ~ 0.72 bit
-    RangeDecoder dec(bytes, "test");
+    const std::string test_context = "test", cut_context = "cut";
+    RangeDecoder dec(bytes, test_context);
     std::array<BitModel, 4> models_d{};
     ctx = 0;
     for (int b : bits) {
@@ -314,7 +315,7 @@ TEST(RangeCoder, AdaptiveBitsRoundTripAndTruncationFails) {
     EXPECT_EQ(dec.decode_direct(10), 0x2A5u);
     EXPECT_TRUE(dec.at_end());  // consumed exactly what was written
     auto truncated_decode = [&] {
-        RangeDecoder cut(std::span<const std::uint8_t>(bytes).first(bytes.size() / 2), "cut");
+        RangeDecoder cut(std::span<const std::uint8_t>(bytes).first(bytes.size() / 2), cut_context);
         std::array<BitModel, 4> m{};
         for (std::size_t i = 0; i < bits.size(); ++i) cut.decode(m[0]);
     };

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <optional>
 #include <random>
 
 using namespace treelobes;
@@ -132,4 +134,82 @@ TEST(CorruptCode, MutatedPaperCodesAreDecodedOrRejected) {
             }
         }
     }
+}
+
+namespace {
+
+// The internode form of a symbol string made of moves and terminators only (no check).
+InternodeVectors internode_form(const ChainCode& code) {
+    InternodeVectors out;
+    out.kind = code.kind;
+    out.radii = code.radii;
+    Voxel delta = Voxel::Zero();
+    for (const char c : code.symbols) {
+        if (c < kFork) {
+            delta[(c - '0') % 3] += c < '3' ? 1 : -1;
+            continue;
+        }
+        out.vectors.push_back(delta);
+        out.terminators.push_back(c);
+        delta.setZero();
+    }
+    return out;
+}
+
+bool same_tree(const TreeGraph& a, const TreeGraph& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (a.nodes[i].position != b.nodes[i].position || a.nodes[i].radius != b.nodes[i].radius ||
+            a.nodes[i].parent != b.nodes[i].parent || a.nodes[i].children != b.nodes[i].children)
+            return false;
+    return true;
+}
+
+}  // namespace
+
+// The forest decoder builds skeletons from internodes, never from symbol text: it must accept
+// exactly the codes decode_tree accepts, build the same trees, and reject the rest cleanly.
+TEST(CorruptCode, InternodeFormDecodesAndRejectsLikeTheText) {
+    std::mt19937 engine(77);
+    const std::string alphabet = "01234588667778";
+    int accepted = 0, rejected = 0;
+    for (int trial = 0; trial < 20000; ++trial) {
+        std::string symbols;
+        for (std::size_t i = 0, length = engine() % 40; i < length; ++i) symbols += alphabet[engine() % alphabet.size()];
+        if (!symbols.empty() && symbols.back() < kFork) symbols += kTip;  // the internode form has no trailing moves
+        const auto terminators = static_cast<std::size_t>(std::count_if(symbols.begin(), symbols.end(), [](char c) { return c >= kFork; }));
+        std::vector<int> radii(engine() % 8 == 0 ? terminators + 1 : terminators);
+        for (int& r : radii) r = static_cast<int>(engine() % 20) - (engine() % 50 == 0 ? 25 : 0);
+        const ChainCode code{engine() % 2 ? CodeKind::F6 : CodeKind::DBF6, symbols, radii};
+        std::optional<TreeGraph> from_text;
+        try {
+            from_text = decode_tree(code, unit_geometry());
+        } catch (const Error&) {
+        }
+        try {
+            const TreeGraph from_internodes = decode_internodes(internode_form(code), unit_geometry());
+            ASSERT_TRUE(from_text) << symbols << ": accepted only in internode form";
+            EXPECT_TRUE(same_tree(*from_text, from_internodes)) << symbols;
+            ++accepted;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.code(), ExitCode::InvalidInput) << e.what();
+            EXPECT_FALSE(from_text) << symbols << ": rejected only in internode form: " << e.what();
+            ++rejected;
+        }
+    }
+    EXPECT_GT(accepted, 100);
+    EXPECT_GT(rejected, 100);
+    // The structural defects, named.
+    auto error_of = [](const std::string& symbols, const std::vector<int>& radii) -> std::string {
+        try {
+            decode_internodes(internode_form(ChainCode{CodeKind::DBF6, symbols, radii}), unit_geometry(), "internodes");
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "accepted";
+    };
+    EXPECT_TRUE(contains(error_of("11161117", {1, 2}), "1 fork(s) 6 without a lateral branch"));
+    EXPECT_TRUE(contains(error_of("1117117", {1, 2}), "tip 7 of internode 1 ends the last open branch"));
+    EXPECT_TRUE(contains(error_of("1118", {1}), "without the final branch tip 7"));
+    EXPECT_TRUE(contains(error_of("1117", {1, 2}), "radius list has 2 values"));
 }

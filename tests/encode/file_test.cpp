@@ -255,3 +255,36 @@ TEST(ForestFile, ModelPriorIsStoredWhenItPaysAndDecodesExactly) {
     const std::span<const std::uint8_t> record(bytes.data() + e.offset, e.size);
     EXPECT_THROW(read_tree_record(record, position, 0, "record"), Error);
 }
+
+// ForestReader::decode builds skeletons straight from the decoded internodes (the symbol text
+// never exists); it must give exactly the skeleton of the chain code path, for both coders,
+// every LOD, with and without the forest's model prior.
+TEST(ForestFile, DecodeGivesTheSkeletonOfTheChainCodePath) {
+    for (const std::size_t count : {std::size_t{3}, std::size_t{30}}) {  // 30 alike trees: the prior pays
+        std::vector<ForestTree> trees(count);
+        for (std::uint32_t i = 0; i < count; ++i) {
+            trees[i].skeleton = sample_tree(count == 3 ? 70 + i : 50 + i % 4, 300);
+            trees[i].position = {2.0 * i, 1.0, 0};
+            trees[i].azimuth = 0.3f * static_cast<float>(i);
+        }
+        for (Coder coder : {Coder::Interpolative, Coder::Best}) {
+            const std::vector<std::uint8_t> bytes = write_forest_bytes(trees, file_options(coder, 3));
+            ForestReader reader(bytes, "f.forest");
+            for (std::size_t i = 0; i < count; ++i)
+                for (int k = 0; k < 3; ++k) {
+                    const TreeGraph got = reader.decode(i, k);
+                    const TreeGraph expected = place_tree(decode_stored_tree(reader.read(i, k), k, "text"), reader.entry(i));
+                    ASSERT_EQ(got.size(), expected.size()) << "tree " << i << " LOD " << k;
+                    EXPECT_EQ(got.origin, expected.origin);
+                    for (std::size_t n = 0; n < got.size(); ++n) {
+                        ASSERT_EQ(got.nodes[n].position, expected.nodes[n].position) << "tree " << i << " LOD " << k << " node " << n;
+                        ASSERT_EQ(got.nodes[n].radius, expected.nodes[n].radius);
+                        ASSERT_EQ(got.nodes[n].parent, expected.nodes[n].parent);
+                        ASSERT_EQ(std::vector<int>(got.nodes[n].children.begin(), got.nodes[n].children.end()),
+                                  std::vector<int>(expected.nodes[n].children.begin(), expected.nodes[n].children.end()));
+                    }
+                }
+            EXPECT_THROW(reader.decode(0, 3), Error);
+        }
+    }
+}

@@ -46,8 +46,8 @@ public:
     double uniform() { return engine_() * (1.0 / 4294967296.0); }  // [0, 1)
     double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
     int below(int n) { return static_cast<int>(uniform() * n); }  // [0, n)
-    template <class T>
-    void shuffle(std::vector<T>& items) {  // Fisher-Yates
+    template <class Items>
+    void shuffle(Items& items) {  // Fisher-Yates
         for (int i = static_cast<int>(items.size()) - 1; i > 0; --i) std::swap(items[i], items[below(i + 1)]);
     }
 
