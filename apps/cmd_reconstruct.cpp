@@ -66,6 +66,7 @@ nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s
             {"internode_length", rounded(s.internode_length)},
             {"min_twig_length", k.min_twig_length},
             {"smoothing_iterations", k.smoothing_iterations},
+            {"bridge_direction", k.bridge_direction},
             {"root_diameter", o.stage.root_diameter},
             {"voxel_size", o.stage.preprocess.voxel_size},
             {"outlier_neighbours", o.stage.preprocess.outlier_neighbours},
@@ -98,6 +99,7 @@ nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& inpu
                       {"total_branch_length", rounded(s.total_length, 3)},
                       {"branches", s.branches},
                       {"internodes", s.internodes},
+                      {"recentred_nodes", s.recentred_nodes},
                       {"tips", s.tips},
                       {"max_branch_order", s.max_branch_order},
                       {"stem_visible", s.stem_visible},
@@ -223,7 +225,23 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
         ->check(CLI::Range(0, 50))->capture_default_str();
     sub->add_option("--max-gap", k.max_gap, "Leave parts joined only across a longer gap (metres) out of the skeleton (0 = keep all)")
         ->check(CLI::NonNegativeNumber);
+    sub->add_option("--bridge-direction", k.bridge_direction,
+                    "Weight of the angle between a gap bridge and its piece's own axis (0 = shortest bridges)")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     sub->add_option("--fit-axes", k.fit_axes, "Centre wide branch slices on fitted circles (true/false)")->capture_default_str();
+    sub->add_option("--recentre", o.stage.recentre.enabled,
+                    "Move thin internodes across onto the centroid of their own points (true/false): on leafy scans the "
+                    "skeleton otherwise runs beside branches hidden in foliage")
+        ->capture_default_str();
+    sub->add_option("--recentre-max-spread", o.stage.recentre.max_spread,
+                    "Internodes whose points spread wider than this (RMS around their centroid, metres) are thick and stay put")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    sub->add_option("--recentre-inside-band", o.stage.recentre.inside_band,
+                    "Nodes closer to their points' centroid than this many spreads are inside their branch and stay put")
+        ->check(CLI::NonNegativeNumber)
+        ->capture_default_str();
     sub->add_option("--root-diameter", o.stage.root_diameter, "Stem diameter at the base in metres (0 = from the stem fit)")
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--voxel-size", o.stage.preprocess.voxel_size, "Keep one point per voxel of this size in metres (0 = off)")

@@ -5,6 +5,7 @@
 #include "reconstruct/kd_tree.hpp"
 #include "reconstruct/union_find.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -163,10 +164,107 @@ void large_component_bridges(std::span<const Eigen::Vector3f> points, const std:
     }
 }
 
+// One end of an elongated piece: its extreme point along the piece's principal axis and the
+// direction the piece leaves by there (the principal axis of its last third, pointing out).
+struct PieceEnd {
+    int point = -1;
+    Eigen::Vector3f outward = Eigen::Vector3f::Zero();
+};
+
+Eigen::Vector3f principal_axis(std::span<const Eigen::Vector3f> points, const std::vector<int>& members, double* elongation = nullptr) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i : members) mean += points[i].cast<double>();
+    mean /= static_cast<double>(members.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int i : members) {
+        const Eigen::Vector3d d = points[i].cast<double>() - mean;
+        cov += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+    if (elongation) *elongation = solver.eigenvalues()[2] / std::max(solver.eigenvalues()[1], 1e-12);
+    return solver.eigenvectors().col(2).cast<float>();
+}
+
+// The two ends of a piece of at least `min_points` points whose principal variance is at least
+// `min_elongation` times the next (a stretch of branch, not a crumb or a patch of bark); none
+// otherwise, since such a piece has no direction to continue in.
+std::vector<PieceEnd> piece_ends(std::span<const Eigen::Vector3f> points, const std::vector<int>& members, std::size_t min_points,
+                                 double min_elongation) {
+    if (members.size() < min_points) return {};
+    double elongation = 0;
+    const Eigen::Vector3f axis = principal_axis(points, members, &elongation);
+    if (elongation < min_elongation) return {};
+    std::vector<float> t(members.size());
+    for (std::size_t i = 0; i < members.size(); ++i) t[i] = points[members[i]].dot(axis);
+    const auto [low, high] = std::minmax_element(t.begin(), t.end());
+    const float third = (*high - *low) / 3.0f;
+    std::vector<PieceEnd> ends;
+    for (const float sign : {-1.0f, 1.0f}) {
+        const float extreme = sign < 0 ? *low : *high;
+        std::vector<int> tail;
+        for (std::size_t i = 0; i < members.size(); ++i)
+            if (sign * (t[i] - extreme) >= -third) tail.push_back(members[i]);
+        Eigen::Vector3f outward = sign * axis;
+        if (tail.size() >= 4) {
+            const Eigen::Vector3f local = principal_axis(points, tail);
+            outward = local.dot(outward) < 0 ? -local : local;
+        }
+        ends.push_back({members[static_cast<std::size_t>((sign < 0 ? low : high) - t.begin())], outward});
+    }
+    return ends;
+}
+
+// Cost of a bridge from a point of an elongated piece to a foreign point: its length, times
+// 1 + weight (1 - cos) where cos is the cosine between the bridge and the direction the piece
+// leaves by at its nearest end (the better of the two). A branch broken by an occlusion gap
+// thus continues along its own axis to the part it came from instead of jumping sideways to
+// the nearest bark, and a piece lying beside a stem pays for a side join.
+float bridge_cost(const Eigen::Vector3f& from, const Eigen::Vector3f& to, std::span<const PieceEnd> ends, float weight) {
+    const Eigen::Vector3f d = to - from;
+    const float length = d.norm();
+    if (length <= 0) return 0.0f;
+    float best_cos = -1.0f;
+    for (const PieceEnd& e : ends) best_cos = std::max(best_cos, d.dot(e.outward) / length);
+    return length * (1.0f + weight * (1.0f - best_cos));
+}
+
+// Replaces each elongated piece's shortest bridge by the cheapest bridge (bridge_cost) from one
+// of its ends when that is cheaper. Candidates lie within the shortest bridge's cost of an end
+// (no farther point can be cheaper).
+void directed_bridges(std::span<const Eigen::Vector3f> points, const KdTree& tree, const std::vector<int>& label,
+                      const std::vector<std::vector<int>>& members, std::size_t largest, float weight,
+                      std::vector<Candidate>& best) {
+    constexpr std::size_t kMinPoints = 5;      // a few samples of a sparse twig already show its direction
+    constexpr double kMinElongation = 9.0;     // length at least 3 times the width
+    constexpr std::size_t kMaxCandidates = 4096;
+    std::vector<int> found;
+    std::vector<float> d2;
+    for (std::size_t c = 0; c < members.size(); ++c) {
+        if (c == largest || best[c].a < 0) continue;
+        const std::vector<PieceEnd> ends = piece_ends(points, members[c], kMinPoints, kMinElongation);
+        if (ends.empty()) continue;
+        float cost = bridge_cost(points[best[c].a], points[best[c].b], ends, weight);
+        const float shortest_cost = cost;
+        Candidate chosen = best[c];
+        for (const PieceEnd& e : ends) {
+            tree.radius_search(points[e.point], shortest_cost, found, d2, kMaxCandidates);
+            for (std::size_t j = 0; j < found.size(); ++j) {
+                if (label[found[j]] == static_cast<int>(c)) continue;
+                const float q = bridge_cost(points[e.point], points[found[j]], std::span(&e, 1), weight);
+                if (q < cost) {
+                    cost = q;
+                    chosen = {d2[j], e.point, found[j]};
+                }
+            }
+        }
+        best[c] = chosen;
+    }
+}
+
 // Borůvka-style joining: each round every component except the largest gets its shortest
-// bridge (see above), then all bridges are added. Returns the bridging edges.
+// bridge (see above), or its directed one (directed_bridges), then all bridges are added. Returns the bridging edges.
 std::vector<Edge> bridge_components(std::span<const Eigen::Vector3f> points, const KdTree& tree, const KnnTable& table,
-                                    UnionFind& sets, float& longest) {
+                                    float direction_weight, UnionFind& sets, float& longest) {
     constexpr std::size_t kSmall = 64;
     std::vector<Edge> bridges;
     const int n = static_cast<int>(points.size());
@@ -192,6 +290,7 @@ std::vector<Edge> bridge_components(std::span<const Eigen::Vector3f> points, con
                   std::to_string(std::count(exact.begin(), exact.end(), false)) + " need an exact search");
         small_component_bridges(tree, label, members, kSmall, exact, best);
         large_component_bridges(points, label, members, kSmall, largest, exact, best);
+        if (direction_weight > 0) directed_bridges(points, tree, label, members, largest, direction_weight, best);
         for (std::size_t c = 0; c < members.size(); ++c) {
             const Candidate& e = best[c];
             if (e.a < 0 || !sets.unite(e.a, e.b)) continue;
@@ -240,6 +339,8 @@ NeighbourGraph build_neighbour_graph(std::span<const Eigen::Vector3f> points, co
         throw Error::usage("neighbour graph: neighbours must be in 2..64, got " + std::to_string(options.neighbours));
     if (!(options.beta > 0.0) || !std::isfinite(options.beta)) throw Error::usage("neighbour graph: beta must be > 0");
     if (!(options.gap_factor > 0.0f)) throw Error::usage("neighbour graph: gap factor must be > 0");
+    if (!(options.direction_weight >= 0.0f) || !std::isfinite(options.direction_weight))
+        throw Error::usage("neighbour graph: direction weight must be >= 0");
     std::unique_ptr<KdTree> own;
     if (!tree || tree->size() != points.size()) {
         own = std::make_unique<KdTree>(points);
@@ -261,7 +362,7 @@ NeighbourGraph build_neighbour_graph(std::span<const Eigen::Vector3f> points, co
 
     float longest = 0.0f;
     std::vector<Edge> bridges;
-    if (options.join_components) bridges = bridge_components(points, *tree, table, sets, longest);
+    if (options.join_components) bridges = bridge_components(points, *tree, table, options.direction_weight, sets, longest);
     const auto t2 = std::chrono::steady_clock::now();
     // Both lists are sorted (bridges after a sort of their own): merging keeps the whole sorted.
     std::sort(bridges.begin(), bridges.end());

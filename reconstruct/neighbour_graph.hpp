@@ -1,6 +1,7 @@
 // The neighbour graph of seed 001 §4.1: every point is joined to its k nearest neighbours
 // (symmetrised), each edge (u, v) weighted ||u - v||^beta. Separate pieces of the cloud (gaps
-// in the scan) are joined by the shortest bridging edges, so every point reaches every other.
+// in the scan) are joined by bridging edges, so every point reaches every other: the shortest
+// ones, or (direction_weight > 0) for an elongated piece the one its end axis points along.
 #pragma once
 
 #include <Eigen/Core>
@@ -20,6 +21,7 @@ struct NeighbourGraphOptions {
     bool join_components = true;  // add bridging edges until the graph is connected
     float gap_factor = 10.0f;     // automatic max_edge_length in median nearest-neighbour distances: a clump
                                   // of fewer than k points must not reach across a gap with kNN edges
+    float direction_weight = 0.0f;  // > 0: an elongated piece joins where its own axis leads (see bridge_cost), 0 = shortest bridges
 };
 
 // Undirected graph in compressed rows: the neighbours of vertex i are

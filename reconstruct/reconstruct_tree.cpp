@@ -110,6 +110,7 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     s.longest_bridge = sk.longest_bridge;
     s.stem_visible = sk.base.stem_visible;
     if (!s.stem_visible) s.quality.flags.push_back("stem_not_visible");
+    s.recentred_nodes = recentre_internodes(sk.tree, pre.points, sk.point_internode, o.recentre);
     clock.mark("skeleton");
 
     out.trunk = fit_trunk(pre.points, sk.point_internode, sk.tree, o.trunk);

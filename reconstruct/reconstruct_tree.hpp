@@ -7,6 +7,7 @@
 #include "core/tree_graph.hpp"
 #include "reconstruct/allometry.hpp"
 #include "reconstruct/preprocess.hpp"
+#include "reconstruct/recentre.hpp"
 #include "reconstruct/skeleton.hpp"
 #include "reconstruct/tree_quality.hpp"
 #include "reconstruct/trunk.hpp"
@@ -20,6 +21,7 @@ namespace treelobes {
 struct ReconstructOptions {
     PreprocessOptions preprocess;
     SkeletonOptions skeleton;
+    RecentreOptions recentre;  // thin internodes moved across onto their points (reconstruct/recentre.hpp)
     TrunkOptions trunk;
     AllometryOptions allometry;
     QualityOptions quality;
@@ -42,6 +44,7 @@ struct TreeSummary {
     float total_length = 0.0f;     // sum of skeleton internode lengths (metres)
     std::size_t branches = 0;      // axes: the trunk plus one per lateral child
     std::size_t internodes = 0;
+    std::size_t recentred_nodes = 0;  // nodes moved onto their internode's points
     std::size_t tips = 0;
     int max_branch_order = 0;
     float spacing = 0.0f;

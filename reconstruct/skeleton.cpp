@@ -307,11 +307,97 @@ Clusters merge_fragments(std::span<const Eigen::Vector3f> points, const Clusters
     return out;
 }
 
+// Where the geodesic distance winds around a sparse thick stem (it runs along the bark as
+// easily as up it), a bin is an arc of a helix rather than a cross-section, its centroid lies on
+// the bark and the circle fit across the cluster's own direction fails or finds a small circle
+// on the arc. The stem's cross-section is then cut directly: a slab one bin thick, across the
+// axis that circle fits found below (the parent and up to four further ancestors, all on the
+// axis), at the height of the cluster's centroid along that axis, holding the points of the
+// clusters near it in the cluster tree (arcs of one height lie many bins apart along the
+// winding). The circle fitted to the slab places the node when it is trustworthy and continues
+// the stem (centre within half a radius of the extrapolated axis, radius within a factor 1.6
+// of the stem's). A slab too sparse for a fit continues the axis below, for up to 16 bins, when
+// that axis is straight and the cluster's own points lie on the stem's ring (an arc of it, not
+// a branch leaving it). Stems thinner than 0.12 m keep their clusters' own fits (tried down to
+// 0.04 m: worse on archi and HS).
+struct SlabFit {
+    Eigen::Vector3f position;
+    float radius = 0.0f;
+    bool extrapolated = false;  // too sparse for a fit: on the axis below
+};
+
+std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, const Clusters& c,
+                                   const std::vector<std::vector<int>>& members, const std::vector<std::vector<int>>& children,
+                                   const std::vector<Eigen::Vector3f>& position, const std::vector<bool>& on_axis, float stem,
+                                   int extrapolated, int k, float spacing, float bin_width) {
+    constexpr std::size_t sparse_slab = 24;  // points a slab needs for a circle fit
+    constexpr int max_extrapolated = 16;      // bins
+    constexpr float min_slab_radius = 0.12f;  // metres: thinner stems keep the clusters' own fits
+    constexpr int reach = 8;                 // bins either side whose clusters the slab draws from
+    if (!(stem >= std::max(2.0f * spacing, min_slab_radius))) return std::nullopt;
+    const int below = c.parent[k];
+    const Eigen::Vector3f base = position[below];
+    // The axis below: on-axis ancestors back to four bin widths away (nodes of a winding stretch
+    // may share one position), at least two.
+    int low = below;
+    for (int step = 0; step < 16 && c.parent[low] >= 0 && on_axis[c.parent[low]] && (base - position[low]).norm() < 4.0f * bin_width;
+         ++step)
+        low = c.parent[low];
+    if ((base - position[low]).norm() < 2.0f * bin_width) return std::nullopt;
+    const Eigen::Vector3f direction = (base - position[low]).normalized();
+    const Eigen::Vector3f centroid = c.centroid(k).cast<float>();
+    const float t = (centroid - base).dot(direction);
+    if (!(t > -bin_width) || t > 2.0f * bin_width) return std::nullopt;
+    // An arc winding level with the node below: the stem has not risen.
+    const Eigen::Vector3f centre = base + std::max(t, 0.0f) * direction;
+    if ((centroid - centre).norm() > 1.5f * stem) return std::nullopt;  // beside the stem
+    const Eigen::Vector3f u = direction.unitOrthogonal(), v = direction.cross(u);
+    auto across = [&](const Eigen::Vector3f& p) { return Eigen::Vector2f((p - centre).dot(u), (p - centre).dot(v)); };
+    // The cluster's own points must lie on the ring of radius r around `axis` (in the plane).
+    auto on_ring = [&](const Eigen::Vector2f& axis, float r) {
+        const float band = std::max(2.0f * spacing, 0.4f * r);
+        std::size_t near = 0;
+        for (int i : members[k]) near += std::abs((across(points[i]) - axis).norm() - r) < band;
+        return 10 * near >= 7 * members[k].size();
+    };
+    int top = k;
+    while (c.parent[top] >= 0 && c.bin[c.parent[top]] >= c.bin[k] - reach) top = c.parent[top];
+    std::vector<Eigen::Vector2f> flat;
+    std::vector<int> stack{top};
+    while (!stack.empty()) {
+        const int x = stack.back();
+        stack.pop_back();
+        for (int i : members[x])
+            if (std::abs((points[i] - centre).dot(direction)) <= 0.5f * bin_width && across(points[i]).norm() <= 3.0f * stem)
+                flat.push_back(across(points[i]));
+        for (int y : children[x])
+            if (c.bin[y] <= c.bin[k] + reach) stack.push_back(y);
+    }
+    if (flat.size() < sparse_slab) {
+        if (extrapolated >= max_extrapolated || !on_ring(Eigen::Vector2f::Zero(), stem)) return std::nullopt;
+        // Only a straight axis is continued (a curving limb would soon leave it): the axis below
+        // must bend by less than 20 degrees between its lower and upper halves.
+        const float half = 0.5f * (base - position[low]).norm();
+        int mid = below;
+        while (mid != low && (base - position[mid]).norm() < half) mid = c.parent[mid];
+        if (mid == low || (position[mid] - position[low]).norm() < 0.25f * half) return std::nullopt;
+        const Eigen::Vector3f lower = (position[mid] - position[low]).normalized(), upper = (base - position[mid]).normalized();
+        if (lower.dot(upper) < std::cos(20.0f * std::numbers::pi_v<float> / 180.0f)) return std::nullopt;
+        return SlabFit{centre, stem, true};
+    }
+    const CircleFit circle = fit_circle(flat, std::max(0.005f, spacing), stem / 1.6f, 1.6f * stem, 100);
+    const bool trusted = circle.ok && circle.coverage >= 0.2f && circle.inliers * 2 >= flat.size() &&
+                         circle.rms < 0.25f * circle.radius && circle.centre.norm() < 0.5f * circle.radius;
+    if (!trusted) return std::nullopt;
+    return SlabFit{centre + circle.centre.x() * u + circle.centre.y() * v, circle.radius, false};
+}
+
 // Where a cluster sits on its branch axis. The centroid of a thick branch's slice lies on the
 // scanned side of the bark, not on the axis (a half-visible stem puts it 0.64 r off), so for
 // wide clusters a circle is fitted across the local branch direction and its centre used
 // when the fit is trustworthy (enough of the circle seen, small residuals).
-std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> points, const Clusters& c, float spacing, bool fit) {
+std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> points, const Clusters& c, float spacing, float bin_width,
+                                            bool fit) {
     std::vector<Eigen::Vector3f> position(c.size());
     for (std::size_t k = 0; k < c.size(); ++k) position[k] = c.centroid(static_cast<int>(k)).cast<float>();
     if (!fit) return position;
@@ -325,10 +411,27 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
     // takes its parent's (a one-sided scan is one-sided all along the stem).
     std::vector<Eigen::Vector3f> offset(c.size(), Eigen::Vector3f::Zero());
     std::vector<bool> has_offset(c.size(), false);
+    std::vector<bool> on_axis(c.size(), false);      // placed by a trusted circle or slab fit
+    std::vector<float> axis_radius(c.size(), 0.0f);  // of that circle
+    std::vector<int> extrapolated(c.size(), 0);      // consecutive slabs too sparse to fit, up to this cluster
+    std::size_t resliced = 0;
     for (std::size_t k = 0; k < c.size(); ++k) {
         // A window of three bins (parent, cluster, only child) gives the fit more of the bark.
         const int below = c.parent[k];
         const int above = children[k].size() == 1 ? children[k].front() : -1;
+        // A cluster on a thick stem whose axis is known below is placed by a slab across that
+        // axis (its own bin may be an arc of a winding geodesic); elsewhere by its own fit.
+        if (below >= 0 && on_axis[below]) {
+            if (const auto slab = slab_centre(points, c, members, children, position, on_axis, axis_radius[below],
+                                              extrapolated[below], static_cast<int>(k), spacing, bin_width)) {
+                ++resliced;
+                extrapolated[k] = slab->extrapolated ? extrapolated[below] + 1 : 0;
+                position[k] = slab->position;
+                axis_radius[k] = slab->radius;
+                on_axis[k] = true;
+                continue;
+            }
+        }
         // The branch direction over up to three clusters either side: slice centroids of a
         // one-sided scan zigzag, and a tilted projection plane smears the circle. Positions
         // below are final already (parents come first). At a branch end or a fork the last
@@ -379,10 +482,13 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
         ++moved;
         offset[k] = circle.centre.x() * u + circle.centre.y() * v;
         has_offset[k] = true;
+        on_axis[k] = true;
+        axis_radius[k] = circle.radius;
         position[k] += offset[k];
     }
     log_debug("skeleton: circle fits tried on " + std::to_string(tried) + " of " + std::to_string(c.size()) + " clusters, " +
-              std::to_string(moved) + " moved onto the fitted axis, " + std::to_string(inherited) + " took their parent's offset");
+              std::to_string(moved) + " moved onto the fitted axis, " + std::to_string(resliced) + " onto a slab fit across the axis below, " +
+              std::to_string(inherited) + " took their parent's offset");
     return position;
 }
 
@@ -602,7 +708,9 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
         given_near = &own_near;
     }
     const KnnTable& near = *given_near;
-    const NeighbourGraph graph = build_neighbour_graph(points, {o.neighbours, o.beta, o.max_edge_length, true}, &index, &near);
+    NeighbourGraphOptions graph_options{o.neighbours, o.beta, o.max_edge_length, true};
+    graph_options.direction_weight = o.bridge_direction;
+    const NeighbourGraph graph = build_neighbour_graph(points, graph_options, &index, &near);
     r.graph_components = graph.components;
     r.bridges = graph.bridges;
     r.longest_bridge = graph.longest_bridge;
@@ -650,7 +758,7 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     r.clusters = clusters.size();
     lap("bins");
 
-    TreeGraph tree = cluster_tree(clusters, axis_positions(points, clusters, r.spacing, o.fit_axes), r.base.position, root_spread);
+    TreeGraph tree = cluster_tree(clusters, axis_positions(points, clusters, r.spacing, r.bin_width, o.fit_axes), r.base.position, root_spread);
     lap("axis fits");
     std::vector<int> node_of_point(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) node_of_point[i] = clusters.of_point[i] + 1;

@@ -1,6 +1,8 @@
 // Skeleton extraction from a single-tree point cloud (seed 001 §4.1, after Xu et al. 2007 and
 // Livny et al. 2010):
-//   1. neighbour graph with edge weights ||u-v||^beta (reconstruct/neighbour_graph.hpp);
+//   1. neighbour graph with edge weights ||u-v||^beta (reconstruct/neighbour_graph.hpp); a
+//      piece cut off by an occlusion gap is bridged where its own axis leads, not sideways to
+//      the nearest bark (the straight join the skeleton draws across the gap follows the bridge);
 //   2. stem foot (reconstruct/tree_base.hpp) and two multi-source Dijkstra runs from its
 //      points: one over the weights ||u-v||^beta (the shortest-path tree of the paper) and one
 //      over Euclidean lengths (the geodesic distance, a smooth field: paths of the weighted
@@ -9,7 +11,9 @@
 //      from a first slicing at w) and each bin into connected clusters of nearby points; a
 //      cluster hangs from the lower-bin cluster that most weighted-tree edges enter it from, so
 //      the clusters form one rooted tree shaped by beta; fragments of one cross-section merge;
-//      wide slices are centred on a fitted circle (one-sided scans);
+//      wide slices are centred on a fitted circle (one-sided scans), and slices of a thick stem
+//      whose axis is known below on a circle fitted to a slab cut across that axis (where the
+//      geodesic distance winds around a sparse stem, a bin is an arc of the bark, not a ring);
 //   4. leaf chains shorter than the twig length are pruned, chains are smoothed and resampled
 //      to near-uniform internodes of length l;
 //   5. the children of every node are ordered main (largest subtree) first and nodes are
@@ -46,6 +50,7 @@ struct SkeletonOptions {
     int smoothing_iterations = 1;   // Laplacian passes over each chain (0 = none)
     int geodesic_smoothing = 3;     // neighbour-averaging passes over the geodesic field before binning
     bool fit_axes = true;           // move wide clusters onto a fitted circle centre (one-sided scans)
+    float bridge_direction = 2.0f;  // weight of the angle between a gap bridge and its piece's axis (0 = shortest bridges)
     float max_gap = 0.0f;           // metres; parts reached only across a longer gap stay out of the skeleton (0 = gap_factor x spacing)
     TreeBaseOptions base;
 };

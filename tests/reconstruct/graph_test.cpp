@@ -137,6 +137,42 @@ TEST(NeighbourGraph, PiecesAreJoinedByTheShortestBridges) {
     EXPECT_TRUE(found);
 }
 
+TEST(NeighbourGraph, ElongatedPieceJoinsAlongItsOwnAxis) {
+    // A stem (A) with a branch (B) that bends up to run 0.3 m beside it, and the branch's
+    // continuation (C) beyond a 0.4 m occlusion gap. C's nearest foreign points lie 0.3 m
+    // sideways on the stem; its own axis leads down to B's top, which is where it belongs.
+    std::vector<Eigen::Vector3f> p;
+    add_line(p, {0, 0, 0}, {0, 0, 3}, 0.01f);                 // A
+    add_line(p, {0, 0, 1}, {0.3f, 0, 1.3f}, 0.01f);           // B, joined to A
+    add_line(p, {0.3f, 0, 1.31f}, {0.3f, 0, 1.6f}, 0.01f);
+    const int c_first = static_cast<int>(p.size());
+    add_line(p, {0.3f, 0, 2.0f}, {0.3f, 0, 3.0f}, 0.01f);     // C
+    auto bridge_of_c = [&](float weight) {
+        NeighbourGraphOptions options;
+        options.neighbours = 4;
+        options.direction_weight = weight;
+        const NeighbourGraph g = build_neighbour_graph(p, options);
+        EXPECT_EQ(g.components, 2u);
+        EXPECT_EQ(g.bridges, 1u);
+        for (int v = c_first; v < static_cast<int>(p.size()); ++v)
+            for (std::uint32_t e = g.offsets[v]; e < g.offsets[v + 1]; ++e)
+                if (g.targets[e] < c_first) return std::make_pair(v, g.targets[e]);
+        return std::make_pair(-1, -1);
+    };
+    const auto [from, to] = bridge_of_c(2.0f);
+    ASSERT_GE(from, 0);
+    EXPECT_LT((p[from] - Eigen::Vector3f(0.3f, 0, 2.0f)).norm(), 1e-4f);
+    EXPECT_LT((p[to] - Eigen::Vector3f(0.3f, 0, 1.6f)).norm(), 1e-4f);
+    // The shortest bridge goes sideways to the stem.
+    const auto [side_from, side_to] = bridge_of_c(0.0f);
+    ASSERT_GE(side_from, 0);
+    EXPECT_NEAR((p[side_from] - p[side_to]).norm(), 0.3f, 1e-4f);
+    EXPECT_NEAR(p[side_to].x(), 0.0f, 1e-4f);
+    NeighbourGraphOptions bad;
+    bad.direction_weight = -1.0f;
+    EXPECT_THROW(build_neighbour_graph(p, bad), Error);
+}
+
 TEST(ShortestPaths, SingleSourceDistancesAndParents) {
     // An L: 0..1 m along x then 0..1 m along y, points 0.1 m apart.
     std::vector<Eigen::Vector3f> p;

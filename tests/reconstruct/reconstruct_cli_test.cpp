@@ -142,3 +142,16 @@ TEST(EvalCli, SkeletonAgainstItselfAndBadReference) {
     EXPECT_EQ(bad.exit_code, 2);
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
+
+TEST(ReconstructCli, RecentreOptionsReachTheSummary) {
+    TempDir dir;
+    write_y_tree(dir / "y.xyz");
+    auto recentred = [&](const std::string& flags) {
+        const auto r = run_cli("reconstruct " + quoted(dir / "y.xyz") + " --out " + quoted(dir / "out") + " --overwrite " + flags);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return nlohmann::json::parse(slurp(dir / "out" / "y_summary.json"))["tree"]["recentred_nodes"].get<int>();
+    };
+    EXPECT_EQ(recentred("--recentre false"), 0);
+    EXPECT_GT(recentred("--recentre-inside-band 0 --recentre-max-spread 0.2"), 0);  // every thin node off its centre moves
+    EXPECT_EQ(run_cli("reconstruct " + quoted(dir / "y.xyz") + " --out " + quoted(dir / "out") + " --recentre-max-spread 0").exit_code, 1);
+}

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 
 using namespace treelobes;
 using test::Segment;
@@ -114,6 +115,31 @@ TEST(Skeleton, OneSidedThickStemStaysOnItsAxis) {
     EXPECT_GT(median_error(centroids.tree), 0.12f);
 }
 
+TEST(Skeleton, StemSeenOnlyAsAHelicalStripStaysOnItsAxis) {
+    // A 0.25 m stem scanned all round below 2 m and above 3.2 m, but in between only along a
+    // strip winding twice around it (a sparse stretch where the geodesic distance climbs along
+    // the bark): every geodesic bin there is an arc, not a ring. The slab fits across the axis
+    // found below keep the skeleton on the axis; the arcs' own fits leave it on the bark.
+    std::vector<Eigen::Vector3f> points;
+    const float radius = 0.25f, pi = std::numbers::pi_v<float>;
+    for (float z = 0.0f; z <= 4.5f; z += 0.02f)
+        for (int a = 0; a < 80; ++a) {
+            const float angle = 2.0f * pi * static_cast<float>(a) / 80.0f + 0.7f * z;
+            if (z > 2.0f && z < 3.2f) {  // the strip: within 0.9 rad of angle 2 pi (z - 2) / 0.6
+                const float centre = 2.0f * pi * (z - 2.0f) / 0.6f;
+                const float off = std::remainder(angle - centre, 2.0f * pi);
+                if (std::abs(off) > 0.9f) continue;
+            }
+            points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
+        }
+    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 4.5f}, radius}};
+    const SkeletonResult r = reconstruct_skeleton(points, {});
+    float worst = 0;
+    for (const auto& node : r.tree.nodes)
+        if (node.position.z() > 2.1f && node.position.z() < 3.1f) worst = std::max(worst, test::distance_to_axes(node.position, truth));
+    EXPECT_LT(worst, 0.1f);
+}
+
 TEST(Skeleton, DetachedPieceIsBridgedIntoTheOneTree) {
     // A branch piece floating 0.25 m beside the stem (occlusion gap) still joins the tree.
     std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f}, {{0.35f, 0, 1.5f}, {1.2f, 0, 2.2f}, 0.04f}};
@@ -133,6 +159,27 @@ TEST(Skeleton, DetachedPieceIsBridgedIntoTheOneTree) {
     EXPECT_EQ(cut.tree.tip_count(), 1u);
     EXPECT_GT(cut.detached_points, 0u);
     for (int node : cut.point_internode) EXPECT_GT(node, 0);
+}
+
+TEST(Skeleton, BranchBeyondAGapContinuesAlongItsAxisNotSidewaysToTheStem) {
+    // A branch bends up to run 0.35 m beside the stem and is lost for 0.4 m (occlusion); its
+    // continuation lies closer to the stem's bark (0.24 m) than to its own lower part. The
+    // skeleton must bridge the gap along the branch, not draw a join across to the stem.
+    const std::vector<Segment> scanned{{{0, 0, 0}, {0, 0, 3}, 0.08f},
+                                       {{0, 0, 1}, {0.35f, 0, 1.35f}, 0.03f},
+                                       {{0.35f, 0, 1.35f}, {0.35f, 0, 1.6f}, 0.03f},
+                                       {{0.35f, 0, 2.0f}, {0.35f, 0, 3.0f}, 0.03f}};
+    std::vector<Segment> truth = scanned;
+    truth.push_back({{0.35f, 0, 1.6f}, {0.35f, 0, 2.0f}, 0.03f});  // the unscanned stretch
+    const PointCloud cloud = test::cloud_from(scanned, 3000);
+    const SkeletonResult r = reconstruct_skeleton(cloud.positions, {});
+    r.tree.validate("gap along the axis");
+    EXPECT_GE(r.graph_components, 2u);
+    EXPECT_LT(max_axis_error(r.tree, truth), 0.08f);
+    // Shortest bridges join the continuation sideways to the stem, through empty space.
+    SkeletonOptions shortest;
+    shortest.bridge_direction = 0.0f;
+    EXPECT_GT(max_axis_error(reconstruct_skeleton(cloud.positions, shortest).tree, truth), 0.12f);
 }
 
 TEST(Skeleton, DeterministicAndRejectsBadInput) {
