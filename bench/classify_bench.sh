@@ -72,7 +72,8 @@ for name, c in d["classifiers"].items():
     r = c["random_splits"]
     line = (f"  {name:10s} rate {100*r['average_recognition_rate']:.1f} %  trees {100*r['tree_accuracy']:.1f} %  "
             f"confident {100*r['confident_fraction']:.0f} % of trees at {100*r['confident_accuracy']:.1f} %, "
-            f"others {100*r['unconfident_accuracy']:.1f} %  train {r['train_seconds_mean']:.3f} s/split  rounds {r['mean_rounds']:.0f}")
+            f"others {100*r['unconfident_accuracy']:.1f} %  train {r['train_seconds_mean']:.3f} s/split "
+            f"({r.get('cpu_seconds_mean', 0):.2f} s CPU with prediction)  rounds {r['mean_rounds']:.0f}")
     if "voted_average_recognition_rate" in r:
         line += f"  voted {100*r['voted_average_recognition_rate']:.1f} %"
     if "site_split" in c:

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <map>
 #include <set>
 
@@ -89,6 +90,7 @@ public:
         }
         voted_ = voted != nullptr;
         train_seconds_ += run.train_seconds, predict_seconds_ += run.predict_seconds, rounds_ += run.rounds;
+        cpu_seconds_ += run.cpu_seconds;
         ++experiments_;
     }
 
@@ -120,7 +122,7 @@ public:
         s.voted = voted_;
         if (!voted_) s.voted_average_rate = 0, s.voted_species_rate.assign(classes_, 0);
         s.voted_tree_accuracy = voted_ ? ratio(voted_tree_correct_, tree_total_) : 0.0;
-        s.train_seconds = train_seconds_, s.predict_seconds = predict_seconds_;
+        s.train_seconds = train_seconds_, s.predict_seconds = predict_seconds_, s.cpu_seconds = cpu_seconds_;
         s.mean_rounds = ratio(rounds_, experiments_);
         return s;
     }
@@ -133,7 +135,7 @@ private:
     std::vector<std::vector<double>> confusion_;
     std::vector<std::vector<int>> row_predictions_;
     double tree_correct_ = 0, tree_total_ = 0, confident_correct_ = 0, confident_total_ = 0, unconfident_correct_ = 0;
-    double voted_tree_correct_ = 0, train_seconds_ = 0, predict_seconds_ = 0, rounds_ = 0;
+    double voted_tree_correct_ = 0, train_seconds_ = 0, predict_seconds_ = 0, cpu_seconds_ = 0, rounds_ = 0;
     int experiments_ = 0;
     bool voted_ = false;
 };
@@ -150,7 +152,10 @@ ClassifierRun run_experiment(const LabelledSet& set, const Classifier& classifie
         if (compact[c] == 0) compact[c] = static_cast<int>(original.size()), original.push_back(c);
     std::vector<int> y;
     for (auto r : train) y.push_back(compact[set.labels[r]]);
-    ClassifierRun run = classifier(set.features.select_rows(train), y, static_cast<int>(original.size()), set.features.select_rows(test), seed);
+    const FeatureTable train_table = set.features.select_rows(train), test_table = set.features.select_rows(test);
+    const std::clock_t cpu_start = std::clock();
+    ClassifierRun run = classifier(train_table, y, static_cast<int>(original.size()), test_table, seed);
+    run.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
     for (auto& p : run.probabilities) {
         std::vector<double> full(classes, 0.0);
         for (std::size_t k = 0; k < original.size(); ++k) full[original[k]] = p[k];

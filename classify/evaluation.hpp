@@ -46,6 +46,9 @@ std::vector<Eigen::Vector2d> planting_layout(const std::vector<int>& labels, int
 struct ClassifierRun {
     std::vector<std::vector<double>> probabilities;  // per test row
     double train_seconds = 0, predict_seconds = 0;
+    // Process CPU time of the training and prediction over all threads (set by the evaluation):
+    // unlike the wall times it does not grow when other jobs share the cores.
+    double cpu_seconds = 0;
     int rounds = 0;
 };
 // Trains on (train, labels) with `classes` classes and predicts `test`; `seed` varies per split.
@@ -78,6 +81,7 @@ struct Scores {
     double voted_average_rate = 0, voted_tree_accuracy = 0;
     std::vector<double> voted_species_rate;
     double train_seconds = 0, predict_seconds = 0;  // totals over the splits
+    double cpu_seconds = 0;                         // total CPU time of training + prediction
     double mean_rounds = 0;
     int experiments = 0;                       // splits (or groups) evaluated
     // Per row of the set: [row][predicted class] = how often it was predicted so when tested.

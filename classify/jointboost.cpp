@@ -67,6 +67,17 @@ constexpr int kMaxStackClasses = 64;
 
 // Contribution z^2/w of one side of a stump to the gain (the error is sum(w) - gain).
 inline double term(double z, double w) { return w > 0 ? z * z / w : 0.0; }
+// Per class, max(separate stump gain, K_c) for one threshold from the side sums below (wl, zl)
+// and above (wg, zg). Written without branches so that the divisions vectorise: w = 0 means every
+// weight on that side is 0, hence z = 0, and 0 / 1 gives term()'s 0.
+void class_bounds(const double* __restrict wl, const double* __restrict zl, const double* __restrict wg,
+                  const double* __restrict zg, const double* __restrict k, double* __restrict out, std::size_t classes) {
+    for (std::size_t c = 0; c < classes; ++c) {
+        const double dl = wl[c] > 0 ? wl[c] : 1.0, dg = wg[c] > 0 ? wg[c] : 1.0;
+        const double v = zg[c] * zg[c] / dg + zl[c] * zl[c] / dl;
+        out[c] = v > k[c] ? v : k[c];
+    }
+}
 
 void validate_training_input(const FeatureTable& table, const std::vector<int>& labels,
                              const std::vector<std::string>& classes) {
@@ -102,32 +113,31 @@ class RoundFitter {
 public:
     RoundFitter(const FeatureTable& table, const std::vector<int>& labels, int classes)
         : table_(table), labels_(labels), n_(table.rows()), f_(table.cols()), c_(classes),
-          weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0), order_(table.cols()) {
+          weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0), order_(table.cols()), splits_(table.cols()),
+          priority_(table.cols(), 0.0) {
         presort();
     }
 
     // Fits the stump of the next round; false when no feature has two distinct values.
     //
     // Exact branch and bound: for each threshold, separate stumps per class bound the gain of
-    // any shared stump (Cauchy-Schwarz: (sum z)^2 / sum w <= sum z^2 / w). Phase 1 computes the
-    // bounds of all thresholds; phase 2 runs the greedy sharing search only where the bound can
-    // still beat the best gain found so far, features with the highest bound first. A threshold
-    // is skipped only when it cannot win or tie, so the result equals the exhaustive search.
+    // any shared stump (Cauchy-Schwarz: (sum z)^2 / sum w <= sum z^2 / w). Each feature's side
+    // sums are accumulated once; the greedy sharing search then runs only on thresholds whose
+    // bound can still beat the best gain found so far (by any feature), highest bound first. A
+    // threshold is skipped only when it cannot win or tie, so the result equals the exhaustive
+    // search whatever the order; features are visited by their best bound of the previous round
+    // so that the best gain, and with it the pruning, rises early.
     bool fit(Stump& stump) {
         compute_class_totals();
-        std::vector<std::vector<std::pair<double, int>>> bounds(f_);  // per feature: (bound, position), best first
-        tbb::parallel_for(std::size_t(0), f_, [&](std::size_t f) { bounds[f] = threshold_bounds(f); });
         std::vector<std::size_t> visit;
         for (std::size_t f = 0; f < f_; ++f)
-            if (!bounds[f].empty()) visit.push_back(f);
+            if (!splits_[f].empty()) visit.push_back(f);
         if (visit.empty()) return false;
-        std::stable_sort(visit.begin(), visit.end(),
-                         [&](std::size_t a, std::size_t b) { return bounds[a].front().first > bounds[b].front().first; });
+        std::stable_sort(visit.begin(), visit.end(), [&](std::size_t a, std::size_t b) { return priority_[a] > priority_[b]; });
         std::vector<Candidate> per_feature(f_);
         SharedBest shared;
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, visit.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
-            for (std::size_t v = r.begin(); v != r.end(); ++v)
-                per_feature[visit[v]] = best_for_feature(visit[v], bounds[visit[v]], shared);
+            for (std::size_t v = r.begin(); v != r.end(); ++v) per_feature[visit[v]] = best_for_feature(visit[v], shared);
         });
         // Serial reduction in feature order: the lower feature index wins a tie.
         const Candidate* best = nullptr;
@@ -164,7 +174,11 @@ private:
             std::vector<int> order(n_);
             std::iota(order.begin(), order.end(), 0);
             std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return value(i, f) < value(j, f); });
-            if (n_ > 1 && value(order.front(), f) < value(order.back(), f)) order_[f] = std::move(order);
+            if (n_ > 1 && value(order.front(), f) < value(order.back(), f)) {
+                for (std::size_t t = 0; t + 1 < n_; ++t)
+                    if (value(order[t + 1], f) > value(order[t], f)) splits_[f].push_back(static_cast<int>(t));
+                order_[f] = std::move(order);
+            }
         });
     }
 
@@ -270,37 +284,28 @@ private:
         }
     }
 
-    // Gain bound of every threshold of feature f (split after sorted position t), best first;
-    // empty for a constant feature.
-    std::vector<std::pair<double, int>> threshold_bounds(std::size_t f) const {
-        std::vector<std::pair<double, int>> bounds;
-        const auto& order = order_[f];
-        if (order.empty()) return bounds;
-        thread_local std::vector<double> pw, pz, sw, sz;  // scratch reused across calls
-        side_sums(f, pw, pz, sw, sz);
-        const std::size_t cc = static_cast<std::size_t>(c_);
-        for (std::size_t t = 0; t + 1 < n_; ++t) {
-            if (!(value(order[t + 1], f) > value(order[t], f))) continue;  // not between distinct values
-            const std::size_t row = (t + 1) * cc;
-            double bound = 0;
-            for (int c = 0; c < c_; ++c)
-                bound += std::max(term(sz[row + c], sw[row + c]) + term(pz[row + c], pw[row + c]), k_gain_[c]);
-            bounds.emplace_back(bound, static_cast<int>(t));
-        }
-        // Best bound first; the rest is sorted only if the feature is visited in phase 2.
-        std::iter_swap(bounds.begin(), std::max_element(bounds.begin(), bounds.end(),
-                                                        [](const auto& a, const auto& b) { return a.first < b.first; }));
-        return bounds;
-    }
-
-    // The best stump of feature f: thresholds in decreasing order of their bound until the bound
-    // cannot beat the best gain of any feature so far.
-    Candidate best_for_feature(std::size_t f, std::vector<std::pair<double, int>>& bounds, SharedBest& shared) const {
+    // The best stump of feature f. The bound of a threshold (split after sorted position t) is
+    // the sum over classes of max(separate stump gain, K_c); thresholds whose bound cannot beat
+    // the best gain of any feature so far are dropped, the others are tried in decreasing order of
+    // their bound (ties: lower position first) until the rest cannot win.
+    Candidate best_for_feature(std::size_t f, SharedBest& shared) {
         Candidate best;
-        if (shared.beats(bounds.front().first)) return best;
-        thread_local std::vector<double> pw, pz, sw, sz;  // scratch reused across calls
+        thread_local std::vector<double> pw, pz, sw, sz, ind;  // scratch reused across calls
+        thread_local std::vector<std::pair<double, int>> bounds;
         side_sums(f, pw, pz, sw, sz);
         const std::size_t cc = static_cast<std::size_t>(c_);
+        ind.resize(cc);
+        bounds.clear();
+        double top = -kInf;
+        for (int t : splits_[f]) {
+            const std::size_t row = (static_cast<std::size_t>(t) + 1) * cc;
+            class_bounds(&pw[row], &pz[row], &sw[row], &sz[row], k_gain_.data(), ind.data(), cc);
+            double bound = 0;  // the bound only prunes, so its summation order is free
+            for (std::size_t c = 0; c < cc; ++c) bound += ind[c];
+            top = std::max(top, bound);
+            if (!shared.beats(bound)) bounds.emplace_back(bound, t);
+        }
+        priority_[f] = top;
         std::vector<int> path(cc);
         // A heap hands out thresholds by decreasing bound (ties: lower position first) and stops
         // as soon as the rest cannot win, without sorting them all.
@@ -358,6 +363,8 @@ private:
     std::vector<double> weights_;            // sample-major: weights_[i * classes + c]
     std::vector<double> signed_weights_;     // z_i^c w_i^c, same layout
     std::vector<std::vector<int>> order_;
+    std::vector<std::vector<int>> splits_;   // per feature: sorted positions t with value(t + 1) > value(t)
+    std::vector<double> priority_;           // per feature: its best bound in the previous round (visit order)
     std::vector<double> total_w_, total_z_, k_gain_;
     double k_gain_sum_ = 0;
     double loss_ = 1.0;  // mean exp(-z H), H = 0 at the start

@@ -139,6 +139,7 @@ json scores_json(const Scores& s, const std::vector<std::string>& classes) {
               {"unconfident_accuracy", s.unconfident_accuracy},
               {"train_seconds_total", s.train_seconds},
               {"train_seconds_mean", s.experiments ? s.train_seconds / s.experiments : 0.0},
+              {"cpu_seconds_mean", s.experiments ? s.cpu_seconds / s.experiments : 0.0},
               {"predict_seconds_total", s.predict_seconds},
               {"mean_rounds", s.mean_rounds}};
     if (s.voted) {
@@ -257,15 +258,16 @@ std::string report_summary(const EvaluationReport& report) {
     char line[256];
     std::snprintf(line, sizeof line, " (%.1f s)\n\n", report.seconds);
     out << line;
-    out << "| classifier | average recognition rate | tree accuracy | confident: share / accuracy | unconfident accuracy | with voting | site split | train s/split |\n"
-        << "|---|---|---|---|---|---|---|---|\n";
+    out << "| classifier | average recognition rate | tree accuracy | confident: share / accuracy | unconfident accuracy | with voting | site split | train s/split | CPU s/split |\n"
+        << "|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& c : report.classifiers) {
         const Scores& s = c.random_splits;
         out << "| " << c.name << " | " << percent(s.average_rate) << " % | " << percent(s.tree_accuracy) << " % | "
             << percent(s.confident_fraction) << " % / " << percent(s.confident_accuracy) << " % | " << percent(s.unconfident_accuracy)
             << " % | " << (s.voted ? percent(s.voted_average_rate) + " %" : std::string("-")) << " | "
             << (c.site_split.experiments > 0 ? percent(c.site_split.average_rate) + " %" : std::string("-")) << " | ";
-        std::snprintf(line, sizeof line, "%.3f", s.experiments ? s.train_seconds / s.experiments : 0.0);
+        std::snprintf(line, sizeof line, "%.3f | %.3f", s.experiments ? s.train_seconds / s.experiments : 0.0,
+                      s.experiments ? s.cpu_seconds / s.experiments : 0.0);
         out << line << " |\n";
     }
     out << "\n| species | trees |";

@@ -146,6 +146,28 @@ TEST(JointBoost, SeparatesGaussianClusters) {
     for (const auto& s : model.stumps) EXPECT_NE(s.feature, 3) << "the pure-noise feature should not be chosen";
 }
 
+// The rounds of fit_jointboost_rounds against the naive reference, stump by stump.
+void expect_rounds_match_naive(const FeatureTable& t, const std::vector<int>& y, int classes, int rounds) {
+    const auto model = fit_jointboost_rounds(t, y, class_names(classes), rounds);
+    ASSERT_EQ(model.stumps.size(), static_cast<std::size_t>(rounds));
+    std::vector<std::vector<double>> w(classes, std::vector<double>(t.rows(), 1.0));
+    for (int m = 0; m < rounds; ++m) {
+        const NaiveStump ref = naive_round(t, y, w);
+        const Stump& s = model.stumps[m];
+        SCOPED_TRACE("round " + std::to_string(m));
+        EXPECT_EQ(s.feature, ref.feature);
+        EXPECT_NEAR(s.threshold, ref.threshold, 1e-12);
+        EXPECT_EQ(s.sharing, ref.sharing);
+        EXPECT_NEAR(s.a, ref.a, 1e-9);
+        EXPECT_NEAR(s.b, ref.b, 1e-9);
+        for (int c = 0; c < classes; ++c) EXPECT_NEAR(s.k[c], ref.k[c], 1e-9);
+        // Update the reference weights with the reference stump: w <- w exp(-z h).
+        for (int c = 0; c < classes; ++c)
+            for (std::size_t i = 0; i < t.rows(); ++i)
+                w[c][i] *= std::exp(-(y[i] == c ? 1.0 : -1.0) * ref.h(c, t.at(i, ref.feature)));
+    }
+}
+
 TEST(JointBoost, FirstRoundsMatchNaiveReference) {
     // Integer-valued features create repeated values (thresholds only between distinct values).
     synth::Rng rng(5);
@@ -158,25 +180,34 @@ TEST(JointBoost, FirstRoundsMatchNaiveReference) {
         t.add_row(test::numbered("t", static_cast<std::size_t>(i)), row);
         y.push_back(c);
     }
-    const int rounds = 4;
-    const auto model = fit_jointboost_rounds(t, y, class_names(4), rounds);
-    ASSERT_EQ(model.stumps.size(), static_cast<std::size_t>(rounds));
-    std::vector<std::vector<double>> w(4, std::vector<double>(t.rows(), 1.0));
-    for (int m = 0; m < rounds; ++m) {
-        const NaiveStump ref = naive_round(t, y, w);
-        const Stump& s = model.stumps[m];
-        SCOPED_TRACE("round " + std::to_string(m));
-        EXPECT_EQ(s.feature, ref.feature);
-        EXPECT_NEAR(s.threshold, ref.threshold, 1e-12);
-        EXPECT_EQ(s.sharing, ref.sharing);
-        EXPECT_NEAR(s.a, ref.a, 1e-9);
-        EXPECT_NEAR(s.b, ref.b, 1e-9);
-        for (int c = 0; c < 4; ++c) EXPECT_NEAR(s.k[c], ref.k[c], 1e-9);
-        // Update the reference weights with the reference stump: w <- w exp(-z h).
-        for (int c = 0; c < 4; ++c)
-            for (std::size_t i = 0; i < t.rows(); ++i)
-                w[c][i] *= std::exp(-(y[i] == c ? 1.0 : -1.0) * ref.h(c, t.at(i, ref.feature)));
+    expect_rounds_match_naive(t, y, 4, 4);
+}
+
+TEST(JointBoost, ManyRoundsOverManyFeaturesMatchNaiveReference) {
+    // The fast search visits features in the order of their previous round's bound and prunes
+    // thresholds against the best gain of any feature so far; over many rounds the order changes
+    // and duplicated columns tie exactly (the lower index must win), yet every stump must be the
+    // exhaustive search's.
+    synth::Rng rng(17);
+    const int classes = 5, features = 9;
+    FeatureTable t = empty_table(features);
+    std::vector<int> y;
+    for (int i = 0; i < 45; ++i) {
+        const int c = i % classes;
+        double row[features];
+        row[0] = rng.normal() + 0.6 * c;
+        row[1] = std::floor(rng.uniform(0, 5)) + (c == 3 ? 2 : 0);
+        row[2] = rng.normal() - (c <= 1 ? 1.2 : 0.0);
+        row[3] = rng.normal();                        // noise
+        row[4] = row[2];                              // duplicate of feature 2: exact ties
+        row[5] = rng.normal() + (c == 4 ? 1.5 : 0.0);
+        row[6] = std::floor(rng.uniform(0, 3));       // few distinct values
+        row[7] = rng.normal() * (1.0 + 0.3 * c);
+        row[8] = row[0];                              // duplicate of feature 0
+        t.add_row(test::numbered("t", static_cast<std::size_t>(i)), row);
+        y.push_back(c);
     }
+    expect_rounds_match_naive(t, y, classes, 14);
 }
 
 TEST(JointBoost, ClassesWithACommonFeatureShareTheFirstStump) {
