@@ -40,6 +40,7 @@ struct ReconstructCliOptions {
     std::string mesh_format = "ply";
     bool overwrite = false;
     bool reject_non_trees = false;
+    std::string outlier_test = "auto";
     ReconstructOptions stage;
     BranchMeshOptions mesh;
 };
@@ -71,6 +72,8 @@ nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s
             {"voxel_size", o.stage.preprocess.voxel_size},
             {"outlier_neighbours", o.stage.preprocess.outlier_neighbours},
             {"outlier_sigma", o.stage.preprocess.outlier_sigma},
+            {"outlier_ratio", o.stage.preprocess.outlier_ratio},
+            {"outlier_test", o.outlier_test},
             {"ground", o.flags.ground},
             {"mesh_sides", o.mesh.sides},
             {"mesh_subdivisions", o.mesh.subdivisions}};
@@ -90,7 +93,9 @@ nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& inpu
             {"input", input.string()},
             {"options", options_json(o, s)},
             {"points", {{"input", s.input_points}, {"used", s.used_points}, {"duplicates", s.duplicates},
-                        {"outliers", s.outliers}, {"ground", s.ground_points}}},
+                        {"outliers", s.outliers}, {"ground", s.ground_points},
+                        {"outlier_test", o.stage.preprocess.outlier_neighbours == 0 ? "off" : s.local_outlier_test ? "local" : "global"},
+                        {"linear_fraction", s.linear_fraction < 0 ? nlohmann::json() : nlohmann::json(rounded(s.linear_fraction, 3))}}},
             {"tree", {{"height", rounded(s.height, 3)},
                       {"dbh", s.dbh_fitted ? nlohmann::json(rounded(s.dbh, 3)) : nlohmann::json()},
                       {"root_diameter", rounded(s.root_diameter, 3)},
@@ -163,6 +168,7 @@ int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
     if (global.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(global.threads));
     apply_species_flags(o.flags, o.stage);
+    o.stage.preprocess.outlier_test = parse_outlier_test(o.outlier_test);
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
@@ -248,6 +254,21 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
         ->check(CLI::NonNegativeNumber);
     sub->add_option("--outlier-neighbours", o.stage.preprocess.outlier_neighbours, "k of the outlier filter (0 = off)")
         ->check(CLI::Range(0, 64))->capture_default_str();
+    sub->add_option("--outlier-test", o.outlier_test,
+                    "Outlier test: global (mean k-NN distance beyond the scan's mean + --outlier-sigma deviations), local "
+                    "(beyond --outlier-ratio times the neighbours' own: keeps the sparse twigs of leafy TLS scans), auto "
+                    "(local when few points have linear neighbourhoods, as in leafy crowns)")
+        ->check(CLI::IsMember({"auto", "global", "local"}))
+        ->capture_default_str();
+    sub->add_option("--outlier-ratio", o.stage.preprocess.outlier_ratio,
+                    "Local outlier test: drop points whose mean k-NN distance exceeds this many times their neighbours' own")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    sub->add_option("--outlier-sigma", o.stage.preprocess.outlier_sigma,
+                    "Global outlier test: drop points whose mean k-NN distance exceeds the scan's mean + this many "
+                    "standard deviations")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
     sub->add_option("--mesh-sides", o.mesh.sides, "Vertices per ring of the branch mesh")->check(CLI::Range(3, 64))->capture_default_str();
     sub->add_option("--mesh-subdivisions", o.mesh.subdivisions, "Rings per internode of the branch mesh")->check(CLI::Range(1, 16))
         ->capture_default_str();

@@ -57,7 +57,7 @@ LateralCentre robust_lateral_centre(const std::vector<Eigen::Vector3d>& lateral,
 }  // namespace
 
 std::size_t recentre_internodes(TreeGraph& tree, std::span<const Eigen::Vector3f> points, std::span<const int> point_internode,
-                                const RecentreOptions& o) {
+                                const RecentreOptions& o, const std::vector<bool>& fixed) {
     if (!(o.max_spread > 0.0f) || !std::isfinite(o.max_spread)) throw Error::usage("recentre: maximum spread must be > 0");
     if (o.min_points < 1) throw Error::usage("recentre: minimum points must be >= 1");
     if (o.passes < 0 || o.passes > 20) throw Error::usage("recentre: reweighting passes must be in 0..20");
@@ -65,6 +65,7 @@ std::size_t recentre_internodes(TreeGraph& tree, std::span<const Eigen::Vector3f
     if (!(o.inside_band >= 0.0) || !std::isfinite(o.inside_band)) throw Error::usage("recentre: inside band must be >= 0");
     if (!(o.min_sigma > 0.0) || !std::isfinite(o.min_sigma)) throw Error::usage("recentre: minimum sigma must be > 0");
     if (points.size() != point_internode.size()) throw Error(ExitCode::Internal, "recentre: one internode per point expected");
+    if (!fixed.empty() && fixed.size() != tree.size()) throw Error(ExitCode::Internal, "recentre: one fixed flag per node expected");
     if (!o.enabled || tree.size() < 2) return 0;
 
     // Points grouped by internode, in input order (a counting sort: deterministic and O(n)).
@@ -85,6 +86,7 @@ std::size_t recentre_internodes(TreeGraph& tree, std::span<const Eigen::Vector3f
     std::vector<Eigen::Vector3d> lateral;
     std::size_t moved = 0;
     for (std::size_t u = 1; u < n; ++u) {
+        if (!fixed.empty() && fixed[u]) continue;
         const std::size_t count = start[u + 1] - start[u];
         if (count < static_cast<std::size_t>(o.min_points)) continue;
         const Eigen::Vector3d a = tree.nodes[tree.nodes[u].parent].position.cast<double>();

@@ -45,9 +45,11 @@ struct RecentreOptions {
 // offsets across the segment parent(u) -> u, averaged with weights that favour the densest
 // part, see recentre.cpp) when it lies outside its branch, up to dead_band x the bark's spread
 // from that centre; all measured on the input positions. `point_internode[i]` is the node at the
-// upper end of point i's internode (< 1: the point is ignored). Returns the number of nodes
-// moved. Throws Error(Usage) for options out of range.
+// upper end of point i's internode (< 1: the point is ignored). Nodes u with `fixed[u]` stay put
+// (an empty `fixed`: none): the skeleton placed them on an axis measured by circle fits, which
+// the points of their internode (often a patch of one side's bark) would only pull off. Returns
+// the number of nodes moved. Throws Error(Usage) for options out of range.
 std::size_t recentre_internodes(TreeGraph& tree, std::span<const Eigen::Vector3f> points, std::span<const int> point_internode,
-                                const RecentreOptions& options);
+                                const RecentreOptions& options, const std::vector<bool>& fixed = {});
 
 }  // namespace treelobes

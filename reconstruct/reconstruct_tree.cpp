@@ -94,6 +94,8 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     s.used_points = pre.points.size();
     s.duplicates = pre.duplicates;
     s.outliers = pre.outliers;
+    s.local_outlier_test = pre.local_outlier_test;
+    s.linear_fraction = pre.linear_fraction;
     s.ground_points = pre.ground;
     s.ground_removed = pre.ground_found;
     clock.mark("preprocess");
@@ -110,7 +112,8 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     s.longest_bridge = sk.longest_bridge;
     s.stem_visible = sk.base.stem_visible;
     if (!s.stem_visible) s.quality.flags.push_back("stem_not_visible");
-    s.recentred_nodes = recentre_internodes(sk.tree, pre.points, sk.point_internode, o.recentre);
+    // Nodes on an axis measured by circle fits stay there (see recentre.hpp).
+    s.recentred_nodes = recentre_internodes(sk.tree, pre.points, sk.point_internode, o.recentre, sk.node_on_axis);
     clock.mark("skeleton");
 
     out.trunk = fit_trunk(pre.points, sk.point_internode, sk.tree, o.trunk);

@@ -33,6 +33,8 @@ struct TreeSummary {
     std::size_t used_points = 0;
     std::size_t duplicates = 0;
     std::size_t outliers = 0;
+    bool local_outlier_test = false;  // the local outlier test ran (reconstruct/preprocess.hpp)
+    float linear_fraction = -1.0f;    // points with linear neighbourhoods, when measured (-1: not)
     std::size_t ground_points = 0;
     bool ground_removed = false;
     float height = 0.0f;           // metres from the stem foot to the highest point

@@ -316,7 +316,9 @@ Clusters merge_fragments(std::span<const Eigen::Vector3f> points, const Clusters
 // clusters near it in the cluster tree (arcs of one height lie many bins apart along the
 // winding). The circle fitted to the slab places the node when it is trustworthy and continues
 // the stem (centre within half a radius of the extrapolated axis, radius within a factor 1.6
-// of the stem's). A slab too sparse for a fit continues the axis below, for up to 16 bins, when
+// of the stem's). A slab too sparse for a fit continues the axis below, for up to 16 bin widths
+// of axis length (measured along the axis, not in clusters: the arcs of a winding stretch follow
+// one another at nearly one height), when
 // that axis is straight and the cluster's own points lie on the stem's ring (an arc of it, not
 // a branch leaving it). Stems thinner than 0.12 m keep their clusters' own fits (tried down to
 // 0.04 m: worse on archi and HS).
@@ -324,14 +326,15 @@ struct SlabFit {
     Eigen::Vector3f position;
     float radius = 0.0f;
     bool extrapolated = false;  // too sparse for a fit: on the axis below
+    float rise = 0.0f;          // metres along the axis from the node below
 };
 
 std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, const Clusters& c,
                                    const std::vector<std::vector<int>>& members, const std::vector<std::vector<int>>& children,
                                    const std::vector<Eigen::Vector3f>& position, const std::vector<bool>& on_axis, float stem,
-                                   int extrapolated, int k, float spacing, float bin_width) {
+                                   float extrapolated, int k, float spacing, float bin_width) {
     constexpr std::size_t sparse_slab = 24;  // points a slab needs for a circle fit
-    constexpr int max_extrapolated = 16;      // bins
+    constexpr float max_extrapolated = 16.0f;  // bin widths of axis length
     constexpr float min_slab_radius = 0.12f;  // metres: thinner stems keep the clusters' own fits
     constexpr int reach = 8;                 // bins either side whose clusters the slab draws from
     if (!(stem >= std::max(2.0f * spacing, min_slab_radius))) return std::nullopt;
@@ -374,7 +377,7 @@ std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, cons
             if (c.bin[y] <= c.bin[k] + reach) stack.push_back(y);
     }
     if (flat.size() < sparse_slab) {
-        if (extrapolated >= max_extrapolated || !on_ring(Eigen::Vector2f::Zero(), stem)) return std::nullopt;
+        if (extrapolated + std::max(t, 0.0f) > max_extrapolated * bin_width || !on_ring(Eigen::Vector2f::Zero(), stem)) return std::nullopt;
         // Only a straight axis is continued (a curving limb would soon leave it): the axis below
         // must bend by less than 20 degrees between its lower and upper halves.
         const float half = 0.5f * (base - position[low]).norm();
@@ -383,7 +386,7 @@ std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, cons
         if (mid == low || (position[mid] - position[low]).norm() < 0.25f * half) return std::nullopt;
         const Eigen::Vector3f lower = (position[mid] - position[low]).normalized(), upper = (base - position[mid]).normalized();
         if (lower.dot(upper) < std::cos(20.0f * std::numbers::pi_v<float> / 180.0f)) return std::nullopt;
-        return SlabFit{centre, stem, true};
+        return SlabFit{centre, stem, true, std::max(t, 0.0f)};
     }
     const CircleFit circle = fit_circle(flat, std::max(0.005f, spacing), stem / 1.6f, 1.6f * stem, 100);
     const bool trusted = circle.ok && circle.coverage >= 0.2f && circle.inliers * 2 >= flat.size() &&
@@ -395,11 +398,13 @@ std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, cons
 // Where a cluster sits on its branch axis. The centroid of a thick branch's slice lies on the
 // scanned side of the bark, not on the axis (a half-visible stem puts it 0.64 r off), so for
 // wide clusters a circle is fitted across the local branch direction and its centre used
-// when the fit is trustworthy (enough of the circle seen, small residuals).
+// when the fit is trustworthy (enough of the circle seen, small residuals). `fitted` receives,
+// per cluster, whether a trusted circle or slab fit placed it.
 std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> points, const Clusters& c, float spacing, float bin_width,
-                                            bool fit) {
+                                            bool fit, std::vector<char>& fitted) {
     std::vector<Eigen::Vector3f> position(c.size());
     for (std::size_t k = 0; k < c.size(); ++k) position[k] = c.centroid(static_cast<int>(k)).cast<float>();
+    fitted.assign(c.size(), 0);
     if (!fit) return position;
     std::vector<std::vector<int>> members(c.size()), children(c.size());
     for (std::size_t i = 0; i < points.size(); ++i) members[c.of_point[i]].push_back(static_cast<int>(i));
@@ -413,7 +418,7 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
     std::vector<bool> has_offset(c.size(), false);
     std::vector<bool> on_axis(c.size(), false);      // placed by a trusted circle or slab fit
     std::vector<float> axis_radius(c.size(), 0.0f);  // of that circle
-    std::vector<int> extrapolated(c.size(), 0);      // consecutive slabs too sparse to fit, up to this cluster
+    std::vector<float> extrapolated(c.size(), 0.0f);  // axis length over consecutive slabs too sparse to fit, up to this cluster
     std::size_t resliced = 0;
     for (std::size_t k = 0; k < c.size(); ++k) {
         // A window of three bins (parent, cluster, only child) gives the fit more of the bark.
@@ -425,7 +430,7 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
             if (const auto slab = slab_centre(points, c, members, children, position, on_axis, axis_radius[below],
                                               extrapolated[below], static_cast<int>(k), spacing, bin_width)) {
                 ++resliced;
-                extrapolated[k] = slab->extrapolated ? extrapolated[below] + 1 : 0;
+                extrapolated[k] = slab->extrapolated ? extrapolated[below] + slab->rise : 0.0f;
                 position[k] = slab->position;
                 axis_radius[k] = slab->radius;
                 on_axis[k] = true;
@@ -489,6 +494,7 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
     log_debug("skeleton: circle fits tried on " + std::to_string(tried) + " of " + std::to_string(c.size()) + " clusters, " +
               std::to_string(moved) + " moved onto the fitted axis, " + std::to_string(resliced) + " onto a slab fit across the axis below, " +
               std::to_string(inherited) + " took their parent's offset");
+    for (std::size_t k = 0; k < c.size(); ++k) fitted[k] = on_axis[k];
     return position;
 }
 
@@ -551,13 +557,22 @@ float distance_to_polyline(const TreeGraph& tree, const std::vector<int>& nodes,
     return best;
 }
 
+// Per-node flags carried through keep_nodes: a kept node keeps its flag under its new number.
+std::vector<char> kept_flags(const std::vector<char>& flags, const std::vector<bool>& keep, const std::vector<int>& new_index,
+                             std::size_t size) {
+    std::vector<char> out(size, 0);
+    for (std::size_t u = 0; u < flags.size(); ++u)
+        if (keep[u]) out[static_cast<std::size_t>(new_index[u])] = flags[u];
+    return out;
+}
+
 // Removes spurious leaf chains hanging from a fork: those whose tip stays closer than
 // `min_length` (or than twice the thickness of the fork: bark bumps and scan fragments of a
 // thick stem) to the axis the fork belongs to (the node below the fork and the fork's longest
 // chain). Never every branch of a fork: the chain holding the most points survives (at a
 // ragged branch end, a longer chain may be a few points of bark). Repeats until nothing
-// changes. Updates node_of_point.
-std::size_t prune_twigs(TreeGraph& tree, float min_length, std::vector<int>& node_of_point) {
+// changes. Updates node_of_point and the per-node flags.
+std::size_t prune_twigs(TreeGraph& tree, float min_length, std::vector<int>& node_of_point, std::vector<char>& flags) {
     std::size_t removed = 0;
     for (int round = 0; round < 20; ++round) {
         const auto chains = tree_chains(tree);
@@ -592,6 +607,7 @@ std::size_t prune_twigs(TreeGraph& tree, float min_length, std::vector<int>& nod
         std::vector<int> new_index;
         tree = keep_nodes(tree, keep, new_index);
         for (int& node : node_of_point) node = new_index[node];
+        flags = kept_flags(flags, keep, new_index, tree.size());
     }
     return removed;
 }
@@ -619,11 +635,14 @@ Eigen::Vector3f point_at(const std::vector<Eigen::Vector3f>& p, const std::vecto
 }
 
 // Resamples every chain to round(L / l) internodes of equal length; forks and tips stay
-// exact. new_of_old[old node] = new node at the upper end of the internode covering it.
-TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old) {
+// exact. new_of_old[old node] = new node at the upper end of the internode covering it. A new
+// node is flagged (new_flags) when both old nodes of the stretch it lies on are (flags).
+TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old, const std::vector<char>& flags,
+                   std::vector<char>& new_flags) {
     TreeGraph out;
     out.origin = tree.origin;
     out.add_node(tree.nodes[0].position, 0.0f, -1);
+    new_flags.assign(1, flags[0]);
     new_of_old.assign(tree.size(), -1);
     new_of_old[0] = 0;
     for (const auto& chain : tree_chains(tree)) {
@@ -643,9 +662,14 @@ TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old)
         const float step = total / static_cast<float>(m);
         std::vector<int> created(static_cast<std::size_t>(m) + 1, previous);
         for (int t = 1; t <= m; ++t) {
-            const Eigen::Vector3f pos = t == m ? p.back() : point_at(p, arc, step * static_cast<float>(t));
+            const float s = step * static_cast<float>(t);
+            const Eigen::Vector3f pos = t == m ? p.back() : point_at(p, arc, s);
             previous = out.add_node(pos, 0.0f, previous);
             created[t] = previous;
+            const std::size_t i = t == m ? chain.size() - 1
+                                         : std::clamp<std::size_t>(static_cast<std::size_t>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()), 1,
+                                                                   chain.size() - 1);
+            new_flags.push_back(flags[chain[i - 1]] && flags[chain[i]]);
         }
         for (std::size_t i = 1; i < chain.size(); ++i) {
             const int t = std::clamp(static_cast<int>(std::ceil(arc[i] / step - 1e-4f)), 1, m);
@@ -758,7 +782,13 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     r.clusters = clusters.size();
     lap("bins");
 
-    TreeGraph tree = cluster_tree(clusters, axis_positions(points, clusters, r.spacing, r.bin_width, o.fit_axes), r.base.position, root_spread);
+    std::vector<char> fitted;
+    TreeGraph tree =
+        cluster_tree(clusters, axis_positions(points, clusters, r.spacing, r.bin_width, o.fit_axes, fitted), r.base.position, root_spread);
+    // Node flags: placed on a measured axis (the root by the foot's circle fit).
+    std::vector<char> on_axis(tree.size(), 0);
+    on_axis[0] = r.base.circle_fitted;
+    for (std::size_t k = 0; k < fitted.size(); ++k) on_axis[k + 1] = fitted[k];
     lap("axis fits");
     std::vector<int> node_of_point(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) node_of_point[i] = clusters.of_point[i] + 1;
@@ -770,17 +800,21 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
         std::vector<int> new_index;
         tree = keep_nodes(tree, keep, new_index);
         for (int& node : node_of_point) node = new_index[node];
+        on_axis = kept_flags(on_axis, keep, new_index, tree.size());
     }
-    r.pruned_nodes = prune_twigs(tree, twig, node_of_point);
+    r.pruned_nodes = prune_twigs(tree, twig, node_of_point, on_axis);
     smooth_chains(tree, o.smoothing_iterations);
 
     for (auto& node : tree.nodes) node.radius = 0.0f;  // spreads served their purpose
     std::vector<int> map;
-    tree = resample(tree, r.internode_length, map);
+    std::vector<char> resampled_on_axis;
+    tree = resample(tree, r.internode_length, map, on_axis, resampled_on_axis);
     for (int& node : node_of_point) node = map[node];
     tree.order_children_by_subtree_length();
-    tree = keep_nodes(tree, std::vector<bool>(tree.size(), true), map);
+    const std::vector<bool> all(tree.size(), true);
+    tree = keep_nodes(tree, all, map);
     for (int& node : node_of_point) node = map[node];
+    on_axis = kept_flags(resampled_on_axis, all, map, tree.size());
     // The root has no internode of its own: its points belong to the first internode above it.
     const int first = tree.nodes[0].children.empty() ? 0 : tree.nodes[0].children.front();
     for (int& node : node_of_point)
@@ -790,6 +824,7 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     r.tree = std::move(tree);
     r.point_internode = std::move(node_of_point);
     r.point_geodesic = sp.length;
+    r.node_on_axis.assign(on_axis.begin(), on_axis.end());
     return r;
 }
 

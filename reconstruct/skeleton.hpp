@@ -59,6 +59,10 @@ struct SkeletonResult {
     TreeGraph tree;                     // radii are 0: reconstruct/allometry.hpp sets them
     std::vector<int> point_internode;   // per input point: node at the upper end of its internode
     std::vector<float> point_geodesic;  // per input point: geodesic distance from the stem foot (metres)
+    // Per node: placed on a branch axis measured by a trusted circle or slab fit (with the node
+    // below it). Such a node's internode may hold only a patch of one side's bark (sparse or
+    // one-sided scans of thick stems), so later re-centring on those points must leave it.
+    std::vector<bool> node_on_axis;
     TreeBase base;
     float spacing = 0.0f;               // median nearest-neighbour distance (metres)
     float bin_width = 0.0f;

@@ -140,6 +140,35 @@ TEST(Skeleton, StemSeenOnlyAsAHelicalStripStaysOnItsAxis) {
     EXPECT_LT(worst, 0.1f);
 }
 
+TEST(Skeleton, NarrowSparseStripWindingRoundAThickStemStaysOnItsAxis) {
+    // As above, but the strip is narrow (0.6 rad) and winds once per 0.8 m over 0.6 m: its slabs
+    // are too sparse for a circle fit, and the axis below is continued. The arcs it is cut into
+    // follow one another at nearly one height, so the reach of that continuation is counted along
+    // the axis (11 bins here), not in clusters (more than 16 of them).
+    std::vector<Eigen::Vector3f> points;
+    const float radius = 0.25f, pi = std::numbers::pi_v<float>;
+    for (float z = 0.0f; z <= 4.5f; z += 0.02f)
+        for (int a = 0; a < 60; ++a) {
+            const float angle = 2.0f * pi * static_cast<float>(a) / 60.0f + 0.7f * z;
+            if (z > 2.0f && z < 2.6f) {
+                const float centre = 2.0f * pi * (z - 2.0f) / 0.8f;
+                if (std::abs(std::remainder(angle - centre, 2.0f * pi)) > 0.3f) continue;
+            }
+            points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
+        }
+    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 4.5f}, radius}};
+    const SkeletonResult r = reconstruct_skeleton(points, {});
+    std::size_t inside = 0;
+    float worst = 0;
+    for (const auto& node : r.tree.nodes)
+        if (node.position.z() > 2.1f && node.position.z() < 2.5f) {
+            ++inside;
+            worst = std::max(worst, test::distance_to_axes(node.position, truth));
+        }
+    EXPECT_GT(inside, 3u);
+    EXPECT_LT(worst, 0.1f);
+}
+
 TEST(Skeleton, DetachedPieceIsBridgedIntoTheOneTree) {
     // A branch piece floating 0.25 m beside the stem (occlusion gap) still joins the tree.
     std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f}, {{0.35f, 0, 1.5f}, {1.2f, 0, 2.2f}, 0.04f}};
