@@ -132,15 +132,23 @@ int run_train(const TrainCommand& c, const GlobalOptions& global) {
         correct += std::max_element(p.begin(), p.end()) - p.begin() == set.labels[r];
     }
     const double accuracy = static_cast<double>(correct) / static_cast<double>(table.rows());
-    const json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"trees", table.rows()},
+    json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"trees", table.rows()},
                           {"features", table.cols()},    {"classes", set.classes}, {"rounds", report.rounds},
                           {"rounds_tried", report.rounds_tried}, {"temperature", report.temperature}, {"training_accuracy", accuracy}, {"seconds", seconds},
                           {"out", c.out}};
+    std::string routing;
+    if (model.routed()) {
+        summary["scan_routing"] = {{"feature", model.feature_names[model.route_feature]}, {"threshold", model.route_threshold},
+                                   {"sparse_classes", model.parts[0].classes.size()}, {"dense_classes", model.parts[1].classes.size()}};
+        routing = "  one model per scan kind: " + model.feature_names[model.route_feature] +
+                  format(" <= %.1f", model.route_threshold) + " (sparse: " + std::to_string(report.parts[0].rounds) + " rounds), above (dense: " +
+                  std::to_string(report.parts[1].rounds) + " rounds)\n";
+    }
     print(summary, global,
           "JointBoost: " + std::to_string(table.rows()) + " trees, " + std::to_string(set.classes.size()) + " species, " +
-              std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " stumps (early stop after " +
+              std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " rounds (early stop after " +
               std::to_string(report.rounds_tried) + format(", temperature %.2f", report.temperature) + "), training accuracy " + format("%.1f %%", 100 * accuracy) + " -> " + c.out +
-              format(" (%.2f s)\n", seconds));
+              format(" (%.2f s)\n", seconds) + routing);
     return 0;
 }
 
@@ -388,6 +396,12 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     t->add_option("--seed", train->options.seed, "Seed of the cross-validation folds")->capture_default_str();
     t->add_flag("--no-calibration{false}", train->options.calibrate,
                 "Keep the probability temperature at 1 instead of fitting it out of fold");
+    t->add_flag("--no-scan-routing{false}", train->options.route_by_scan,
+                "One model for all trees instead of one per scan kind (told apart by scan_point_density)");
+    t->add_flag("--refit{false}", train->options.fold_ensemble,
+                "Boost the final model again on all training trees instead of averaging the cross-validation runs");
+    t->add_flag("--average-scores{false}", train->options.average_probabilities,
+                "The fold ensemble averages its members' scores H instead of their probabilities");
     t->callback([train, &global, &job] { job = [train, &global] { return run_train(*train, global); }; });
 
     auto predict = std::make_shared<PredictCommand>();
@@ -421,6 +435,15 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
         ->check(CLI::NonNegativeNumber)->capture_default_str();
     e->add_flag("--no-calibration{false}", evaluate->jointboost.calibrate,
                 "JointBoost: keep the probability temperature at 1 instead of fitting it out of fold");
+    e->add_flag("--no-scan-routing{false}", evaluate->jointboost.route_by_scan,
+                "JointBoost: one model for all trees instead of one per scan kind (told apart by scan_point_density)");
+    e->add_option("--settled-logloss", evaluate->jointboost.settled_logloss,
+                  "JointBoost: stop when every out-of-fold tree is right at a mean log-loss below this (0 = off)")
+        ->check(CLI::NonNegativeNumber)->capture_default_str();
+    e->add_flag("--refit{false}", evaluate->jointboost.fold_ensemble,
+                "JointBoost: boost the final model again on all training trees instead of averaging the cross-validation runs");
+    e->add_flag("--average-scores{false}", evaluate->jointboost.average_probabilities,
+                "JointBoost: the fold ensemble averages its members' scores H instead of their probabilities");
     e->add_option("--layout", evaluate->layout,
                   "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
                   "replaces the dataset's positions")

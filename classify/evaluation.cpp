@@ -10,7 +10,11 @@
 #include <cmath>
 #include <ctime>
 #include <map>
+#include <mutex>
 #include <set>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace treelobes::classify {
 
@@ -205,16 +209,35 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
     report.tree_groups = set.groups;
     std::vector<ScoreAccumulator> random_acc(classifiers.size(), ScoreAccumulator(classes, set.labels.size()));
     std::vector<int> train_counts(classes, 0);
-    Progress progress("classify evaluate: random splits", static_cast<std::size_t>(options.splits));
-    for (int s = 0; s < options.splits; ++s) {
-        const std::uint64_t seed = synth::stream_seed(options.seed, static_cast<std::uint64_t>(s));
-        std::vector<std::size_t> train, test;
-        stratified_split(set.labels, classes, options.train_fraction, seed, true, train, test);
-        if (s == 0)
-            for (auto r : train) ++train_counts[set.labels[r]];
-        for (std::size_t k = 0; k < classifiers.size(); ++k)
-            score_experiment(set, test, run_experiment(set, classifiers[k].run, train, test, seed), options, random_acc[k]);
-        progress.advance();
+    const auto splits = static_cast<std::size_t>(options.splits);
+    std::vector<std::vector<std::size_t>> train(splits), test(splits);
+    std::vector<std::uint64_t> seeds(splits);
+    for (std::size_t s = 0; s < splits; ++s) {
+        seeds[s] = synth::stream_seed(options.seed, static_cast<std::uint64_t>(s));
+        stratified_split(set.labels, classes, options.train_fraction, seeds[s], true, train[s], test[s]);
+    }
+    for (auto r : train.front()) ++train_counts[set.labels[r]];
+    // The splits of one classifier run side by side (each one's training is parallel inside too,
+    // but a round of 5-fold boosting on 100-200 trees is too short to keep two cores busy): the
+    // runs are scored afterwards in split order, so the report does not depend on the threads.
+    // Their CPU time is measured for the classifier's splits together and shared out evenly.
+    Progress progress("classify evaluate: random splits", splits * classifiers.size());
+    std::mutex progress_mutex;
+    for (std::size_t k = 0; k < classifiers.size(); ++k) {
+        std::vector<ClassifierRun> runs(splits);
+        const std::clock_t cpu_start = std::clock();
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, splits, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t s = range.begin(); s != range.end(); ++s) {
+                runs[s] = run_experiment(set, classifiers[k].run, train[s], test[s], seeds[s]);
+                const std::lock_guard<std::mutex> lock(progress_mutex);
+                progress.advance();
+            }
+        });
+        const double cpu_per_split = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / static_cast<double>(splits);
+        for (std::size_t s = 0; s < splits; ++s) {
+            runs[s].cpu_seconds = cpu_per_split;
+            score_experiment(set, test[s], runs[s], options, random_acc[k]);
+        }
     }
     progress.finish();
 

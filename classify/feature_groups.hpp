@@ -27,6 +27,7 @@ struct TreeFrame {
     float major_variance = 0, minor_variance = 0;  // variances of x and y (principal axes)
     float trunk_diameter = 0;             // metres; 0 when no stem is visible (shape group sets it)
     float crown_base = 0;                 // metres (shape group sets it)
+    std::size_t input_points = 0;         // points of the input cloud (before thinning and cleaning)
     const FeatureOptions* options = nullptr;
     // One neighbour search serves the normals and the skeleton: a kd-tree over `points` and
     // their kNN table (nearest first, at least normal_neighbours and skeleton_table_width wide),
@@ -79,6 +80,8 @@ void compute_skeleton(const TreeFrame& frame, FeatureSink& out);
 void skip_skeleton(FeatureSink& out);  // zeros for every skeleton feature
 void describe_envelope(Catalogue& c);
 void compute_envelope(const TreeFrame& frame, FeatureSink& out);
+void describe_scan(Catalogue& c);
+void compute_scan(const TreeFrame& frame, FeatureSink& out);
 
 // Small statistics shared by the groups.
 float quantile(std::vector<float> values, double q);  // 0 for an empty vector

@@ -80,7 +80,7 @@ std::vector<FeatureInfo> build_catalogue() {
         {"radial", detail::describe_radial},       {"horizontal", detail::describe_horizontal},
         {"structure", detail::describe_structure}, {"normals", detail::describe_normals},
         {"hull", detail::describe_hull},           {"skeleton", detail::describe_skeleton},
-        {"envelope", detail::describe_envelope},
+        {"envelope", detail::describe_envelope},   {"scan", detail::describe_scan},
     };
     for (const auto& [group, describe] : groups) {
         detail::Catalogue catalogue(list, group);
@@ -170,6 +170,7 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
         throw Error::input(name, "too few points for shape features (" + std::to_string(cloud.size()) + ", need 50)");
     TreeFrame frame;
     frame.options = &options;
+    frame.input_points = cloud.size();
     const auto raw = thinned(cloud.positions, options.max_raw_points);
     const auto z = coordinate(raw, 2);
     const float base = detail::quantile(z, 0.001), rough_height = detail::quantile(z, 0.999) - base;
@@ -268,6 +269,7 @@ std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptio
     t.skeleton = seconds_since(start);
     start = Clock::now();
     detail::compute_envelope(frame, out);
+    detail::compute_scan(frame, out);
     t.points += seconds_since(start);
     if (values.size() != feature_catalogue().size())
         throw Error(ExitCode::Internal, "feature extraction produced " + std::to_string(values.size()) + " of " +

@@ -8,7 +8,8 @@
 // tree is moved or turned about the vertical. Density: the points are first reduced to one per
 // voxel of a size proportional to the tree height, and features are distributions (fractions,
 // quantiles, moments, angles) of those voxel points, so a thinned scan gives nearly the same
-// vector. Only the trunk diameter and the point-count variation read the raw points.
+// vector. Only the trunk diameter and the point-count variation read the raw points; the scan
+// group's point density is the one feature that follows the density on purpose (routing only).
 #pragma once
 
 #include "core/point_cloud.hpp"
@@ -30,8 +31,8 @@ struct FeatureOptions {
 
 struct FeatureInfo {
     std::string name;
-    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton, envelope
-    std::string unit;         // "m", "deg", "1" (dimensionless), "count", "1/m"
+    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton, envelope, scan
+    std::string unit;         // "m", "deg", "1" (dimensionless), "count", "1/m", "1/m^2"
     std::string description;  // how it is computed
 };
 
@@ -48,6 +49,12 @@ struct FeatureTimings {
 // cloud has too few points or is too flat to be a tree.
 std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptions& options = {},
                                      const std::string& name = {}, FeatureTimings* timings = nullptr);
+
+// The scan group's feature: input points per m^2 of crown cover. It tells the scan kind (airborne
+// or terrestrial), changes with the point density by design, and is never a classifier feature.
+inline constexpr const char* kScanDensityFeature = "scan_point_density";
+// True for features that describe the scan rather than the tree (the classifiers skip them).
+bool is_scan_descriptor(const std::string& feature_name);
 
 // docs/features.md as generated from the catalogue (a test keeps the committed file in sync).
 std::string features_markdown();

@@ -1,5 +1,6 @@
 #include "classify/jointboost.hpp"
 
+#include "classify/features.hpp"
 #include "classify/splits.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -28,9 +29,18 @@ void Stump::finalise(int classes) {
 }
 
 std::vector<double> probabilities_from_scores(const std::vector<double>& scores, double temperature) {
+    // In logs, relative to the largest: when every class scores far below zero (an ensemble
+    // member wrong about a tree, a low temperature) each sigma(t) underflows to 0 and the plain
+    // ratio would be 0 / 0. log sigma(t) = -log(1 + e^-t), evaluated without overflow.
     std::vector<double> p(scores.size());
+    double top = -std::numeric_limits<double>::infinity();
+    for (std::size_t c = 0; c < scores.size(); ++c) {
+        const double t = 2.0 * scores[c] / temperature;
+        p[c] = t > 0 ? -std::log1p(std::exp(-t)) : t - std::log1p(std::exp(t));
+        top = std::max(top, p[c]);
+    }
     double sum = 0;
-    for (std::size_t c = 0; c < scores.size(); ++c) sum += p[c] = 1.0 / (1.0 + std::exp(-2.0 * scores[c] / temperature));
+    for (double& v : p) sum += v = std::isfinite(top) ? std::exp(v - top) : 1.0;
     for (double& v : p) v /= sum;
     return p;
 }
@@ -47,8 +57,23 @@ double fit_temperature(const std::vector<std::vector<double>>& scores, const std
     return best_t;
 }
 
+std::size_t JointBoostModel::part_index(const double* features) const {
+    return features[route_feature] <= route_threshold ? 0 : 1;
+}
+
 std::vector<double> JointBoostModel::scores(const double* features) const {
+    if (routed()) {
+        const std::size_t k = part_index(features);
+        const auto part = parts[k].scores(features);
+        std::vector<double> h(classes.size(), -std::numeric_limits<double>::infinity());
+        for (std::size_t c = 0; c < part.size(); ++c) h[part_class_ids[k][c]] = part[c];
+        return h;
+    }
     std::vector<double> h(classes.size(), 0.0);
+    for (const auto& member : members) {
+        const auto m = member.scores(features);
+        for (std::size_t c = 0; c < h.size(); ++c) h[c] += m[c] / static_cast<double>(members.size());
+    }
     for (const auto& s : stumps) {
         const auto& values = features[s.feature] > s.threshold ? s.above : s.below;
         for (std::size_t c = 0; c < h.size(); ++c) h[c] += values[c];
@@ -57,6 +82,21 @@ std::vector<double> JointBoostModel::scores(const double* features) const {
 }
 
 std::vector<double> JointBoostModel::probabilities(const double* features) const {
+    if (routed()) {
+        const std::size_t k = part_index(features);
+        const auto part = parts[k].probabilities(features);
+        std::vector<double> p(classes.size(), 0.0);
+        for (std::size_t c = 0; c < part.size(); ++c) p[part_class_ids[k][c]] = part[c];
+        return p;
+    }
+    if (!members.empty()) {
+        std::vector<double> p(classes.size(), 0.0);
+        for (const auto& member : members) {
+            const auto m = probabilities_from_scores(member.scores(features), temperature);
+            for (std::size_t c = 0; c < p.size(); ++c) p[c] += m[c] / static_cast<double>(members.size());
+        }
+        return p;
+    }
     return probabilities_from_scores(scores(features), temperature);
 }
 
@@ -168,9 +208,10 @@ private:
     double value(std::size_t i, std::size_t f) const { return table_.at(i, f); }
 
     // Sample indices sorted by each feature (stable: equal values keep row order). Constant
-    // features get an empty order and are never split.
+    // features and the scan descriptor get an empty order and are never split.
     void presort() {
         tbb::parallel_for(std::size_t(0), f_, [&](std::size_t f) {
+            if (is_scan_descriptor(table_.feature_names[f])) return;
             std::vector<int> order(n_);
             std::iota(order.begin(), order.end(), 0);
             std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return value(i, f) < value(j, f); });
@@ -425,10 +466,11 @@ JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vect
     return model;
 }
 
-JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels,
-                                 const std::vector<std::string>& classes, const JointBoostOptions& options,
-                                 JointBoostReport* report) {
-    validate_training_input(table, labels, classes);
+namespace {
+
+// One model (no routing): early stopping by K-fold cross-validation, calibration, final model.
+JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& labels, const std::vector<std::string>& classes,
+                             const JointBoostOptions& options, JointBoostReport* report) {
     if (options.max_rounds < 1) throw Error::usage("JointBoost: max_rounds must be at least 1");
     if (options.folds < 0) throw Error::usage("JointBoost: the number of folds must not be negative");
     JointBoostReport local;
@@ -494,6 +536,7 @@ JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<in
         r.validation_error.push_back(static_cast<double>(errors) / static_cast<double>(labels.size()));
         r.validation_logloss.push_back(score.second);
         if (score.first <= best.first) best = score, best_rounds = m + 1;
+        if (score.first == 0 && score.second < options.settled_logloss) break;
         if (options.patience > 0 && m + 1 - best_rounds >= options.patience) break;
     }
     r.rounds_tried = static_cast<int>(r.validation_error.size());
@@ -518,34 +561,142 @@ JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<in
     // The fold runs learnt from (K-1)/K of the trees; boosting on all of them needs about K/(K-1)
     // times the rounds to reach the same fit (measured: 98.2 % at 300 rounds against 97.4 % at the
     // ~170 rounds the folds chose, 480-tree set, 10 splits).
-    const int final_rounds = best_rounds;
-    JointBoostModel model = fit_jointboost_rounds(table, labels, classes, final_rounds);
+    JointBoostModel model;
+    if (options.fold_ensemble) {
+        model.classes = classes;
+        model.feature_names = table.feature_names;
+        const double share = options.average_probabilities ? 1.0 : 1.0 / folds;
+        if (options.average_probabilities) model.members.resize(folds, model);
+        for (int k = 0; k < folds; ++k)
+            for (std::size_t m = 0; m < std::min<std::size_t>(best_rounds, fold_stumps[k].size()); ++m) {
+                Stump s = fold_stumps[k][m];
+                s.a *= share, s.b *= share;
+                for (double& v : s.k) v *= share;
+                s.finalise(class_count);
+                (options.average_probabilities ? model.members[k].stumps : model.stumps).push_back(std::move(s));
+            }
+    } else {
+        model = fit_jointboost_rounds(table, labels, classes, best_rounds);
+    }
     model.temperature = r.temperature = temperature;
-    r.rounds = static_cast<int>(model.stumps.size());
+    r.rounds = options.fold_ensemble ? best_rounds : static_cast<int>(model.stumps.size());
     return model;
 }
 
-void save_jointboost(const JointBoostModel& model, const std::filesystem::path& path) {
+}  // namespace
+
+std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std::vector<int>& labels,
+                                           const JointBoostOptions& options) {
+    const auto column = std::find(table.feature_names.begin(), table.feature_names.end(), kScanDensityFeature);
+    if (!options.route_by_scan || column == table.feature_names.end()) return {-1, 0.0};
+    const auto f = static_cast<std::size_t>(column - table.feature_names.begin());
+    std::vector<std::pair<double, std::size_t>> density;  // (log10 density, row)
+    for (std::size_t r = 0; r < table.rows(); ++r) density.emplace_back(std::log10(std::max(table.at(r, f), 1e-12)), r);
+    std::sort(density.begin(), density.end());
+    const std::size_t n = density.size(), min_trees = static_cast<std::size_t>(std::max(1, options.route_min_trees));
+    std::size_t cut = 0;  // the split lies between sorted positions cut - 1 and cut
+    double widest = std::log10(std::max(options.route_min_ratio, 1.0));
+    for (std::size_t i = min_trees; i + min_trees <= n; ++i)
+        if (const double gap = density[i].first - density[i - 1].first; gap >= widest && gap > 0) widest = gap, cut = i;
+    if (cut == 0) return {-1, 0.0};
+    for (auto [begin, end] : {std::pair<std::size_t, std::size_t>{0, cut}, {cut, n}}) {
+        std::vector<char> seen(labels.empty() ? 0 : *std::max_element(labels.begin(), labels.end()) + 1, 0);
+        int distinct = 0;
+        for (std::size_t i = begin; i < end; ++i) distinct += !seen[labels[density[i].second]]++;
+        if (distinct < 2) return {-1, 0.0};
+    }
+    return {static_cast<int>(f), std::pow(10.0, (density[cut - 1].first + density[cut].first) / 2)};
+}
+
+JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels,
+                                 const std::vector<std::string>& classes, const JointBoostOptions& options,
+                                 JointBoostReport* report) {
+    validate_training_input(table, labels, classes);
+    JointBoostReport local;
+    JointBoostReport& r = report ? *report : local;
+    const auto [route_feature, threshold] = choose_scan_routing(table, labels, options);
+    if (route_feature < 0) return train_single(table, labels, classes, options, &r);
+
+    JointBoostModel model;
+    model.classes = classes;
+    model.feature_names = table.feature_names;
+    model.route_feature = route_feature;
+    model.route_threshold = threshold;
+    r = {};
+    r.temperature = 0;
+    for (int side = 0; side < 2; ++side) {
+        std::vector<std::size_t> rows;
+        for (std::size_t i = 0; i < table.rows(); ++i)
+            if ((table.at(i, route_feature) <= threshold) == (side == 0)) rows.push_back(i);
+        // The part's classes: those present on its side, in the order of `classes`.
+        std::vector<int> compact(classes.size(), -1), ids;
+        for (auto i : rows) compact[labels[i]] = 0;
+        std::vector<std::string> names;
+        for (std::size_t c = 0; c < classes.size(); ++c)
+            if (compact[c] == 0) compact[c] = static_cast<int>(ids.size()), ids.push_back(static_cast<int>(c)), names.push_back(classes[c]);
+        std::vector<int> y;
+        for (auto i : rows) y.push_back(compact[labels[i]]);
+        JointBoostReport part_report;
+        model.parts.push_back(train_single(table.select_rows(rows), y, names, options, &part_report));
+        model.part_class_ids.push_back(std::move(ids));
+        r.rounds += part_report.rounds, r.rounds_tried += part_report.rounds_tried;
+        r.temperature += part_report.temperature / 2;
+        r.parts.push_back(std::move(part_report));
+    }
+    return model;
+}
+
+namespace {
+
+constexpr const char* kProbabilityMapping = "p_c = sigma(2 H_c / T) / sum_c' sigma(2 H_c' / T), sigma(t) = 1/(1+exp(-t))";
+
+nlohmann::json stumps_json(const JointBoostModel& model) {
     nlohmann::json stumps = nlohmann::json::array();
     for (const auto& s : model.stumps)
         stumps.push_back({{"feature", s.feature}, {"threshold", s.threshold}, {"a", s.a}, {"b", s.b},
                           {"sharing", s.sharing}, {"k", s.k}});
-    const nlohmann::json doc = {
+    return stumps;
+}
+
+// Temperature, stumps and (ensembles) the members' stumps of a single model.
+void add_single(const JointBoostModel& model, nlohmann::json& doc) {
+    doc["temperature"] = model.temperature;
+    doc["stumps"] = stumps_json(model);
+    if (model.members.empty()) return;
+    doc["members"] = nlohmann::json::array();
+    for (const auto& member : model.members) doc["members"].push_back({{"stumps", stumps_json(member)}});
+}
+
+}  // namespace
+
+void save_jointboost(const JointBoostModel& model, const std::filesystem::path& path) {
+    nlohmann::json doc = {
         {"format", "treelobes-jointboost"},
         {"version", kJointBoostModelVersion},
-        {"probability", "p_c = sigma(2 H_c / T) / sum_c' sigma(2 H_c' / T), sigma(t) = 1/(1+exp(-t))"},
-        {"temperature", model.temperature},
+        {"probability", kProbabilityMapping},
         {"classes", model.classes},
         {"features", model.feature_names},
-        {"stumps", stumps},
     };
+    if (!model.routed()) {
+        add_single(model, doc);
+    } else {
+        doc["routing"] = {{"feature", model.feature_names[model.route_feature]},
+                          {"threshold", model.route_threshold},
+                          {"rule", "feature <= threshold: models[0] (sparser scans), otherwise models[1]"}};
+        nlohmann::json parts = nlohmann::json::array();
+        for (std::size_t k = 0; k < model.parts.size(); ++k) {
+            nlohmann::json part = {{"scan", k == 0 ? "sparse" : "dense"}, {"classes", model.parts[k].classes}};
+            add_single(model.parts[k], part);
+            parts.push_back(std::move(part));
+        }
+        doc["models"] = parts;
+    }
     write_file_atomically(path, doc.dump(1) + "\n");
 }
 
 namespace {
 
-Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const std::string& file, std::size_t index) {
-    const std::string where = "stump " + std::to_string(index) + ": ";
+Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const std::string& file, const std::string& where) {
     Stump s;
     s.feature = j.at("feature").get<int>();
     s.threshold = j.at("threshold").get<double>();
@@ -565,6 +716,59 @@ Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const s
     return s;
 }
 
+// Temperature and stumps of a single model (`model` has its classes and feature names).
+void parse_single(const nlohmann::json& j, int version, JointBoostModel& model, const std::string& file, const std::string& where) {
+    if (model.classes.size() < 2) throw Error::input(file, where + "fewer than two classes");
+    if (version >= 2) model.temperature = j.at("temperature").get<double>();
+    if (!(model.temperature > 0) || !std::isfinite(model.temperature)) throw Error::input(file, where + "the temperature must be positive");
+    const auto& stumps = j.at("stumps");
+    if (!stumps.is_array()) throw Error::input(file, where + "\"stumps\" is not an array");
+    for (std::size_t m = 0; m < stumps.size(); ++m)
+        model.stumps.push_back(parse_stump(stumps[m], model, file, where + "stump " + std::to_string(m) + ": "));
+    if (version < 3 || !j.contains("members")) return;
+    const auto& members = j.at("members");
+    if (!members.is_array() || members.empty()) throw Error::input(file, where + "\"members\" is not a non-empty array");
+    for (std::size_t k = 0; k < members.size(); ++k) {
+        JointBoostModel member;
+        member.classes = model.classes;
+        member.feature_names = model.feature_names;
+        const auto& list = members[k].at("stumps");
+        if (!list.is_array()) throw Error::input(file, where + "member " + std::to_string(k) + ": \"stumps\" is not an array");
+        for (std::size_t m = 0; m < list.size(); ++m)
+            member.stumps.push_back(parse_stump(list[m], member, file, where + "member " + std::to_string(k) + " stump " + std::to_string(m) + ": "));
+        model.members.push_back(std::move(member));
+    }
+}
+
+void parse_routing(const nlohmann::json& doc, JointBoostModel& model, const std::string& file) {
+    const auto& routing = doc.at("routing");
+    const auto name = routing.at("feature").get<std::string>();
+    const auto it = std::find(model.feature_names.begin(), model.feature_names.end(), name);
+    if (it == model.feature_names.end()) throw Error::input(file, "routing feature '" + name + "' is not among the features");
+    model.route_feature = static_cast<int>(it - model.feature_names.begin());
+    model.route_threshold = routing.at("threshold").get<double>();
+    if (!std::isfinite(model.route_threshold)) throw Error::input(file, "routing threshold is not finite");
+    const auto& parts = doc.at("models");
+    if (!parts.is_array() || parts.size() != 2) throw Error::input(file, "a routed model needs exactly two \"models\"");
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        const std::string where = "models[" + std::to_string(k) + "]: ";
+        JointBoostModel part;
+        part.classes = parts[k].at("classes").get<std::vector<std::string>>();
+        part.feature_names = model.feature_names;
+        std::vector<int> ids;
+        for (const auto& c : part.classes) {
+            const auto found = std::find(model.classes.begin(), model.classes.end(), c);
+            if (found == model.classes.end()) throw Error::input(file, where + "class '" + c + "' is not among the classes");
+            const int id = static_cast<int>(found - model.classes.begin());
+            if (std::find(ids.begin(), ids.end(), id) != ids.end()) throw Error::input(file, where + "class '" + c + "' twice");
+            ids.push_back(id);
+        }
+        parse_single(parts[k], kJointBoostModelVersion, part, file, where);
+        model.parts.push_back(std::move(part));
+        model.part_class_ids.push_back(std::move(ids));
+    }
+}
+
 }  // namespace
 
 JointBoostModel load_jointboost(const std::filesystem::path& path) {
@@ -581,18 +785,16 @@ JointBoostModel load_jointboost(const std::filesystem::path& path) {
     if (!doc.contains("version") || !doc["version"].is_number_integer())
         throw Error::input(file, "the model has no integer \"version\"");
     const int version = doc["version"].get<int>();
-    if (version != kJointBoostModelVersion && version != 1)
-        throw Error::input(file, "model version " + std::to_string(version) + " is not supported (this build reads version " +
+    if (version < 1 || version > kJointBoostModelVersion)
+        throw Error::input(file, "model version " + std::to_string(version) + " is not supported (this build reads versions 1 to " +
                                      std::to_string(kJointBoostModelVersion) + ")");
     JointBoostModel model;
     try {
         model.classes = doc.at("classes").get<std::vector<std::string>>();
         model.feature_names = doc.at("features").get<std::vector<std::string>>();
         if (model.classes.size() < 2) throw Error::input(file, "fewer than two classes");
-        if (version >= 2) model.temperature = doc.at("temperature").get<double>();
-        if (!(model.temperature > 0) || !std::isfinite(model.temperature)) throw Error::input(file, "the temperature must be positive");
-        const auto& stumps = doc.at("stumps");
-        for (std::size_t m = 0; m < stumps.size(); ++m) model.stumps.push_back(parse_stump(stumps[m], model, file, m));
+        if (version >= 3 && doc.contains("routing")) parse_routing(doc, model, file);
+        else parse_single(doc, version, model, file, "");
     } catch (const nlohmann::json::exception& e) {
         throw Error::input(file, std::string("malformed JointBoost model: ") + e.what());
     }

@@ -31,6 +31,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace treelobes::classify {
@@ -46,10 +47,33 @@ struct JointBoostOptions {
     // serves for validation once, which matters with ten or twenty trees per species: a single
     // held-out fifth stops at a noisy, far too early round. folds < 2 disables early stopping
     // (max_rounds are used, T = 1).
-    int folds = 3;
-    int patience = 100;
+    int folds = 5;
+    int patience = 50;
+    // Stop as soon as every out-of-fold tree is right and their mean log-loss (T = 1) is below
+    // this: nothing is left to learn out of fold, and more rounds only sharpen margins that the
+    // fitted temperature undoes (terrestrial scans reach it after ~100 rounds instead of running
+    // to max_rounds on ever smaller log-loss gains). 0 disables it.
+    double settled_logloss = 0.01;
     // Fit the temperature T on the out-of-fold scores at the chosen round (false: T = 1).
     bool calibrate = true;
+    // The final model: true = the K fold runs cut at the chosen round, averaged (H = mean of
+    // their H; their stumps with a, b, k divided by K), which needs no extra boosting run and
+    // whose members disagree on the doubtful trees; false = boosting again on all training trees
+    // for the chosen number of rounds (one sharper model).
+    bool fold_ensemble = true;
+    // With the fold ensemble: average the members' probabilities (their mixture: members that
+    // disagree leave the tree doubtful, so the confidence rule sends it to the vote) instead of
+    // their scores H (one stump list, whose sum can stay confident when members disagree).
+    bool average_probabilities = true;
+    // Routing by scan kind: when the table has the scan descriptor (kScanDensityFeature) and the
+    // training trees' densities fall into two clusters (the widest gap between consecutive log
+    // densities is at least a factor route_min_ratio, with route_min_trees trees or more and two
+    // or more classes on each side), one sub-model is trained per side and each tree is routed
+    // by its density, the threshold being the geometric mean of the gap's ends. Chosen on the
+    // training trees only; otherwise one model. The descriptor is never a stump feature.
+    bool route_by_scan = true;
+    double route_min_ratio = 3.0;
+    int route_min_trees = 20;
     std::uint64_t seed = 1;            // fold assignment
 };
 
@@ -71,8 +95,25 @@ struct JointBoostModel {
     std::vector<Stump> stumps;
     double temperature = 1.0;                // T of the probability mapping
 
+    // Routing by scan kind (empty `parts`: a single model). A tree whose feature route_feature is
+    // <= route_threshold goes to parts[0] (the sparser scans: airborne), the others to parts[1].
+    // Each part is a single model over the same feature_names whose classes are a subset of
+    // `classes` (part_class_ids maps them); the classes it lacks get probability 0.
+    int route_feature = -1;
+    double route_threshold = 0;
+    std::vector<JointBoostModel> parts;
+    std::vector<std::vector<int>> part_class_ids;
+    // Ensemble of members (empty: none): the probabilities are the mean of the members'
+    // probabilities, each at this model's temperature; H the mean of their H. `stumps` is then
+    // empty.
+    std::vector<JointBoostModel> members;
+
     int class_count() const { return static_cast<int>(classes.size()); }
-    // H(v, c) for one feature vector (length feature_names.size()).
+    bool routed() const { return !parts.empty(); }
+    // The part serving a feature vector (routed models only).
+    std::size_t part_index(const double* features) const;
+    // H(v, c) for one feature vector (length feature_names.size()); routed: the part's H, and
+    // -infinity for the classes the part lacks.
     std::vector<double> scores(const double* features) const;
     // Normalised logistic of 2H / T (see above); sums to 1.
     std::vector<double> probabilities(const double* features) const;
@@ -86,14 +127,16 @@ std::vector<double> probabilities_from_scores(const std::vector<double>& scores,
 double fit_temperature(const std::vector<std::vector<double>>& scores, const std::vector<int>& labels);
 
 struct JointBoostReport {
-    int rounds = 0;                          // stumps in the returned model
+    int rounds = 0;                          // boosting rounds of the returned model (fold ensemble: of each member)
     int rounds_tried = 0;                    // rounds run before early stopping
-    double temperature = 1.0;                // fitted T (1 without calibration)
+    double temperature = 1.0;                // fitted T (1 without calibration; routed: the parts' mean)
     // After each round tried: mean exp(-z H) over trees and classes (the fold runs' mean with
     // cross-validation), and the out-of-fold error rate and mean log-loss (T = 1).
     std::vector<double> training_loss;
     std::vector<double> validation_error;
     std::vector<double> validation_logloss;
+    // Routed models: the report of each part (rounds and rounds_tried above are their sums).
+    std::vector<JointBoostReport> parts;
 };
 
 // Trains on `table` with class ids `labels` (0..classes.size()-1, one per row). Throws
@@ -108,11 +151,19 @@ JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vect
                                       const std::vector<std::string>& classes, int rounds,
                                       std::vector<double>* training_loss = nullptr);
 
-// Model file: JSON with "format": "treelobes-jointboost", "version": 2, the class and feature
-// names, the probability mapping with its temperature and the stumps. Written atomically; the
-// reader also takes version 1 files (no temperature: T = 1), checks the format, version and every
-// index and throws Error::input naming the file otherwise.
-inline constexpr int kJointBoostModelVersion = 2;
+// The scan routing train_jointboost would choose for these training trees: the column of the scan
+// descriptor and the density threshold, or route_feature = -1 (one model).
+std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std::vector<int>& labels,
+                                           const JointBoostOptions& options);
+
+// Model file: JSON with "format": "treelobes-jointboost", "version": 3, the class and feature
+// names, the probability mapping, and either the temperature and stumps (and, for an ensemble
+// averaging probabilities, "members": one {stumps} each) of a single model, or "routing"
+// (feature name, threshold) with "models": one {scan, classes, temperature, stumps[, members]}
+// per scan kind. Written atomically; the reader also takes version 2 (single model) and 1 (no
+// temperature: T = 1) files, checks the format, version and every index and name and throws
+// Error::input naming the file otherwise.
+inline constexpr int kJointBoostModelVersion = 3;
 void save_jointboost(const JointBoostModel& model, const std::filesystem::path& path);
 JointBoostModel load_jointboost(const std::filesystem::path& path);
 

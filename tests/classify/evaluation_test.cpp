@@ -13,6 +13,7 @@
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -137,6 +138,41 @@ TEST(ClassifyEvaluation, PerSpeciesRatesConfusionAndSplitCounts) {
     EXPECT_EQ(bad.species_rate, (std::vector<double>{1.0, 0.0, 0.0}));
     EXPECT_NEAR(bad.average_rate, 1.0 / 3, 1e-12);
     for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(bad.confusion[c][0], 7.0 * 5);
+}
+
+// The splits run side by side; the report is scored in split order, so it is the same with one
+// thread as with many (JointBoost with a cross-validation ensemble, noisy classes so that some
+// trees are wrong and unconfident).
+TEST(ClassifyEvaluation, ParallelSplitsGiveTheSameReportAsOneThread) {
+    const LabelledSet set = clustered_set(4, 12, 1.2, true, 3);
+    EvaluationOptions options;
+    options.splits = 6;
+    JointBoostOptions jb;
+    jb.fold_ensemble = true;
+    jb.max_rounds = 60;
+    const NamedClassifier jointboost = {"JointBoost", [jb](const FeatureTable& train, const std::vector<int>& y, int classes,
+                                                           const FeatureTable& test, std::uint64_t seed) {
+        JointBoostOptions o = jb;
+        o.seed = seed;
+        std::vector<std::string> names;
+        for (int c = 0; c < classes; ++c) names.push_back(std::to_string(c));
+        const auto model = train_jointboost(train, y, names, o);
+        ClassifierRun run;
+        for (std::size_t r = 0; r < test.rows(); ++r) run.probabilities.push_back(model.probabilities(test.row(r)));
+        return run;
+    }};
+    const auto many = evaluate(set, {jointboost}, options).classifiers[0].random_splits;
+    Scores one;
+    {
+        tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
+        one = evaluate(set, {jointboost}, options).classifiers[0].random_splits;
+    }
+    EXPECT_EQ(many.row_predictions, one.row_predictions);
+    EXPECT_EQ(many.confusion, one.confusion);
+    EXPECT_EQ(many.voted_species_rate, one.voted_species_rate);
+    EXPECT_EQ(many.confident_fraction, one.confident_fraction);
+    EXPECT_LT(many.average_rate, 1.0);
+    EXPECT_GT(many.average_rate, 0.5);
 }
 
 TEST(ClassifyEvaluation, AverageRateIsTheMeanOfSpeciesRatesNotTreeAccuracy) {

@@ -101,7 +101,7 @@ TEST(ClassifyFeatures, CatalogueHasMoreThan200DocumentedUniqueFeatures) {
     const auto& catalogue = feature_catalogue();
     EXPECT_GT(catalogue.size(), 200u);
     std::set<std::string> names;
-    const std::set<std::string> units = {"m", "deg", "1", "count", "1/m"};
+    const std::set<std::string> units = {"m", "deg", "1", "count", "1/m", "1/m^2"};
     for (const auto& f : catalogue) {
         EXPECT_TRUE(names.insert(f.name).second) << "duplicate feature " << f.name;
         EXPECT_TRUE(units.count(f.unit)) << f.name << " has unit '" << f.unit << "'";
@@ -170,6 +170,30 @@ TEST(ClassifyFeatures, NearlyTheSameVectorAtHalfTheDensity) {
                                  "profile_shape_10", "hull_cylinder_ratio"})
             EXPECT_NEAR(feature(half, name), feature(vectors[s], name), 0.05 * std::abs(feature(vectors[s], name)) + 1e-3) << name;
     }
+}
+
+// The scan descriptor follows the point density on purpose (it routes trees to the model of
+// their scan kind) and nothing else: the same tree moved or turned keeps it, half the points
+// halve it. It is the only feature whose name is_scan_descriptor() accepts.
+TEST(ClassifyFeatures, ScanDensityHalvesWithHalfThePointsAndIgnoresPose) {
+    const auto& vectors = species_vectors();
+    for (std::size_t s = 0; s < 2; ++s) {
+        SCOPED_TRACE(kSpecies[s]);
+        const double full = feature(vectors[s], kScanDensityFeature);
+        const auto cloud = tree(kSpecies[s]);
+        const double per_disc = static_cast<double>(cloud.size()) / (3.14159265358979 * std::pow(feature(vectors[s], "crown_radius"), 2));
+        EXPECT_NEAR(full, per_disc, 1e-6 * per_disc);
+        EXPECT_GT(full, 1000.0) << "a terrestrial scan";
+        const auto turned = compute_features(transformed(cloud, 37, {120.0f, -80.0f, 15.0f}));
+        EXPECT_NEAR(feature(turned, kScanDensityFeature), full, 0.03 * full);
+        const double half = feature(compute_features(random_half(cloud, 4)), kScanDensityFeature);
+        EXPECT_GT(half, 0.45 * full);
+        EXPECT_LT(half, 0.55 * full);
+    }
+    int descriptors = 0;
+    for (const auto& name : feature_names()) descriptors += is_scan_descriptor(name);
+    EXPECT_EQ(descriptors, 1);
+    EXPECT_TRUE(is_scan_descriptor(kScanDensityFeature));
 }
 
 TEST(ClassifyFeatures, DeterministicAndSkeletonGroupCanBeSkipped) {

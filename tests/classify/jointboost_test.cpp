@@ -1,5 +1,6 @@
 // JointBoost on synthetic feature tables with known structure, against a naive reference
 // implementation of the same rounds, and model files.
+#include "classify/features.hpp"
 #include "classify/jointboost.hpp"
 #include "core/error.hpp"
 #include "synth/random.hpp"
@@ -13,6 +14,8 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <span>
+#include <tuple>
 
 using namespace treelobes;
 using namespace treelobes::classify;
@@ -45,6 +48,17 @@ void gaussian_clusters(int classes, int dims, int per_class, std::uint64_t seed,
             table.add_row(test::numbered("t", static_cast<std::size_t>(table.rows())), row);
             y.push_back(c);
         }
+}
+
+// Every stump of a model: its own, its ensemble members' and its routed parts'.
+std::vector<Stump> all_stumps(const JointBoostModel& model) {
+    std::vector<Stump> out = model.stumps;
+    for (const auto* list : {&model.members, &model.parts})
+        for (const auto& sub : *list) {
+            const auto more = all_stumps(sub);
+            out.insert(out.end(), more.begin(), more.end());
+        }
+    return out;
 }
 
 double accuracy(const JointBoostModel& model, const FeatureTable& table, const std::vector<int>& y) {
@@ -143,7 +157,22 @@ TEST(JointBoost, SeparatesGaussianClusters) {
     EXPECT_GE(accuracy(model, test, y_test), 0.96);
     EXPECT_GT(report.rounds, 0);
     EXPECT_LT(report.rounds_tried, 400);  // early stopping kicked in
-    for (const auto& s : model.stumps) EXPECT_NE(s.feature, 3) << "the pure-noise feature should not be chosen";
+    // The default model averages the 5 fold runs, each boosted on 4/5 of the trees: their late
+    // rounds fit a little noise (measured: 15 of 435 stumps), which averaging dilutes.
+    ASSERT_EQ(model.members.size(), 5u);
+    for (const auto& member : model.members) EXPECT_EQ(member.stumps.size(), static_cast<std::size_t>(report.rounds));
+    const auto stumps = all_stumps(model);
+    int noise = 0;
+    for (const auto& s : stumps) noise += s.feature == 3;
+    EXPECT_LT(noise, static_cast<int>(stumps.size()) / 20);
+    // Boosted again on all trees for the chosen rounds: the same bound.
+    JointBoostOptions refit;
+    refit.fold_ensemble = false;
+    const auto single = train_jointboost(train, y_train, class_names(6), refit);
+    EXPECT_GE(accuracy(single, test, y_test), 0.96);
+    noise = 0;
+    for (const auto& s : single.stumps) noise += s.feature == 3;
+    EXPECT_LT(noise, static_cast<int>(single.stumps.size()) / 20);
 }
 
 // The rounds of fit_jointboost_rounds against the naive reference, stump by stump.
@@ -273,6 +302,13 @@ TEST(JointBoost, EarlyStoppingOnNoise) {
     EXPECT_GT(*std::min_element(report.validation_error.begin(), report.validation_error.end()), 0.3);
 }
 
+TEST(JointBoost, ProbabilitiesStayDefinedWhenEveryScoreIsFarBelowZero) {
+    const auto p = probabilities_from_scores({-900.0, -1000.0, -1000.0}, 0.25);
+    EXPECT_NEAR(p[0], 1.0, 1e-12);  // sigma ratios: e^(2 * 100 / 0.25) in favour of class 0
+    const auto q = probabilities_from_scores({-1000.0, -1000.0}, 1.0);
+    EXPECT_NEAR(q[0], 0.5, 1e-12);
+}
+
 TEST(JointBoost, ProbabilitiesAreTheNormalisedLogisticOf2H) {
     const std::vector<double> h = {0.5, -0.2, 1.5};
     const auto p = probabilities_from_scores(h);
@@ -313,22 +349,33 @@ TEST(JointBoost, ModelFileRoundTripsAndRejectsBadFiles) {
     save_jointboost(model, dir / "m.jb");
     const auto loaded = load_jointboost(dir / "m.jb");
     EXPECT_EQ(loaded.feature_names, t.feature_names);
-    ASSERT_EQ(loaded.stumps.size(), model.stumps.size());
+    ASSERT_EQ(all_stumps(loaded).size(), all_stumps(model).size());
+    ASSERT_EQ(loaded.members.size(), model.members.size());
     for (std::size_t r = 0; r < t.rows(); ++r) EXPECT_EQ(loaded.scores(t.row(r)), model.scores(t.row(r)));
     EXPECT_EQ(loaded.temperature, model.temperature);
     for (std::size_t r = 0; r < t.rows(); ++r) EXPECT_EQ(loaded.probabilities(t.row(r)), model.probabilities(t.row(r)));
 
     std::string text = read_file(dir / "m.jb");
-    test::write_text(dir / "v3.jb", std::string(text).replace(text.find("\"version\": 2"), 12, "\"version\": 3"));
+    test::write_text(dir / "v4.jb", std::string(text).replace(text.find("\"version\": 3"), 12, "\"version\": 4"));
     try {
-        load_jointboost(dir / "v3.jb");
-        FAIL() << "version 3 accepted";
+        load_jointboost(dir / "v4.jb");
+        FAIL() << "version 4 accepted";
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), ExitCode::InvalidInput);
-        EXPECT_NE(std::string(e.what()).find("version 3"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("version 4"), std::string::npos);
     }
+    // Version 2 files (a single stump list, as --refit and --average-scores still write) load as
+    // they are.
+    JointBoostOptions flat;
+    flat.average_probabilities = false;
+    const auto single = train_jointboost(t, y, class_names(4), flat);
+    EXPECT_TRUE(single.members.empty());
+    save_jointboost(single, dir / "s.jb");
+    const std::string flat_text = read_file(dir / "s.jb");
+    test::write_text(dir / "v2.jb", std::string(flat_text).replace(flat_text.find("\"version\": 3"), 12, "\"version\": 2"));
+    EXPECT_EQ(load_jointboost(dir / "v2.jb").probabilities(t.row(0)), single.probabilities(t.row(0)));
     // Version 1 files (before the temperature) still load, with T = 1.
-    std::string v1 = std::string(text).replace(text.find("\"version\": 2"), 12, "\"version\": 1");
+    std::string v1 = std::string(text).replace(text.find("\"version\": 3"), 12, "\"version\": 1");
     v1.replace(v1.find("\"temperature\": "), 15, "\"old_temperature\": ");
     test::write_text(dir / "v1.jb", v1);
     EXPECT_EQ(load_jointboost(dir / "v1.jb").temperature, 1.0);
@@ -355,4 +402,164 @@ TEST(JointBoost, RejectsBadTrainingInput) {
     t.add_row("z", b);
     EXPECT_THROW(train_jointboost(t, {0, 1, 1}, class_names(2), {}), Error);
     EXPECT_THROW(train_jointboost(t, {0, 0, 0}, class_names(2), {}), Error);  // class 1 has no trees
+}
+
+namespace {
+
+// Two scan kinds in one table: feature f0 tells the classes apart in the sparse kind and f1 in
+// the dense kind, with the opposite sign, so that no single threshold of either serves both; the
+// scan descriptor (tens against thousands of points per m^2) tells the kinds apart.
+void two_scan_kinds(int per_class_and_kind, std::uint64_t seed, FeatureTable& table, std::vector<int>& y) {
+    synth::Rng rng(seed);
+    table = empty_table(3);
+    table.feature_names.push_back(kScanDensityFeature);
+    for (int i = 0; i < per_class_and_kind; ++i)
+        for (int kind = 0; kind < 2; ++kind)
+            for (int c = 0; c < 3; ++c) {
+                double row[4] = {rng.normal(), rng.normal(), rng.normal(), kind == 0 ? 40.0 + 100.0 * rng.uniform() : 900.0 + 9000.0 * rng.uniform()};
+                row[kind] += (kind == 0 ? 4.0 : -4.0) * (c - 1);
+                table.add_row(test::numbered("t", table.rows()), row);
+                y.push_back(c);
+            }
+}
+
+}  // namespace
+
+TEST(JointBoost, RoutesTreesToOneSubModelPerScanKind) {
+    FeatureTable t;
+    std::vector<int> y;
+    two_scan_kinds(15, 5, t, y);
+    JointBoostReport report;
+    const auto model = train_jointboost(t, y, class_names(3), {}, &report);
+    ASSERT_TRUE(model.routed());
+    ASSERT_EQ(model.parts.size(), 2u);
+    EXPECT_EQ(model.route_feature, 3);
+    EXPECT_GT(model.route_threshold, 140.0);  // in the gap, the geometric mean of its ends
+    EXPECT_LT(model.route_threshold, 900.0);
+    EXPECT_EQ(report.parts.size(), 2u);
+    EXPECT_EQ(report.rounds, report.parts[0].rounds + report.parts[1].rounds);
+    for (const auto& part : model.parts) {
+        EXPECT_EQ(part.classes, class_names(3));
+        ASSERT_FALSE(part.members.empty());
+        for (const auto& s : all_stumps(part)) EXPECT_NE(s.feature, 3) << "the scan descriptor is not a tree feature";
+    }
+    // The sparse part splits on f0, the dense one on f1 (their own informative feature).
+    EXPECT_EQ(model.parts[0].members.front().stumps.front().feature, 0);
+    EXPECT_EQ(model.parts[1].members.front().stumps.front().feature, 1);
+    FeatureTable test_set;
+    std::vector<int> test_y;
+    two_scan_kinds(10, 6, test_set, test_y);
+    EXPECT_GE(accuracy(model, test_set, test_y), 0.9);
+    // A tree is served by the part of its density: the same vector at the other density is read
+    // with the other part's feature.
+    std::vector<double> sparse(test_set.row(0), test_set.row(0) + 4), dense = sparse;
+    dense[3] = 5000;
+    EXPECT_EQ(model.part_index(sparse.data()), 0u);
+    EXPECT_EQ(model.part_index(dense.data()), 1u);
+    EXPECT_EQ(model.probabilities(sparse.data()), model.parts[0].probabilities(sparse.data()));
+    EXPECT_EQ(model.probabilities(dense.data()), model.parts[1].probabilities(dense.data()));
+
+    // Without routing, one model over the same trees (the descriptor still unused).
+    JointBoostOptions single;
+    single.route_by_scan = false;
+    const auto one = train_jointboost(t, y, class_names(3), single);
+    EXPECT_FALSE(one.routed());
+    for (const auto& s : all_stumps(one)) EXPECT_NE(s.feature, 3);
+}
+
+TEST(JointBoost, NoRoutingWithoutTwoDensityClusters) {
+    FeatureTable t;
+    std::vector<int> y;
+    two_scan_kinds(15, 7, t, y);
+    // All densities within a factor 3 of each other: one model.
+    for (std::size_t r = 0; r < t.rows(); ++r) t.values[r * t.cols() + 3] = 100.0 + static_cast<double>(r);
+    EXPECT_EQ(choose_scan_routing(t, y, {}).first, -1);
+    EXPECT_FALSE(train_jointboost(t, y, class_names(3), {}).routed());
+    // Two clusters, but one side holds fewer than route_min_trees trees: one model.
+    for (std::size_t r = 0; r < t.rows(); ++r) t.values[r * t.cols() + 3] = r < 10 ? 50.0 : 5000.0;
+    EXPECT_EQ(choose_scan_routing(t, y, {}).first, -1);
+    JointBoostOptions few;
+    few.route_min_trees = 10;
+    EXPECT_EQ(choose_scan_routing(t, y, few).first, 3);
+}
+
+TEST(JointBoost, RoutedModelFileRoundTripsWithTwoSubModels) {
+    FeatureTable t;
+    std::vector<int> y;
+    two_scan_kinds(12, 9, t, y);
+    // Class 2 only in the dense kind: the sparse part has two classes and gives class 2 nothing.
+    FeatureTable kept = empty_table(0);
+    kept.feature_names = t.feature_names;
+    std::vector<int> kept_y;
+    for (std::size_t r = 0; r < t.rows(); ++r)
+        if (!(y[r] == 2 && t.at(r, 3) < 500)) kept.add_row(t.ids[r], std::span<const double>(t.row(r), t.cols())), kept_y.push_back(y[r]);
+    const auto model = train_jointboost(kept, kept_y, class_names(3), {});
+    ASSERT_TRUE(model.routed());
+    EXPECT_EQ(model.parts[0].classes, (std::vector<std::string>{"class0", "class1"}));
+    EXPECT_EQ(model.part_class_ids[0], (std::vector<int>{0, 1}));
+    TempDir dir;
+    save_jointboost(model, dir / "routed.jb");
+    const std::string text = read_file(dir / "routed.jb");
+    EXPECT_NE(text.find("\"version\": 3"), std::string::npos);
+    EXPECT_NE(text.find("\"routing\""), std::string::npos);
+    const auto loaded = load_jointboost(dir / "routed.jb");
+    ASSERT_TRUE(loaded.routed());
+    EXPECT_EQ(loaded.route_feature, model.route_feature);
+    EXPECT_EQ(loaded.route_threshold, model.route_threshold);
+    EXPECT_EQ(loaded.part_class_ids, model.part_class_ids);
+    for (std::size_t r = 0; r < t.rows(); ++r) {
+        const auto p = loaded.probabilities(t.row(r));
+        EXPECT_EQ(p, model.probabilities(t.row(r)));
+        if (t.at(r, 3) < 500) {
+            EXPECT_EQ(p[2], 0.0);
+        }
+    }
+    // A routed file naming an unknown routing feature or part class, or declaring version 2
+    // (single models only): input errors.
+    const auto part_class = text.find("\"class1\"", text.find("\"models\""));
+    ASSERT_NE(part_class, std::string::npos);
+    for (const auto& [at, from, to] : std::vector<std::tuple<std::size_t, std::string, std::string>>{
+             {text.find("\"feature\": \"scan_point_density\""), "\"feature\": \"scan_point_density\"", "\"feature\": \"nope\""},
+             {part_class, "\"class1\"", "\"class7\""},
+             {text.find("\"version\": 3"), "\"version\": 3", "\"version\": 2"}}) {
+        ASSERT_NE(at, std::string::npos) << from;
+        test::write_text(dir / "bad.jb", std::string(text).replace(at, from.size(), to));
+        EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad.jb"); }), ExitCode::InvalidInput) << to;
+    }
+}
+
+// The fold ensemble averaging probabilities keeps its members (one per fold) in the model and the
+// file; a tree the members disagree on gets their mean probabilities, not those of their mean H.
+TEST(JointBoost, ProbabilityAveragingEnsembleKeepsItsMembersThroughTheFile) {
+    FeatureTable t;
+    std::vector<int> y;
+    two_scan_kinds(12, 11, t, y);
+    JointBoostOptions options;
+    options.average_probabilities = true;
+    const auto model = train_jointboost(t, y, class_names(3), options);
+    ASSERT_TRUE(model.routed());
+    for (const auto& part : model.parts) {
+        EXPECT_EQ(part.members.size(), static_cast<std::size_t>(options.folds));
+        EXPECT_TRUE(part.stumps.empty());
+    }
+    const double* row = t.row(0);
+    const auto& part = model.parts[model.part_index(row)];
+    std::vector<double> mean(part.class_count(), 0.0);
+    for (const auto& member : part.members) {
+        const auto p = probabilities_from_scores(member.scores(row), part.temperature);
+        for (std::size_t c = 0; c < mean.size(); ++c) mean[c] += p[c] / static_cast<double>(part.members.size());
+    }
+    const auto p = part.probabilities(row);
+    for (std::size_t c = 0; c < mean.size(); ++c) EXPECT_NEAR(p[c], mean[c], 1e-12);
+    TempDir dir;
+    save_jointboost(model, dir / "members.jb");
+    const auto loaded = load_jointboost(dir / "members.jb");
+    ASSERT_TRUE(loaded.routed());
+    EXPECT_EQ(loaded.parts[1].members.size(), model.parts[1].members.size());
+    for (std::size_t r = 0; r < t.rows(); ++r) EXPECT_EQ(loaded.probabilities(t.row(r)), model.probabilities(t.row(r)));
+    const std::string text = read_file(dir / "members.jb");
+    const auto at = text.find("\"members\": [");
+    ASSERT_NE(at, std::string::npos);
+    test::write_text(dir / "bad.jb", std::string(text).replace(at, 13, "\"members\": 7, \"x\": ["));
+    EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad.jb"); }), ExitCode::InvalidInput);
 }
