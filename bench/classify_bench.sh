@@ -17,6 +17,7 @@ SPLITS=${SPLITS:-100}
 [[ -x "$BIN" ]] || { echo "classify_bench: $BIN not found (build first or set TREELOBES_BIN)" >&2; exit 1; }
 BIN=$(realpath "$BIN")
 mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)  # absolute: the features run inside the dataset folders, which may be symlinks
 
 # Datasets are kept between runs (synth keeps finished trees).
 "$BIN" --log-level warn synth dataset --per-species "$PER_SPECIES" --seed 11 --max-leaves 8000 --angular-step 0.2 --out "$OUT/tls"
@@ -29,7 +30,7 @@ KEY=$("$BIN" classify features --list | sha1sum | cut -d' ' -f1)
 features() {  # features of one dataset, ids prefixed with the dataset name (as evaluate does)
   local name=$1
   [[ -s "$OUT/${name}_features.csv" && "$(cat "$OUT/${name}_features.key" 2>/dev/null)" == "$KEY" ]] && return
-  (cd "$OUT/$name" && "$BIN" --log-level warn --json classify features */*.las --out "../${name}_features_raw.csv") \
+  (cd "$OUT/$name" && "$BIN" --log-level warn --json classify features */*.las --out "$OUT/${name}_features_raw.csv") \
     > "$OUT/${name}_features.json"
   python3 - "$OUT/${name}_features_raw.csv" "$name" "$OUT/${name}_features.csv" <<'PY'
 import sys

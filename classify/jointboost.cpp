@@ -473,6 +473,8 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
                              const JointBoostOptions& options, JointBoostReport* report) {
     if (options.max_rounds < 1) throw Error::usage("JointBoost: max_rounds must be at least 1");
     if (options.folds < 0) throw Error::usage("JointBoost: the number of folds must not be negative");
+    if (!(options.settled_logloss >= 0) || !std::isfinite(options.settled_logloss))
+        throw Error::usage("JointBoost: the settled log-loss must be a finite number >= 0");
     JointBoostReport local;
     JointBoostReport& r = report ? *report : local;
     r = {};

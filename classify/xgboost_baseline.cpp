@@ -1,6 +1,5 @@
 #include "classify/xgboost_baseline.hpp"
 
-#include "classify/features.hpp"
 #include "classify/splits.hpp"
 #include "core/error.hpp"
 
@@ -24,16 +23,11 @@ void check(int status, const char* what) {
 struct Matrix {
     DMatrixHandle handle = nullptr;
     Matrix(const FeatureTable& t, const std::vector<std::size_t>& rows, const std::vector<int>* labels) {
-        // The scan descriptor (point density) is not a tree feature: JointBoost only routes by it,
-        // so the baseline does not see it either.
-        std::vector<std::size_t> columns;
-        for (std::size_t c = 0; c < t.cols(); ++c)
-            if (!is_scan_descriptor(t.feature_names[c])) columns.push_back(c);
         std::vector<float> data;
-        data.reserve(rows.size() * columns.size());
+        data.reserve(rows.size() * t.cols());
         for (auto r : rows)
-            for (auto c : columns) data.push_back(static_cast<float>(t.at(r, c)));
-        check(XGDMatrixCreateFromMat(data.data(), rows.size(), columns.size(), std::numeric_limits<float>::quiet_NaN(), &handle),
+            for (std::size_t c = 0; c < t.cols(); ++c) data.push_back(static_cast<float>(t.at(r, c)));
+        check(XGDMatrixCreateFromMat(data.data(), rows.size(), t.cols(), std::numeric_limits<float>::quiet_NaN(), &handle),
               "matrix");
         if (labels) {
             std::vector<float> y;

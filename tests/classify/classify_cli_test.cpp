@@ -190,4 +190,9 @@ TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
     EXPECT_NE(r.err.find("height"), std::string::npos) << r.err;
     EXPECT_EQ(run_cli("classify train " + quoted(features())).exit_code, 1);  // --labels and --out missing
     EXPECT_EQ(run_cli("classify evaluate " + quoted(dataset()) + " --out " + quoted(dir / "r") + " --splits 0").exit_code, 1);
+    r = run_cli("classify evaluate " + quoted(dataset()) + " --features " + quoted(features()) + " --out " + quoted(dir / "r") +
+                " --splits 1 --no-xgboost --settled-logloss nan");
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_NE(r.err.find("settled log-loss"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "r" / "summary.json"));
 }
