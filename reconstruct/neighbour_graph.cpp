@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/point_cloud.hpp"
 #include "reconstruct/kd_tree.hpp"
 #include "reconstruct/union_find.hpp"
 
@@ -172,15 +173,7 @@ struct PieceEnd {
 };
 
 Eigen::Vector3f principal_axis(std::span<const Eigen::Vector3f> points, const std::vector<int>& members, double* elongation = nullptr) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : members) mean += points[i].cast<double>();
-    mean /= static_cast<double>(members.size());
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int i : members) {
-        const Eigen::Vector3d d = points[i].cast<double>() - mean;
-        cov += d * d.transpose();
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(point_scatter(points, members).scatter);
     if (elongation) *elongation = solver.eigenvalues()[2] / std::max(solver.eigenvalues()[1], 1e-12);
     return solver.eigenvectors().col(2).cast<float>();
 }

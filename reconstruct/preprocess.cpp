@@ -144,15 +144,7 @@ NeighbourhoodShapes neighbourhood_shapes(const KdTree& tree, const std::vector<E
     std::size_t sampled = 0, linear = 0, planar = 0;
     for (std::size_t c = 0; c < candidates.size(); c += step) {
         tree.knn(points[candidates[c]], kNeighbours, found, d2);
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (int j : found) mean += points[j].cast<double>();
-        mean /= static_cast<double>(found.size());
-        Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-        for (int j : found) {
-            const Eigen::Vector3d d = points[j].cast<double>() - mean;
-            cov += d * d.transpose();
-        }
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov, Eigen::EigenvaluesOnly);
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(point_scatter(points, found).scatter, Eigen::EigenvaluesOnly);
         const Eigen::Vector3d l = solver.eigenvalues();  // ascending
         ++sampled;
         linear += l[2] > 0 && l[2] - l[1] > 0.8 * l[2];

@@ -20,6 +20,27 @@ float max_axis_error(const TreeGraph& tree, const std::vector<Segment>& truth) {
     return worst;
 }
 
+// A 0.25 m stem 4.5 m tall scanned all round (rings of `per_ring` points every 2 cm, turning
+// 0.7 rad per metre), except from 2 m up to `strip_top`, where only the points within
+// `half_width` rad of a strip winding once every `period` metres remain.
+struct HelicalStrip {
+    int per_ring;
+    float strip_top, period, half_width;
+};
+
+std::vector<Eigen::Vector3f> stem_with_helical_strip(const HelicalStrip& h) {
+    std::vector<Eigen::Vector3f> points;
+    const float radius = 0.25f, pi = std::numbers::pi_v<float>;
+    for (float z = 0.0f; z <= 4.5f; z += 0.02f)
+        for (int a = 0; a < h.per_ring; ++a) {
+            const float angle = 2.0f * pi * static_cast<float>(a) / static_cast<float>(h.per_ring) + 0.7f * z;
+            const float strip_centre = 2.0f * pi * (z - 2.0f) / h.period;
+            if (z > 2.0f && z < h.strip_top && std::abs(std::remainder(angle - strip_centre, 2.0f * pi)) > h.half_width) continue;
+            points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
+        }
+    return points;
+}
+
 }  // namespace
 
 TEST(Skeleton, CylinderGivesOneStraightChainAlongTheAxis) {
@@ -120,18 +141,8 @@ TEST(Skeleton, StemSeenOnlyAsAHelicalStripStaysOnItsAxis) {
     // strip winding twice around it (a sparse stretch where the geodesic distance climbs along
     // the bark): every geodesic bin there is an arc, not a ring. The slab fits across the axis
     // found below keep the skeleton on the axis; the arcs' own fits leave it on the bark.
-    std::vector<Eigen::Vector3f> points;
-    const float radius = 0.25f, pi = std::numbers::pi_v<float>;
-    for (float z = 0.0f; z <= 4.5f; z += 0.02f)
-        for (int a = 0; a < 80; ++a) {
-            const float angle = 2.0f * pi * static_cast<float>(a) / 80.0f + 0.7f * z;
-            if (z > 2.0f && z < 3.2f) {  // the strip: within 0.9 rad of angle 2 pi (z - 2) / 0.6
-                const float centre = 2.0f * pi * (z - 2.0f) / 0.6f;
-                const float off = std::remainder(angle - centre, 2.0f * pi);
-                if (std::abs(off) > 0.9f) continue;
-            }
-            points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
-        }
+    const float radius = 0.25f;
+    const std::vector<Eigen::Vector3f> points = stem_with_helical_strip({80, 3.2f, 0.6f, 0.9f});
     const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 4.5f}, radius}};
     const SkeletonResult r = reconstruct_skeleton(points, {});
     float worst = 0;
@@ -145,17 +156,8 @@ TEST(Skeleton, NarrowSparseStripWindingRoundAThickStemStaysOnItsAxis) {
     // are too sparse for a circle fit, and the axis below is continued. The arcs it is cut into
     // follow one another at nearly one height, so the reach of that continuation is counted along
     // the axis (11 bins here), not in clusters (more than 16 of them).
-    std::vector<Eigen::Vector3f> points;
-    const float radius = 0.25f, pi = std::numbers::pi_v<float>;
-    for (float z = 0.0f; z <= 4.5f; z += 0.02f)
-        for (int a = 0; a < 60; ++a) {
-            const float angle = 2.0f * pi * static_cast<float>(a) / 60.0f + 0.7f * z;
-            if (z > 2.0f && z < 2.6f) {
-                const float centre = 2.0f * pi * (z - 2.0f) / 0.8f;
-                if (std::abs(std::remainder(angle - centre, 2.0f * pi)) > 0.3f) continue;
-            }
-            points.emplace_back(radius * std::cos(angle), radius * std::sin(angle), z);
-        }
+    const float radius = 0.25f;
+    const std::vector<Eigen::Vector3f> points = stem_with_helical_strip({60, 2.6f, 0.8f, 0.3f});
     const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 4.5f}, radius}};
     const SkeletonResult r = reconstruct_skeleton(points, {});
     std::size_t inside = 0;
