@@ -15,7 +15,15 @@
 using namespace treelobes;
 
 int main(int argc, char** argv) {
-    const std::size_t target = argc > 1 ? std::strtoul(argv[1], nullptr, 10) : 50000;
+    std::size_t target = 50000;
+    if (argc > 1) {
+        char* end = nullptr;
+        target = std::strtoul(argv[1], &end, 10);
+        if (argc > 2 || *end != '\0' || target < 1000) {
+            std::fprintf(stderr, "usage: bench_classify_features [POINTS >= 1000] (default 50000)\n");
+            return 1;
+        }
+    }
     const auto profiles = load_species_profiles(default_species_file());
     double total = 0, total_cpu = 0;
     int trees = 0;

@@ -131,7 +131,11 @@ struct NeighbourhoodShapes {
     float linear = -1.0f, planar = -1.0f;  // -1: too few points to tell
 };
 
-NeighbourhoodShapes neighbourhood_shapes(const KdTree& tree, const std::vector<Eigen::Vector3f>& points, const std::vector<bool>& skip) {
+// The neighbourhoods come from `table` (the outlier filter's kNN rows, which leave out the point
+// itself: the point and its first 19 neighbours are the 20 nearest, in the same order) when it is
+// wide enough, else from kd-tree queries.
+NeighbourhoodShapes neighbourhood_shapes(const KdTree& tree, const KnnTable& table, const std::vector<Eigen::Vector3f>& points,
+                                         const std::vector<bool>& skip) {
     constexpr int kNeighbours = 20;
     constexpr std::size_t kSamples = 5000;
     std::vector<int> candidates;
@@ -143,7 +147,14 @@ NeighbourhoodShapes neighbourhood_shapes(const KdTree& tree, const std::vector<E
     std::vector<float> d2;
     std::size_t sampled = 0, linear = 0, planar = 0;
     for (std::size_t c = 0; c < candidates.size(); c += step) {
-        tree.knn(points[candidates[c]], kNeighbours, found, d2);
+        const int centre = candidates[c];
+        if (table.k >= kNeighbours - 1) {
+            const int* row = table.row(static_cast<std::size_t>(centre));
+            found.assign(1, centre);
+            for (int j = 0; j < kNeighbours - 1 && row[j] >= 0; ++j) found.push_back(row[j]);
+        } else {
+            tree.knn(points[centre], kNeighbours, found, d2);
+        }
         const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(point_scatter(points, found).scatter, Eigen::EigenvaluesOnly);
         const Eigen::Vector3d l = solver.eigenvalues();  // ascending
         ++sampled;
@@ -287,7 +298,7 @@ Preprocessed preprocess_cloud(const PointCloud& cloud, const PreprocessOptions& 
     if (filter && options.outlier_test == OutlierTest::Auto) {
         std::vector<bool> skip = removed;
         for (std::size_t i = 0; i < merged.size(); ++i) skip[i] = skip[i] || ground[i];
-        const NeighbourhoodShapes shapes = neighbourhood_shapes(*merged_tree, merged, skip);
+        const NeighbourhoodShapes shapes = neighbourhood_shapes(*merged_tree, all, merged, skip);
         out.linear_fraction = shapes.linear;
         out.local_outlier_test = looks_leafy(shapes, options.leafy_linear_fraction);
         log_debug(name + ": neighbourhoods " + std::to_string(shapes.linear) + " linear, " + std::to_string(shapes.planar) +

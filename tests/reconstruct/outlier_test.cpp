@@ -181,3 +181,19 @@ TEST(Outliers, AutoTestPicksTheLocalTestForLeafyCrownsOnly) {
     EXPECT_FALSE(walls.local_outlier_test);
     EXPECT_LT(walls.linear_fraction, 0.09f);
 }
+
+TEST(Outliers, NeighbourhoodShapesFromTheKnnTableMatchKdTreeQueries) {
+    // With a table handed on (as reconstruct and classify ask for) the gate reads the outlier
+    // query's rows instead of querying again: the same neighbourhoods, so the same fractions.
+    PreprocessOptions queries;
+    queries.ground = GroundMode::Keep;
+    PreprocessOptions table = queries;
+    table.table_width = 20;
+    for (bool leaves : {true, false}) {
+        const PointCloud cloud = thin_tree(leaves);
+        const Preprocessed a = preprocess_cloud(cloud, queries), b = preprocess_cloud(cloud, table);
+        EXPECT_GT(a.linear_fraction, 0.0f);
+        EXPECT_EQ(a.linear_fraction, b.linear_fraction) << (leaves ? "leafy" : "bare");
+        EXPECT_EQ(a.local_outlier_test, b.local_outlier_test);
+    }
+}
