@@ -392,7 +392,7 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     t->add_option("--max-rounds", train->options.max_rounds, "Maximum boosting rounds")->check(CLI::Range(1, 100000))->capture_default_str();
     t->add_option("--folds", train->options.folds, "Cross-validation folds for early stopping and calibration (0 = off)")
         ->check(CLI::Range(0, 20))->capture_default_str();
-    t->add_option("--patience", train->options.patience, "Rounds without improvement before stopping")->check(CLI::NonNegativeNumber)->capture_default_str();
+    t->add_option("--patience", train->options.patience, "Rounds without improvement before stopping")->check(cli::NonNegativeNumber)->capture_default_str();
     t->add_option("--seed", train->options.seed, "Seed of the cross-validation folds")->capture_default_str();
     t->add_flag("--no-calibration{false}", train->options.calibrate,
                 "Keep the probability temperature at 1 instead of fitting it out of fold");
@@ -412,7 +412,7 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     p->add_flag("--vote", predict->vote, "Spatial voting among the trees given");
     p->add_option("--confidence", predict->voting.confidence_factor, "Confident when h1 > factor * h2")
         ->check(CLI::Range(1.0, 100.0))->capture_default_str();
-    p->add_option("--radius", predict->voting.radius_m, "Voting neighbourhood, m")->check(CLI::NonNegativeNumber)->capture_default_str();
+    p->add_option("--radius", predict->voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber)->capture_default_str();
     p->add_option("--out,-o", predict->out, "predictions.csv (default: print the table)");
     add_feature_flags(p, predict->flags);
     p->callback([predict, &global, &job] { job = [predict, &global] { return run_predict(*predict, global); }; });
@@ -426,20 +426,20 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     e->add_option("--features", evaluate->features, "Reuse a feature table (e.g. report/features.csv of an earlier run)");
     e->add_option("--confidence", evaluate->options.voting.confidence_factor, "Confident when h1 > factor * h2")
         ->check(CLI::Range(1.0, 100.0))->capture_default_str();
-    e->add_option("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(CLI::NonNegativeNumber)->capture_default_str();
+    e->add_option("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber)->capture_default_str();
     e->add_option("--max-rounds", evaluate->jointboost.max_rounds, "JointBoost maximum rounds")->check(CLI::Range(1, 100000))->capture_default_str();
     e->add_option("--folds", evaluate->jointboost.folds,
                   "JointBoost: cross-validation folds on the training half for early stopping and calibration (0 = off)")
         ->check(CLI::Range(0, 20))->capture_default_str();
     e->add_option("--patience", evaluate->jointboost.patience, "JointBoost: rounds without improvement before stopping")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
+        ->check(cli::NonNegativeNumber)->capture_default_str();
     e->add_flag("--no-calibration{false}", evaluate->jointboost.calibrate,
                 "JointBoost: keep the probability temperature at 1 instead of fitting it out of fold");
     e->add_flag("--no-scan-routing{false}", evaluate->jointboost.route_by_scan,
                 "JointBoost: one model for all trees instead of one per scan kind (told apart by scan_point_density)");
     e->add_option("--settled-logloss", evaluate->jointboost.settled_logloss,
                   "JointBoost: stop when every out-of-fold tree is right at a mean log-loss below this (0 = off)")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
+        ->check(cli::NonNegativeNumber)->capture_default_str();
     e->add_flag("--refit{false}", evaluate->jointboost.fold_ensemble,
                 "JointBoost: boost the final model again on all training trees instead of averaging the cross-validation runs");
     e->add_flag("--average-scores{false}", evaluate->jointboost.average_probabilities,
@@ -449,7 +449,7 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
                   "replaces the dataset's positions")
         ->check(CLI::IsMember({"grouped", "mixed"}));
     e->add_option("--spacing", evaluate->spacing, "Distance between planted trees, m (with --layout)")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::PositiveNumber)->capture_default_str();
     e->add_flag("--no-xgboost", evaluate->no_xgboost, "Skip the XGBoost baseline");
     e->add_flag("--no-site-split", evaluate->no_site_split, "Skip the leave-one-site-out split");
     add_feature_flags(e, evaluate->flags);

@@ -533,13 +533,13 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto* out = sub->add_option("--out", options->out, "Output .dbf6 file (one tree) or .forest file (--forest)");
     sub->add_option("--resolution", options->resolution, "Voxels per internode length (r of Eq. 2)")
         ->required()
-        ->check(CLI::PositiveNumber);
+        ->check(cli::PositiveNumber);
     sub->add_option("--internode-length", options->internode_length,
                     "Internode length l in metres, or 'auto' for the median edge length (per tree)")
         ->capture_default_str();
     sub->add_option("--radius-unit", options->radius_unit, "Metres per radius step of the radius list")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(cli::PositiveNumber);
     sub->add_flag("--f6", options->f6, "Plain F6 code instead of the differential DBF6");
     auto* print = sub->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
     auto* lods = sub->add_option("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
@@ -565,9 +565,9 @@ void add_decode(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("input", options->input, "A .dbf6 or .forest file")->required();
     sub->add_option("--lod", options->lod, "Level of detail to decode (0 = full detail)")
         ->capture_default_str()
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--tree", options->tree, "Forest files: decode only tree I (0-based) into the --out PLY")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--out", options->out,
                     "Output skeleton PLY; for a whole forest (no --tree) a directory receiving one PLY per tree")
         ->required();
@@ -585,7 +585,7 @@ void add_lod(CLI::App& app, const GlobalOptions& global, Job& job) {
                                       "Prune laterals whose first radius is below T (radius units)");
     auto* levels = sub->add_option("--levels", options->levels,
                                    "Print K LODs with thresholds at uniform positions of the sorted unique radii")
-                       ->check(CLI::PositiveNumber);
+                       ->check(cli::PositiveNumber);
     threshold->excludes(levels);
     levels->excludes(threshold);
     sub->callback([options, threshold, levels, &global, &job] {
@@ -601,15 +601,15 @@ void add_decode_code(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("--radii", options->radii, "Comma-separated radii, one per internode")->required();
     sub->add_option("--resolution", options->resolution, "Resolution r used for encoding")
         ->required()
-        ->check(CLI::PositiveNumber);
+        ->check(cli::PositiveNumber);
     sub->add_option("--internode-length", options->internode_length, "Internode length l (metres) used for encoding")
         ->required()
-        ->check(CLI::PositiveNumber);
+        ->check(cli::PositiveNumber);
     sub->add_option("--radius-unit", options->radius_unit, "Metres per radius step")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(cli::PositiveNumber);
     sub->add_option("--root-radius", options->root_radius, "Root vertex radius in radius units (default: the first radius)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_flag("--f6", options->f6, "The code is plain F6 (default: DBF6)");
     sub->add_flag("--ascii", options->ascii, "Write an ASCII PLY instead of binary");
     sub->add_option("--out", options->out, "Output skeleton PLY")->required();

@@ -115,11 +115,11 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("--skeleton-kind", options->skeleton_kind, "skeleton (PLY), treeqsm or points: score other models too")
         ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}))->capture_default_str();
     sub->add_option("--sample-step", options->eval.sample_step, "Metres between samples along segments")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::PositiveNumber)->capture_default_str();
     sub->add_option("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")
-        ->check(CLI::PositiveNumber)->capture_default_str();
+        ->check(cli::PositiveNumber)->capture_default_str();
     sub->add_option("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
-        ->check(CLI::NonNegativeNumber)->capture_default_str();
+        ->check(cli::NonNegativeNumber)->capture_default_str();
     sub->add_option("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
     sub->callback([options, &global, &job] { job = [options, &global] { return run_eval_skeleton(*options, global); }; });
 }

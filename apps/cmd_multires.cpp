@@ -435,7 +435,7 @@ void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     auto* lod = sub->add_option("--lod", o->lods, "LOD level(s) to write (0 = coarsest); default: coarsest and full");
     sub->add_flag("--all", o->all, "Write every LOD level")->excludes(lod);
     sub->add_option("--steps", o->steps, "Derivation length (overrides the file)")->check(CLI::Range(0, kMaxDerivationLength));
-    sub->add_option("--seed", o->seed, "Seed of stochastic rules (overrides the file)")->check(CLI::NonNegativeNumber);
+    sub->add_option("--seed", o->seed, "Seed of stochastic rules (overrides the file)")->check(cli::NonNegativeNumber);
     sub->add_option("--define,-D", o->defines, "Override a #define constant: NAME=VALUE (repeatable)");
     sub->add_option("--max-modules", o->max_modules, "Largest module string a derivation may produce")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));

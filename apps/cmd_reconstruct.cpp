@@ -221,19 +221,19 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
     add_species_flags(sub, o.flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')");
     auto& k = o.stage.skeleton;
     sub->add_option("--neighbours", k.neighbours, "k of the neighbour graph")->check(CLI::Range(2, 64))->capture_default_str();
-    sub->add_option("--bin-width", k.bin_width, "Geodesic bin width in metres (0 = from point spacing)")->check(CLI::NonNegativeNumber);
+    sub->add_option("--bin-width", k.bin_width, "Geodesic bin width in metres (0 = from point spacing)")->check(cli::NonNegativeNumber);
     sub->add_option("--internode-length", k.internode_length, "Skeleton internode length in metres (0 = from point spacing)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--min-twig-length", k.min_twig_length, "Prune leaf branches shorter than this, metres (0 = two bins)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--smoothing", k.smoothing_iterations, "Smoothing passes over the skeleton")->check(CLI::Range(0, 100))->capture_default_str();
     sub->add_option("--geodesic-smoothing", k.geodesic_smoothing, "Neighbour-averaging passes over the geodesic field before binning")
         ->check(CLI::Range(0, 50))->capture_default_str();
     sub->add_option("--max-gap", k.max_gap, "Leave parts joined only across a longer gap (metres) out of the skeleton (0 = keep all)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--bridge-direction", k.bridge_direction,
                     "Weight of the angle between a gap bridge and its piece's own axis (0 = shortest bridges)")
-        ->check(CLI::NonNegativeNumber)
+        ->check(cli::NonNegativeNumber)
         ->capture_default_str();
     sub->add_option("--fit-axes", k.fit_axes, "Centre wide branch slices on fitted circles (true/false)")->capture_default_str();
     sub->add_option("--recentre", o.stage.recentre.enabled,
@@ -242,16 +242,16 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
         ->capture_default_str();
     sub->add_option("--recentre-max-spread", o.stage.recentre.max_spread,
                     "Internodes whose points spread wider than this (RMS around their centroid, metres) are thick and stay put")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::PositiveNumber)
         ->capture_default_str();
     sub->add_option("--recentre-inside-band", o.stage.recentre.inside_band,
                     "Nodes closer to their points' centroid than this many spreads are inside their branch and stay put")
-        ->check(CLI::NonNegativeNumber)
+        ->check(cli::NonNegativeNumber)
         ->capture_default_str();
     sub->add_option("--root-diameter", o.stage.root_diameter, "Stem diameter at the base in metres (0 = from the stem fit)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--voxel-size", o.stage.preprocess.voxel_size, "Keep one point per voxel of this size in metres (0 = off)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(cli::NonNegativeNumber);
     sub->add_option("--outlier-neighbours", o.stage.preprocess.outlier_neighbours, "k of the outlier filter (0 = off)")
         ->check(CLI::Range(0, 64))->capture_default_str();
     sub->add_option("--outlier-test", o.outlier_test,
@@ -262,12 +262,12 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
         ->capture_default_str();
     sub->add_option("--outlier-ratio", o.stage.preprocess.outlier_ratio,
                     "Local outlier test: drop points whose mean k-NN distance exceeds this many times their neighbours' own")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::PositiveNumber)
         ->capture_default_str();
     sub->add_option("--outlier-sigma", o.stage.preprocess.outlier_sigma,
                     "Global outlier test: drop points whose mean k-NN distance exceeds the scan's mean + this many "
                     "standard deviations")
-        ->check(CLI::PositiveNumber)
+        ->check(cli::PositiveNumber)
         ->capture_default_str();
     sub->add_option("--mesh-sides", o.mesh.sides, "Vertices per ring of the branch mesh")->check(CLI::Range(3, 64))->capture_default_str();
     sub->add_option("--mesh-subdivisions", o.mesh.subdivisions, "Rings per internode of the branch mesh")->check(CLI::Range(1, 16))

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <functional>
 #include <string>
 
@@ -18,6 +19,22 @@ struct GlobalOptions {
 };
 
 using Job = std::function<int()>;  // returns the process exit code
+
+// Checks for numeric options: a finite number above (or from) zero. CLI11's PositiveNumber and
+// NonNegativeNumber let "nan" through and quote the whole double range in their message.
+inline CLI::Validator finite_number(bool zero_allowed) {
+    return CLI::Validator(
+        [zero_allowed](std::string& text) -> std::string {
+            double value = 0;
+            if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+            if (!std::isfinite(value) || (zero_allowed ? value < 0 : value <= 0))
+                return std::string("must be a finite number ") + (zero_allowed ? ">= 0" : "> 0") + ", got " + text;
+            return {};
+        },
+        zero_allowed ? "NUMBER >= 0" : "NUMBER > 0");
+}
+inline const CLI::Validator PositiveNumber = finite_number(false);
+inline const CLI::Validator NonNegativeNumber = finite_number(true);
 
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job);

@@ -1,13 +1,14 @@
 #include "apps/reconstruction_flags.hpp"
 
+#include "apps/command.hpp"
 #include "config/species_library.hpp"
 
 namespace treelobes::cli {
 
 void add_species_flags(CLI::App* sub, SpeciesFlags& flags, const std::string& fs_help) {
     sub->add_option("--species", flags.species, "Species from config/species.yaml: sets beta, gamma and f_s");
-    sub->add_option("--beta", flags.beta, "Edge weight exponent ||u-v||^beta (default 1.5, or the species')")->check(CLI::PositiveNumber);
-    sub->add_option("--gamma", flags.gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(CLI::PositiveNumber);
+    sub->add_option("--beta", flags.beta, "Edge weight exponent ||u-v||^beta (default 1.5, or the species')")->check(cli::PositiveNumber);
+    sub->add_option("--gamma", flags.gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(cli::PositiveNumber);
     sub->add_option("--fs", flags.fs, fs_help)->check(CLI::Range(0.01, 1.0));
     sub->add_option("--ground", flags.ground, "Ground points: auto (remove a detected ground plane), remove, keep")
         ->check(CLI::IsMember({"auto", "remove", "keep"}))

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 using treelobes::test::run_cli;
 using treelobes::test::TempDir;
 using treelobes::test::write_text;
@@ -27,6 +29,18 @@ TEST(Cli, UsageErrorsExitWithOne) {
     EXPECT_EQ(run_cli("no-such-command").exit_code, 1);
     EXPECT_EQ(run_cli("info").exit_code, 1);
     EXPECT_EQ(run_cli("--log-level loud info x.xyz").exit_code, 1);
+}
+
+TEST(Cli, NumericOptionsMustBeFiniteAndInRange) {
+    // One line naming the option, for nan and inf as for out-of-range values and non-numbers.
+    for (const char* args : {"--threads nan info x.xyz", "--threads -1 info x.xyz", "reconstruct x.xyz --out o --outlier-ratio nan",
+                             "reconstruct x.xyz --out o --outlier-sigma inf", "reconstruct x.xyz --out o --beta abc",
+                             "reconstruct x.xyz --out o --internode-length -1"}) {
+        const auto r = run_cli(args);
+        EXPECT_EQ(r.exit_code, 1) << args;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << args << ": " << r.err;  // the error and "Run with --help"
+        EXPECT_TRUE(r.err.find("finite number") != std::string::npos || r.err.find("not a number") != std::string::npos) << r.err;
+    }
 }
 
 TEST(Cli, InfoDescribesACloudAsJson) {

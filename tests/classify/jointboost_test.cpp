@@ -404,6 +404,21 @@ TEST(JointBoost, RejectsBadTrainingInput) {
     EXPECT_THROW(train_jointboost(t, {0, 0, 0}, class_names(2), {}), Error);  // class 1 has no trees
 }
 
+TEST(JointBoost, RejectsANonFiniteSettledLogLoss) {
+    FeatureTable t = empty_table(2);
+    for (int r = 0; r < 8; ++r) {
+        const double v[2] = {static_cast<double>(r), static_cast<double>(r % 3)};
+        t.add_row("t" + std::to_string(r), v);
+    }
+    const std::vector<int> y{0, 0, 0, 0, 1, 1, 1, 1};
+    for (double bad : {std::nan(""), std::numeric_limits<double>::infinity(), -0.5}) {
+        JointBoostOptions o;
+        o.folds = 2;
+        o.settled_logloss = bad;
+        EXPECT_EQ(test::error_code_of([&] { train_jointboost(t, y, class_names(2), o); }), ExitCode::Usage) << bad;
+    }
+}
+
 namespace {
 
 // Two scan kinds in one table: feature f0 tells the classes apart in the sparse kind and f1 in
