@@ -51,9 +51,11 @@ std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptio
                                      const std::string& name = {}, FeatureTimings* timings = nullptr);
 
 // The scan group's feature: input points per m^2 of crown cover. It tells the scan kind (airborne
-// or terrestrial), changes with the point density by design, and is never a classifier feature.
+// or terrestrial), changes with the point density by design, and is never a JointBoost stump
+// feature (it routes trees to per-scan-kind models); the XGBoost baseline sees it like any column.
 inline constexpr const char* kScanDensityFeature = "scan_point_density";
-// True for features that describe the scan rather than the tree (the classifiers skip them).
+// True for features that describe the scan rather than the tree (JointBoost routes by them and
+// never splits on them).
 bool is_scan_descriptor(const std::string& feature_name);
 
 // docs/features.md as generated from the catalogue (a test keeps the committed file in sync).

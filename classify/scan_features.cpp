@@ -1,10 +1,11 @@
 // Scan group: what the scanner, not the tree, decides. Its one feature, the point density over
 // the crown's ground plan, is deliberately NOT density-invariant: it tells airborne scans (tens to
 // a few hundred points per m^2) from terrestrial ones (thousands), so that a routed JointBoost
-// model (classify/jointboost.hpp) can send each tree to the sub-model of its scan kind. The
-// classifiers never use it as a feature (is_scan_descriptor()).
+// model (classify/jointboost.hpp) can send each tree to the sub-model of its scan kind. JointBoost
+// never splits on it (is_scan_descriptor()); the XGBoost baseline gets the same table and may.
 #include "classify/feature_groups.hpp"
 
+#include <numbers>
 
 namespace treelobes::classify {
 
@@ -15,7 +16,7 @@ namespace detail {
 void describe_scan(Catalogue& c) {
     c.add(kScanDensityFeature, "1/m^2",
           "input points (before cleaning and voxels) per m^2 of the crown disc pi R^2. Scanner-dependent on purpose (halves "
-          "when the scan is thinned to 50 %): routes a tree to the sub-model of its scan kind, never a classifier feature");
+          "when the scan is thinned to 50 %): routes a tree to the sub-model of its scan kind, never a JointBoost stump feature");
 }
 
 // The disc, not the occupied ground-plan cells: a small airborne crown occupies few cells of its
@@ -23,7 +24,7 @@ void describe_scan(Catalogue& c) {
 // for a 3 m lagerstroemia against 36-205 for other airborne trees; per disc: 36-158 against 850
 // and more for every terrestrial tree of the 480-tree set).
 void compute_scan(const TreeFrame& f, FeatureSink& out) {
-    const double disc = 3.14159265358979323846 * f.crown_radius * f.crown_radius;
+    const double disc = std::numbers::pi * f.crown_radius * f.crown_radius;
     out.add(kScanDensityFeature, static_cast<double>(f.input_points) / disc);
 }
 

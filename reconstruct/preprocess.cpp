@@ -233,6 +233,15 @@ Eigen::Vector2f robust_extent(const std::vector<Eigen::Vector3f>& points, const 
     return extent;
 }
 
+// The points not `removed` at most `tolerance` above (or anywhere below) the plane n.p + d = 0.
+std::vector<bool> on_ground_plane(const std::vector<Eigen::Vector3f>& points, const std::vector<bool>& removed,
+                                  const Eigen::Vector4f& plane, float tolerance) {
+    std::vector<bool> ground(points.size(), false);
+    const Eigen::Vector3f normal = plane.head<3>();
+    for (std::size_t i = 0; i < points.size(); ++i) ground[i] = !removed[i] && normal.dot(points[i]) + plane[3] < tolerance;
+    return ground;
+}
+
 // Ground: a near-horizontal plane among the lowest points that is wider than any stem. Returns
 // the points at most `tolerance` above it (or below it).
 std::vector<bool> find_ground(const std::vector<Eigen::Vector3f>& points, const std::vector<bool>& removed,
@@ -263,9 +272,7 @@ std::vector<bool> find_ground(const std::vector<Eigen::Vector3f>& points, const 
     if (o.ground == GroundMode::Auto && !(wide && substantial)) return ground;
     out.ground_found = true;
     out.ground_plane << plane.normal, plane.offset;
-    for (std::size_t i = 0; i < points.size(); ++i)
-        ground[i] = !removed[i] && plane.signed_distance(points[i]) < o.ground_tolerance;
-    return ground;
+    return on_ground_plane(points, removed, out.ground_plane, o.ground_tolerance);
 }
 
 }  // namespace
@@ -307,10 +314,7 @@ Preprocessed preprocess_cloud(const PointCloud& cloud, const PreprocessOptions& 
             // The ground plane stays the one found without the global test's outliers; points
             // the local test keeps join the ground when they lie on it.
             removed = local_outliers(all, mean, k, options.outlier_ratio, options.outlier_sigma);
-            const Eigen::Vector3f normal = out.ground_plane.head<3>();
-            if (out.ground_found)
-                for (std::size_t i = 0; i < merged.size(); ++i)
-                    ground[i] = !removed[i] && normal.dot(merged[i]) + out.ground_plane[3] < options.ground_tolerance;
+            if (out.ground_found) ground = on_ground_plane(merged, removed, out.ground_plane, options.ground_tolerance);
         }
     }
     out.outliers = static_cast<std::size_t>(std::count(removed.begin(), removed.end(), true));
