@@ -68,6 +68,7 @@ nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s
             {"min_twig_length", k.min_twig_length},
             {"smoothing_iterations", k.smoothing_iterations},
             {"bridge_direction", k.bridge_direction},
+            {"cylinder_axes", o.stage.cylinder_axes.enabled},
             {"root_diameter", o.stage.root_diameter},
             {"voxel_size", o.stage.preprocess.voxel_size},
             {"outlier_neighbours", o.stage.preprocess.outlier_neighbours},
@@ -105,6 +106,7 @@ nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& inpu
                       {"branches", s.branches},
                       {"internodes", s.internodes},
                       {"recentred_nodes", s.recentred_nodes},
+                      {"cylinder_axis_nodes", s.cylinder_axis_nodes},
                       {"tips", s.tips},
                       {"max_branch_order", s.max_branch_order},
                       {"stem_visible", s.stem_visible},
@@ -246,6 +248,26 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
         ->capture_default_str();
     sub->add_option("--recentre-inside-band", o.stage.recentre.inside_band,
                     "Nodes closer to their points' centroid than this many spreads are inside their branch and stay put")
+        ->check(cli::NonNegativeNumber)
+        ->capture_default_str();
+    auto& c = o.stage.cylinder_axes;
+    sub->add_option("--cylinder-axes", c.enabled,
+                    "Move nodes onto the axes of least-squares cylinders fitted to stretches of branch (true/false): sparse "
+                    "one-sided scans see only the scanner-facing arc of a branch, whose centroid lies off the axis. Off by "
+                    "default: it lowers the WoodSKE medians but raises archi tree1's against TreeQSM")
+        ->capture_default_str();
+    sub->add_option("--cylinder-window", c.window, "Metres of branch whose points one cylinder is fitted to")
+        ->check(cli::PositiveNumber)
+        ->capture_default_str();
+    sub->add_option("--cylinder-min-points", c.min_points, "Stretches with fewer points keep their nodes")
+        ->check(CLI::Range(6, 100000))
+        ->capture_default_str();
+    sub->add_option("--cylinder-max-rms", c.max_rms, "Fits whose RMS residual exceeds this many radii are not trusted")
+        ->check(cli::PositiveNumber)
+        ->capture_default_str();
+    sub->add_option("--cylinder-min-spread", c.min_spread,
+                    "Fits wider than the points' cross-section spread (RMS about each internode's centroid) over this many "
+                    "radii are not trusted: a bent twig fits a wide cylinder")
         ->check(cli::NonNegativeNumber)
         ->capture_default_str();
     sub->add_option("--root-diameter", o.stage.root_diameter, "Stem diameter at the base in metres (0 = from the stem fit)")

@@ -114,6 +114,8 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     if (!s.stem_visible) s.quality.flags.push_back("stem_not_visible");
     // Nodes on an axis measured by circle fits stay there (see recentre.hpp).
     s.recentred_nodes = recentre_internodes(sk.tree, pre.points, sk.point_internode, o.recentre, sk.node_on_axis);
+    // Then onto the axes of cylinders fitted to longer stretches (off by default, see cylinder_axes.hpp).
+    s.cylinder_axis_nodes = fit_cylinder_axes(sk.tree, pre.points, sk.point_internode, o.cylinder_axes, sk.node_on_axis);
     clock.mark("skeleton");
 
     out.trunk = fit_trunk(pre.points, sk.point_internode, sk.tree, o.trunk);

@@ -6,6 +6,7 @@
 #include "core/point_cloud.hpp"
 #include "core/tree_graph.hpp"
 #include "reconstruct/allometry.hpp"
+#include "reconstruct/cylinder_axes.hpp"
 #include "reconstruct/preprocess.hpp"
 #include "reconstruct/recentre.hpp"
 #include "reconstruct/skeleton.hpp"
@@ -22,6 +23,7 @@ struct ReconstructOptions {
     PreprocessOptions preprocess;
     SkeletonOptions skeleton;
     RecentreOptions recentre;  // thin internodes moved across onto their points (reconstruct/recentre.hpp)
+    CylinderAxesOptions cylinder_axes;  // nodes moved onto cylinders fitted to stretches of branch (reconstruct/cylinder_axes.hpp)
     TrunkOptions trunk;
     AllometryOptions allometry;
     QualityOptions quality;
@@ -47,6 +49,7 @@ struct TreeSummary {
     std::size_t branches = 0;      // axes: the trunk plus one per lateral child
     std::size_t internodes = 0;
     std::size_t recentred_nodes = 0;  // nodes moved onto their internode's points
+    std::size_t cylinder_axis_nodes = 0;  // nodes moved onto the axis of a fitted cylinder
     std::size_t tips = 0;
     int max_branch_order = 0;
     float spacing = 0.0f;
