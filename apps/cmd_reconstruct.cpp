@@ -68,6 +68,8 @@ nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s
             {"min_twig_length", k.min_twig_length},
             {"smoothing_iterations", k.smoothing_iterations},
             {"bridge_direction", k.bridge_direction},
+            {"max_gap", k.max_gap},
+            {"max_gap_points", k.max_gap_points},
             {"cylinder_axes", o.stage.cylinder_axes.enabled},
             {"root_diameter", o.stage.root_diameter},
             {"voxel_size", o.stage.preprocess.voxel_size},
@@ -94,7 +96,7 @@ nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& inpu
             {"input", input.string()},
             {"options", options_json(o, s)},
             {"points", {{"input", s.input_points}, {"used", s.used_points}, {"duplicates", s.duplicates},
-                        {"outliers", s.outliers}, {"ground", s.ground_points},
+                        {"outliers", s.outliers}, {"ground", s.ground_points}, {"beyond_gaps", s.detached_points},
                         {"outlier_test", o.stage.preprocess.outlier_neighbours == 0 ? "off" : s.local_outlier_test ? "local" : "global"},
                         {"linear_fraction", s.linear_fraction < 0 ? nlohmann::json() : nlohmann::json(rounded(s.linear_fraction, 3))}}},
             {"tree", {{"height", rounded(s.height, 3)},
@@ -232,6 +234,8 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
     sub->add_option("--geodesic-smoothing", k.geodesic_smoothing, "Neighbour-averaging passes over the geodesic field before binning")
         ->check(CLI::Range(0, 50))->capture_default_str();
     sub->add_option("--max-gap", k.max_gap, "Leave parts joined only across a longer gap (metres) out of the skeleton (0 = keep all)")
+        ->check(cli::NonNegativeNumber);
+    sub->add_option("--max-gap-points", k.max_gap_points, "With --max-gap: leave out only parts of fewer points (0 = any size)")
         ->check(cli::NonNegativeNumber);
     sub->add_option("--bridge-direction", k.bridge_direction,
                     "Weight of the angle between a gap bridge and its piece's own axis (0 = shortest bridges)")

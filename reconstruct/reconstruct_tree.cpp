@@ -110,6 +110,7 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     s.graph_components = sk.graph_components;
     s.bridges = sk.bridges;
     s.longest_bridge = sk.longest_bridge;
+    s.detached_points = sk.detached_points;
     s.stem_visible = sk.base.stem_visible;
     if (!s.stem_visible) s.quality.flags.push_back("stem_not_visible");
     // Nodes on an axis measured by circle fits stay there (see recentre.hpp).

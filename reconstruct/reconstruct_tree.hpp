@@ -38,6 +38,7 @@ struct TreeSummary {
     bool local_outlier_test = false;  // the local outlier test ran (reconstruct/preprocess.hpp)
     float linear_fraction = -1.0f;    // points with linear neighbourhoods, when measured (-1: not)
     std::size_t ground_points = 0;
+    std::size_t detached_points = 0;  // in pieces left out of the skeleton beyond gaps (--max-gap); they keep an internode
     bool ground_removed = false;
     float height = 0.0f;           // metres from the stem foot to the highest point
     bool dbh_fitted = false;

@@ -35,6 +35,7 @@ void check_options(const SkeletonOptions& o) {
     if (!(o.fine_bin_factor > 0.0f && o.fine_bin_factor <= 1.0f)) throw Error::usage("skeleton: fine bin factor must be in (0, 1]");
     non_negative(o.thick_slice, "thick slice");
     if (o.smoothing_iterations < 0 || o.smoothing_iterations > 100) throw Error::usage("skeleton: smoothing iterations must be in 0..100");
+    if (o.max_gap_points < 0) throw Error::usage("skeleton: maximum points of a piece left out beyond a gap must be >= 0");
 }
 
 float median_nearest_distance(const NeighbourGraph& g) {
@@ -498,25 +499,38 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
     return position;
 }
 
-// Clusters reached from the base only across a gap longer than `max_gap` (the longest edge on
-// the shortest path of their best-connected point), and everything above them. Such pieces
-// hang on a guessed connection; the lobe stage rather than the skeleton should represent them.
-std::vector<bool> detached_clusters(const Clusters& c, const NeighbourGraph& graph, const ShortestPaths& sp, float max_gap) {
+// Clusters reached from the base only across a gap longer than `max_gap` (an edge of the
+// geodesic shortest-path tree), and everything above them. Such pieces hang on a guessed
+// connection; the lobe stage rather than the skeleton should represent them. With
+// `max_points` > 0 only small pieces go: a piece is everything the shortest-path tree reaches
+// through the gap edge, and one of `max_points` points or more stays, since a big branch seen
+// across a gap is worth its straight join. A cluster goes when all its points are in pieces
+// that go (or its parent goes).
+std::vector<bool> detached_clusters(const Clusters& c, const NeighbourGraph& graph, const ShortestPaths& sp, float max_gap,
+                                    int max_points) {
     std::vector<bool> detached(c.size(), false);
     if (!(max_gap > 0)) return detached;
-    std::vector<float> gap(sp.parent.size(), 0.0f);
+    const std::size_t n = sp.parent.size();
+    std::vector<float> hop(n, 0.0f);  // length of the edge from a point's parent
     for (int v : sp.order) {
         const int u = sp.parent[v];
         if (u < 0) continue;
-        float length = 0;
         for (std::uint32_t e = graph.offsets[v]; e < graph.offsets[v + 1]; ++e)
-            if (graph.targets[e] == u) length = graph.lengths[e];
-        gap[v] = std::max(gap[u], length);
+            if (graph.targets[e] == u) hop[v] = graph.lengths[e];
     }
-    std::vector<float> best(c.size(), std::numeric_limits<float>::infinity());
-    for (std::size_t i = 0; i < gap.size(); ++i) best[c.of_point[i]] = std::min(best[c.of_point[i]], gap[i]);
+    std::vector<int> above(n, 1);  // points of the shortest-path subtree from each point up
+    for (auto it = sp.order.rbegin(); it != sp.order.rend(); ++it)  // children before parents
+        if (sp.parent[*it] >= 0) above[sp.parent[*it]] += above[*it];
+    std::vector<char> gone(n, 0);
+    for (int v : sp.order) {  // parents first
+        const int u = sp.parent[v];
+        gone[v] = (u >= 0 && gone[u]) || (hop[v] > max_gap && (max_points <= 0 || above[v] < max_points));
+    }
+    std::vector<char> all_gone(c.size(), 1);
+    for (std::size_t i = 0; i < n; ++i)
+        if (!gone[i]) all_gone[c.of_point[i]] = 0;
     for (std::size_t k = 0; k < c.size(); ++k)  // parents come first
-        detached[k] = best[k] > max_gap || (c.parent[k] >= 0 && detached[c.parent[k]]);
+        detached[k] = all_gone[k] || (c.parent[k] >= 0 && detached[c.parent[k]]);
     return detached;
 }
 
@@ -792,11 +806,13 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     lap("axis fits");
     std::vector<int> node_of_point(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) node_of_point[i] = clusters.of_point[i] + 1;
-    const std::vector<bool> detached = detached_clusters(clusters, graph, sp, o.max_gap);
+    const std::vector<bool> detached = detached_clusters(clusters, graph, sp, o.max_gap, o.max_gap_points);
     if (std::find(detached.begin(), detached.end(), true) != detached.end()) {
         std::vector<bool> keep(tree.size(), true);
         for (std::size_t k = 0; k < detached.size(); ++k) keep[k + 1] = !detached[k];
         for (std::size_t i = 0; i < points.size(); ++i) r.detached_points += detached[clusters.of_point[i]];
+        log_debug("skeleton: " + std::to_string(r.detached_points) + " points in " +
+                  std::to_string(std::count(detached.begin(), detached.end(), true)) + " clusters beyond gaps left out of the skeleton");
         std::vector<int> new_index;
         tree = keep_nodes(tree, keep, new_index);
         for (int& node : node_of_point) node = new_index[node];

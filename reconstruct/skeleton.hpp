@@ -51,7 +51,8 @@ struct SkeletonOptions {
     int geodesic_smoothing = 3;     // neighbour-averaging passes over the geodesic field before binning
     bool fit_axes = true;           // move wide clusters onto a fitted circle centre (one-sided scans)
     float bridge_direction = 2.0f;  // weight of the angle between a gap bridge and its piece's axis (0 = shortest bridges)
-    float max_gap = 0.0f;           // metres; parts reached only across a longer gap stay out of the skeleton (0 = gap_factor x spacing)
+    float max_gap = 0.0f;           // metres; parts reached only across a longer gap stay out of the skeleton (0 = keep all)
+    int max_gap_points = 0;         // with max_gap: only parts of fewer points stay out, bigger ones keep their join (0 = any size)
     TreeBaseOptions base;
 };
 

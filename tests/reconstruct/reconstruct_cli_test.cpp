@@ -155,3 +155,23 @@ TEST(ReconstructCli, RecentreOptionsReachTheSummary) {
     EXPECT_GT(recentred("--recentre-inside-band 0 --recentre-max-spread 0.2"), 0);  // every thin node off its centre moves
     EXPECT_EQ(run_cli("reconstruct " + quoted(dir / "y.xyz") + " --out " + quoted(dir / "out") + " --recentre-max-spread 0").exit_code, 1);
 }
+
+// A stem with a crumb of bark cut off by a 0.3 m gap: --max-gap leaves it out of the skeleton,
+// --max-gap-points keeps pieces at least that big, and the summary counts the points left out.
+TEST(ReconstructCli, PiecesBeyondGapsAreCountedInTheSummary) {
+    TempDir dir;
+    const std::vector<test::Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f}, {{-0.45f, 0, 2.0f}, {-0.6f, 0, 2.15f}, 0.03f}};
+    write_point_cloud(test::cloud_from(truth, 3000), dir / "t.xyz");
+    auto beyond_gaps = [&](const std::string& flags) {
+        const auto r = run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --overwrite " + flags);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        const auto summary = nlohmann::json::parse(slurp(dir / "out" / "t_summary.json"));
+        return std::pair{summary["points"]["beyond_gaps"].get<int>(), summary["tree"]["tips"].get<int>()};
+    };
+    EXPECT_EQ(beyond_gaps(""), std::pair(0, 2));
+    const auto [left_out, tips] = beyond_gaps("--max-gap 0.15");
+    EXPECT_GT(left_out, 50);
+    EXPECT_EQ(tips, 1);
+    EXPECT_EQ(beyond_gaps("--max-gap 0.15 --max-gap-points 20"), std::pair(0, 2));
+    EXPECT_EQ(run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --max-gap-points -3").exit_code, 1);
+}

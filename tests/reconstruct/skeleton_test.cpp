@@ -192,6 +192,47 @@ TEST(Skeleton, DetachedPieceIsBridgedIntoTheOneTree) {
     for (int node : cut.point_internode) EXPECT_GT(node, 0);
 }
 
+TEST(Skeleton, SizeLimitedDetachmentKeepsABigBranchAcrossAGapAndDropsASmallPiece) {
+    // Two pieces cut off from the stem by ~0.3 m gaps: a 1.1 m branch (~830 points) and a
+    // 0.2 m crumb (~120 points). --max-gap alone drops both with the joins drawn to them; with
+    // a size limit between the two only the crumb goes.
+    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f},
+                                     {{0.35f, 0, 1.5f}, {1.2f, 0, 2.2f}, 0.04f},
+                                     {{-0.45f, 0, 2.0f}, {-0.6f, 0, 2.15f}, 0.03f}};
+    const PointCloud cloud = test::cloud_from(truth, 3000);
+    auto near = [](const SkeletonResult& r, const Eigen::Vector3f& p) {
+        for (const auto& node : r.tree.nodes)
+            if ((node.position - p).norm() < 0.2f) return true;
+        return false;
+    };
+    const Eigen::Vector3f branch_end(1.1f, 0, 2.1f), crumb(-0.55f, 0, 2.1f);
+    const SkeletonResult all = reconstruct_skeleton(cloud.positions, {});
+    EXPECT_EQ(all.tree.tip_count(), 3u);
+    EXPECT_TRUE(near(all, branch_end));
+    EXPECT_TRUE(near(all, crumb));
+
+    SkeletonOptions any_size;
+    any_size.max_gap = 0.15f;
+    const SkeletonResult cut = reconstruct_skeleton(cloud.positions, any_size);
+    EXPECT_EQ(cut.tree.tip_count(), 1u);
+    EXPECT_FALSE(near(cut, branch_end));
+
+    SkeletonOptions small_only = any_size;
+    small_only.max_gap_points = 400;
+    const SkeletonResult r = reconstruct_skeleton(cloud.positions, small_only);
+    r.tree.validate("size-limited gap");
+    EXPECT_EQ(r.tree.tip_count(), 2u);
+    EXPECT_TRUE(near(r, branch_end));
+    EXPECT_FALSE(near(r, crumb));
+    EXPECT_GT(r.detached_points, 50u);
+    EXPECT_LT(r.detached_points, 400u);
+    EXPECT_LT(r.detached_points, cut.detached_points);
+    for (int node : r.point_internode) EXPECT_GT(node, 0);  // the crumb's points hang from the stem
+    SkeletonOptions negative;
+    negative.max_gap_points = -1;
+    EXPECT_THROW(reconstruct_skeleton(cloud.positions, negative), Error);
+}
+
 TEST(Skeleton, BranchBeyondAGapContinuesAlongItsAxisNotSidewaysToTheStem) {
     // A branch bends up to run 0.35 m beside the stem and is lost for 0.4 m (occlusion); its
     // continuation lies closer to the stem's bark (0.24 m) than to its own lower part. The
