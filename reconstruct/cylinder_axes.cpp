@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "reconstruct/internode_points.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Geometry>
@@ -204,18 +205,10 @@ std::size_t fit_cylinder_axes(TreeGraph& tree, std::span<const Eigen::Vector3f> 
     if (!fixed.empty() && fixed.size() != tree.size()) throw Error(ExitCode::Internal, "cylinder axes: one fixed flag per node expected");
     if (!o.enabled || tree.size() < 2) return 0;
 
-    // Points grouped by internode, in input order (counting sort: deterministic, O(n)).
     const std::size_t n = tree.size();
-    std::vector<std::size_t> start(n + 1, 0);
-    for (int u : point_internode)
-        if (u > 0 && static_cast<std::size_t>(u) < n) ++start[static_cast<std::size_t>(u) + 1];
-    for (std::size_t u = 0; u < n; ++u) start[u + 1] += start[u];
-    std::vector<int> grouped(start[n]);
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const int u = point_internode[i];
-        if (u > 0 && static_cast<std::size_t>(u) < n) grouped[fill[static_cast<std::size_t>(u)]++] = static_cast<int>(i);
-    }
+    const InternodePoints groups = group_by_internode(point_internode, n);
+    const std::vector<std::size_t>& start = groups.start;
+    const std::vector<int>& grouped = groups.index;
 
     // A stretch of a dense scan holds thousands of points; an even subset pins the cylinder as
     // well and keeps the fits' cost bounded (OR_wood: windows of up to ~1,100 points).

@@ -1,6 +1,7 @@
 #include "reconstruct/recentre.hpp"
 
 #include "core/error.hpp"
+#include "reconstruct/internode_points.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -68,18 +69,10 @@ std::size_t recentre_internodes(TreeGraph& tree, std::span<const Eigen::Vector3f
     if (!fixed.empty() && fixed.size() != tree.size()) throw Error(ExitCode::Internal, "recentre: one fixed flag per node expected");
     if (!o.enabled || tree.size() < 2) return 0;
 
-    // Points grouped by internode, in input order (a counting sort: deterministic and O(n)).
     const std::size_t n = tree.size();
-    std::vector<std::size_t> start(n + 1, 0);
-    for (int u : point_internode)
-        if (u > 0 && static_cast<std::size_t>(u) < n) ++start[static_cast<std::size_t>(u) + 1];
-    for (std::size_t u = 0; u < n; ++u) start[u + 1] += start[u];
-    std::vector<int> grouped(start[n]);
-    std::vector<std::size_t> fill(start.begin(), start.end() - 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const int u = point_internode[i];
-        if (u > 0 && static_cast<std::size_t>(u) < n) grouped[fill[static_cast<std::size_t>(u)]++] = static_cast<int>(i);
-    }
+    const InternodePoints groups = group_by_internode(point_internode, n);
+    const std::vector<std::size_t>& start = groups.start;
+    const std::vector<int>& grouped = groups.index;
 
     // Shifts are computed on the input positions, then applied together.
     std::vector<Eigen::Vector3f> shift(n, Eigen::Vector3f::Zero());
