@@ -36,6 +36,8 @@ void check_options(const SkeletonOptions& o) {
     non_negative(o.thick_slice, "thick slice");
     if (o.smoothing_iterations < 0 || o.smoothing_iterations > 100) throw Error::usage("skeleton: smoothing iterations must be in 0..100");
     if (o.max_gap_points < 0) throw Error::usage("skeleton: maximum points of a piece left out beyond a gap must be >= 0");
+    if (o.max_gap_points > 0 && !(o.max_gap > 0))  // the size limit alone would silently do nothing
+        throw Error::usage("skeleton: --max-gap-points needs --max-gap (the gap length beyond which pieces are left out)");
 }
 
 float median_nearest_distance(const NeighbourGraph& g) {

@@ -174,4 +174,7 @@ TEST(ReconstructCli, PiecesBeyondGapsAreCountedInTheSummary) {
     EXPECT_EQ(tips, 1);
     EXPECT_EQ(beyond_gaps("--max-gap 0.15 --max-gap-points 20"), std::pair(0, 2));
     EXPECT_EQ(run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --max-gap-points -3").exit_code, 1);
+    const auto alone = run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --overwrite --max-gap-points 20");
+    EXPECT_EQ(alone.exit_code, 1);
+    EXPECT_NE(alone.err.find("--max-gap-points needs --max-gap"), std::string::npos) << alone.err;
 }
