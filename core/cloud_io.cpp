@@ -22,12 +22,6 @@ bool is_text_extension(const std::string& ext) {
     return ext == "xyz" || ext == "txt" || ext == "csv" || ext == "pts" || ext == "asc";
 }
 
-[[noreturn]] void reject_laz(const fs::path& path) {
-    throw Error::input(path.string(),
-                       "LAZ is not supported yet: decompress with `laszip -i FILE.laz -o FILE.las` or "
-                       "`pdal translate FILE.laz FILE.las` and pass the .las file");
-}
-
 // Identifies files by their first bytes when the extension is unknown.
 std::string sniff_format(const fs::path& path) {
     std::ifstream in(path, std::ios::binary);
@@ -46,21 +40,33 @@ void check_readable(const fs::path& path) {
     if (fs::is_directory(path, ec)) throw Error::input(path.string(), "is a directory, expected a point-cloud file");
 }
 
-}  // namespace
+// Formats without a spatial index are read whole, then cut to the box.
+PointCloud keep_inside(PointCloud cloud, const Box3d& box) {
+    std::vector<bool> keep(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) keep[i] = box.contains(cloud.global(i));
+    return cloud.subset(keep);
+}
 
-PointCloud read_point_cloud(const fs::path& path) {
-    check_readable(path);
-    std::string ext = file_extension(path);
-    if (ext == "laz") reject_laz(path);
-    if (ext != "las" && ext != "ply" && ext != "pcd" && !is_text_extension(ext)) {
-        ext = sniff_format(path);
-        if (ext.empty())
-            throw Error::input(path.string(), "unknown point-cloud format (expected .las, .ply, .pcd, .xyz, .txt, .csv, .pts)");
-    }
-    if (ext == "las") return read_las(path);
+PointCloud read_other_format(const fs::path& path, const std::string& ext) {
     if (ext == "ply") return read_ply_cloud(path);
     if (ext == "pcd") return read_pcd(path);
     return read_text_cloud(path);
+}
+
+}  // namespace
+
+PointCloud read_point_cloud(const fs::path& path, const CloudReadOptions& options) {
+    check_readable(path);
+    std::string ext = file_extension(path);
+    if (ext != "las" && ext != "laz" && ext != "ply" && ext != "pcd" && !is_text_extension(ext)) {
+        ext = sniff_format(path);
+        if (ext.empty())
+            throw Error::input(path.string(), "unknown point-cloud format (expected .las, .laz, .ply, .pcd, .xyz, .txt, .csv, .pts)");
+    }
+    // LAZ is LAS with compressed point data: one reader for both.
+    if (ext == "las" || ext == "laz") return read_las(path, options);
+    PointCloud cloud = read_other_format(path, ext);
+    return options.bounds ? keep_inside(std::move(cloud), *options.bounds) : cloud;
 }
 
 void write_point_cloud(const PointCloud& cloud, const fs::path& path) {

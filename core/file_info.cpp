@@ -47,11 +47,19 @@ void snap_to_las_grid(FileInfo& info) {
     }
 }
 
-FileInfo describe_cloud(const fs::path& path) {
-    const PointCloud cloud = read_point_cloud(path);
+FileInfo describe_cloud(const fs::path& path, const std::optional<Box3d>& bounds) {
+    CloudReadOptions options;
+    options.bounds = bounds;
+    const PointCloud cloud = read_point_cloud(path, options);
     FileInfo info;
     info.kind = "point cloud";
     info.format = cloud.source.format;
+    info.bounds_query = bounds.has_value();
+    info.laz_chunk_size = cloud.source.laz_chunk_size;
+    info.laz_chunks = cloud.source.laz_chunks;
+    info.copc_levels = cloud.source.copc_levels;
+    info.copc_nodes = cloud.source.copc_nodes;
+    info.copc_nodes_read = cloud.source.copc_nodes_read;
     info.version = cloud.source.version;
     info.las_point_format = cloud.source.las_point_format;
     if (info.format == "las") {
@@ -70,6 +78,7 @@ FileInfo describe_cloud(const fs::path& path) {
     if (!cloud.gps_time.empty()) add("gps_time", "float64");
     for (const auto& extra : cloud.extras) add(extra.name, attribute_type_name(extra.type));
     if (info.format == "las") snap_to_las_grid(info);
+    if (cloud.source.laz) info.format = "laz";
     info.crs = cloud.georef.crs_wkt;
     if (info.crs.empty() && !cloud.georef.las_vlrs.empty()) info.crs = "GeoTIFF keys (" + std::to_string(cloud.georef.las_vlrs.size()) + " VLRs)";
     return info;
@@ -103,14 +112,14 @@ FileInfo describe_skeleton(const fs::path& path) {
 
 }  // namespace
 
-FileInfo describe_file(const fs::path& path) {
+FileInfo describe_file(const fs::path& path, const std::optional<Box3d>& bounds) {
     const std::string ext = file_extension(path);
     FileInfo info;
     if (ext == "obj" || ext == "off" || ext == "stl") info = describe_mesh(path);
     else if (ext == "ply" && fs::is_regular_file(path)) {
         const std::string kind = ply_kind(path);
-        info = kind == "mesh" ? describe_mesh(path) : kind == "skeleton" ? describe_skeleton(path) : describe_cloud(path);
-    } else info = describe_cloud(path);
+        info = kind == "mesh" ? describe_mesh(path) : kind == "skeleton" ? describe_skeleton(path) : describe_cloud(path, bounds);
+    } else info = describe_cloud(path, bounds);
     info.path = path.string();
     return info;
 }

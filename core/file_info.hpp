@@ -2,7 +2,11 @@
 // counts, bounds in original coordinates, attributes and CRS.
 #pragma once
 
+#include "core/cloud_io.hpp"
+
 #include <Eigen/Core>
+
+#include <optional>
 
 #include <filesystem>
 #include <string>
@@ -26,10 +30,20 @@ struct FileInfo {
     std::size_t face_count = 0;  // meshes
     std::size_t tip_count = 0;   // skeletons
     double total_length = 0.0;   // skeletons, metres
+    // LAZ input: format is "laz"; chunk size (0xFFFFFFFF = variable) and chunk count.
+    std::uint32_t laz_chunk_size = 0;
+    std::size_t laz_chunks = 0;
+    // COPC input: octree levels and nodes with points (-1 levels when not COPC); under a
+    // bounds query, the nodes that were read.
+    int copc_levels = -1;
+    std::size_t copc_nodes = 0, copc_nodes_read = 0;
+    bool bounds_query = false;  // the counts describe the points inside a --bounds box
 };
 
 // Reads the file fully (so that a truncated file is reported) and describes it. Throws
 // Error(InvalidInput) like the readers do.
-FileInfo describe_file(const std::filesystem::path& path);
+// With a bounds box, point clouds are described by the points inside it (COPC: read from the
+// octree nodes meeting the box only).
+FileInfo describe_file(const std::filesystem::path& path, const std::optional<Box3d>& bounds = std::nullopt);
 
 }  // namespace treelobes

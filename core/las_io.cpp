@@ -15,6 +15,11 @@
 #include "core/atomic_file.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
+#include "core/las_io.hpp"
+#include "core/laz_chunk.hpp"
+#include "core/laz_layout.hpp"
+#include "core/little_endian.hpp"
 #include "core/log.hpp"
 #include "core/version.hpp"
 
@@ -27,6 +32,11 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <functional>
+#include <iterator>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <limits>
 #include <optional>
 #include <string>
@@ -40,31 +50,6 @@ namespace treelobes {
 namespace {
 
 using Bytes = std::vector<std::uint8_t>;
-
-// ---------------------------------------------------------------------------------------------
-// Little-endian field access. LAS is little-endian on every host; assembling the bytes keeps the
-// code independent of the host's byte order.
-
-template <std::size_t N> struct UnsignedOfSize;
-template <> struct UnsignedOfSize<1> { using type = std::uint8_t; };
-template <> struct UnsignedOfSize<2> { using type = std::uint16_t; };
-template <> struct UnsignedOfSize<4> { using type = std::uint32_t; };
-template <> struct UnsignedOfSize<8> { using type = std::uint64_t; };
-
-template <typename T>
-T load(const std::uint8_t* p) {
-    using U = typename UnsignedOfSize<sizeof(T)>::type;
-    std::uint64_t bits = 0;
-    for (std::size_t i = 0; i < sizeof(T); ++i) bits |= std::uint64_t{p[i]} << (8 * i);
-    return std::bit_cast<T>(static_cast<U>(bits));
-}
-
-template <typename T>
-void store(std::uint8_t* p, T value) {
-    using U = typename UnsignedOfSize<sizeof(T)>::type;
-    const auto bits = static_cast<std::uint64_t>(std::bit_cast<U>(value));
-    for (std::size_t i = 0; i < sizeof(T); ++i) p[i] = static_cast<std::uint8_t>(bits >> (8 * i));
-}
 
 // Fixed-size character fields are NUL-padded (and not always NUL-terminated when full).
 std::string load_string(const std::uint8_t* p, std::size_t size) {
@@ -121,6 +106,11 @@ constexpr std::string_view kSpecUser = "LASF_Spec";
 constexpr std::uint16_t kExtraBytesRecord = 4;
 constexpr std::uint16_t kWktRecord = 2112;
 constexpr std::uint16_t kGeoKeyDirectoryRecord = 34735;
+constexpr std::string_view kLaszipUser = "laszip encoded";  // LAZ specification 1.4, "LASzip VLR"
+constexpr std::uint16_t kLaszipRecord = 22204;
+constexpr std::string_view kCopcUser = "copc";              // COPC 1.0: info VLR 1, hierarchy EVLR 1000
+constexpr std::uint16_t kCopcInfoRecord = 1;
+constexpr std::uint16_t kCopcHierarchyRecord = 1000;
 
 // Where the optional fields sit in a point record; -1 when the format lacks them.
 struct PointFormat {
@@ -193,54 +183,6 @@ std::string printable(const std::uint8_t* p, std::size_t size) {
 // ---------------------------------------------------------------------------------------------
 // Reading
 
-// A LAS file opened for random access; every read is checked against the file size first.
-class InputFile {
-public:
-    explicit InputFile(const fs::path& path) : name_(path.string()) {
-        std::error_code ec;
-        const fs::file_status status = fs::status(path, ec);
-        if (ec || !fs::exists(status)) fail("no such file");
-        if (fs::is_directory(status)) fail("is a directory, expected a LAS file");
-        // FIFOs and devices have no size to check counts against (and may block forever).
-        if (!fs::is_regular_file(status)) fail("is not a regular file, expected a LAS file");
-        size_ = fs::file_size(path, ec);
-        if (ec) fail("cannot determine the file size: " + ec.message());
-        in_.open(path, std::ios::binary);
-        if (!in_) fail("cannot open for reading (permission denied?)");
-    }
-
-    std::uint64_t size() const { return size_; }
-    const std::string& name() const { return name_; }
-    [[noreturn]] void fail(const std::string& what) const { throw Error::input(name_, what); }
-
-    void read(std::uint64_t offset, std::size_t count, std::uint8_t* out, std::string_view what) {
-        check_range(offset, count, what);
-        in_.clear();
-        in_.seekg(static_cast<std::streamoff>(offset));
-        in_.read(reinterpret_cast<char*>(out), static_cast<std::streamsize>(count));
-        if (static_cast<std::size_t>(in_.gcount()) != count)
-            fail("read error in the " + std::string(what) + " at byte " + std::to_string(offset));
-    }
-
-    Bytes read(std::uint64_t offset, std::size_t count, std::string_view what) {
-        check_range(offset, count, what);  // before allocating
-        Bytes out(count);
-        read(offset, count, out.data(), what);
-        return out;
-    }
-
-private:
-    void check_range(std::uint64_t offset, std::size_t count, std::string_view what) const {
-        if (offset > size_ || count > size_ - offset)
-            fail("the " + std::string(what) + " (" + std::to_string(count) + " bytes at byte " + std::to_string(offset) +
-                 ") runs past the end of the file (" + std::to_string(size_) + " bytes; truncated?)");
-    }
-
-    std::string name_;
-    std::uint64_t size_ = 0;
-    std::ifstream in_;
-};
-
 struct LasHeader {
     int minor = 0;
     std::uint16_t global_encoding = 0;
@@ -253,6 +195,8 @@ struct LasHeader {
     Eigen::Vector3d scale, offset, min, max;
     std::uint64_t evlr_start = 0;
     std::uint32_t evlr_count = 0;
+    bool compressed = false;  // LAZ: the point format byte has bit 7 (or 6) set
+    Bytes raw;                // the header bytes as stored (header_size of them)
 };
 
 // Reads up to the largest header (375 bytes) and checks the signature and minimum length.
@@ -292,10 +236,6 @@ void check_layout(const InputFile& file, const LasHeader& h) {
 }
 
 void check_point_format(const InputFile& file, int format_byte, std::uint16_t record_length) {
-    // LASzip marks compressed point data by setting bit 7 of the point format.
-    if ((format_byte & 0x80) != 0 && (format_byte & 0x3f) <= 10)
-        file.fail("point data is LAZ-compressed; LAZ is not supported yet: decompress with "
-                  "`laszip -i FILE.laz -o FILE.las` or `pdal translate FILE.laz FILE.las` and pass the .las file");
     if (format_byte > 10) file.fail("unsupported point data format " + std::to_string(format_byte) + ", expected 0-10");
     const PointFormat& format = kFormats[static_cast<std::size_t>(format_byte)];
     if (record_length < format.size)
@@ -338,7 +278,13 @@ LasHeader read_header(InputFile& file) {
     h.header_size = load<std::uint16_t>(p + field::header_size);
     h.offset_to_points = load<std::uint32_t>(p + field::offset_to_points);
     h.vlr_count = load<std::uint32_t>(p + field::vlr_count);
+    // LASzip marks compressed point data by setting bit 7 of the point format (some writers
+    // also bit 6); the remaining bits are the uncompressed format.
     h.point_format = p[field::point_format];
+    if ((h.point_format & 0xC0) != 0 && (h.point_format & 0x3F) <= 10) {
+        h.compressed = true;
+        h.point_format &= 0x3F;
+    }
     h.record_length = load<std::uint16_t>(p + field::record_length);
     h.point_count = load<std::uint32_t>(p + field::legacy_point_count);
     for (int k = 0; k < 3; ++k) {
@@ -357,20 +303,22 @@ LasHeader read_header(InputFile& file) {
     }
     check_point_format(file, h.point_format, h.record_length);
     check_scale_offset(file, h);
-    check_point_count(file, h);
+    if (!h.compressed) check_point_count(file, h);  // LAZ counts are checked against the chunk table
+    h.raw = file.read(0, h.header_size, "header");
     return h;
 }
 
 // The records this reader uses: CRS records (kept verbatim) and the Extra Bytes description.
 bool is_wanted_record(const RawVlr& r) {
-    return r.user_id == kProjectionUser || (r.user_id == kSpecUser && r.record_id == kExtraBytesRecord);
+    return r.user_id == kProjectionUser || (r.user_id == kSpecUser && r.record_id == kExtraBytesRecord) ||
+           (r.user_id == kLaszipUser && r.record_id == kLaszipRecord) || r.user_id == kCopcUser;
 }
 
 std::string record_label(std::size_t index, std::size_t count, const std::string& user, std::uint16_t id) {
     return std::to_string(index + 1) + " of " + std::to_string(count) + " ('" + user + "', record " + std::to_string(id) + ")";
 }
 
-std::vector<RawVlr> read_vlrs(InputFile& file, const LasHeader& h) {
+std::vector<RawVlr> read_vlrs(InputFile& file, const LasHeader& h, bool keep_all = false) {
     const std::size_t region_size = h.offset_to_points - h.header_size;
     if (h.vlr_count > region_size / kVlrHeaderSize)
         file.fail("header declares " + std::to_string(h.vlr_count) + " VLRs, but only " + std::to_string(region_size) +
@@ -390,7 +338,7 @@ std::vector<RawVlr> read_vlrs(InputFile& file, const LasHeader& h) {
             file.fail("VLR " + record_label(i, h.vlr_count, record.user_id, record.record_id) + " at byte " +
                       std::to_string(h.header_size + pos) + " declares " + std::to_string(length) +
                       " bytes and runs past the start of point data at byte " + std::to_string(h.offset_to_points));
-        if (is_wanted_record(record)) {
+        if (keep_all || is_wanted_record(record)) {
             record.data.assign(p + kVlrHeaderSize, p + kVlrHeaderSize + length);
             records.push_back(std::move(record));
         }
@@ -401,7 +349,7 @@ std::vector<RawVlr> read_vlrs(InputFile& file, const LasHeader& h) {
 
 // LAS 1.4 extended VLRs live after the point data and may be large (WKT, waveforms); only the
 // wanted ones are loaded, the others are skipped by seeking.
-std::vector<RawVlr> read_evlrs(InputFile& file, const LasHeader& h) {
+std::vector<RawVlr> read_evlrs(InputFile& file, const LasHeader& h, bool keep_all = false) {
     std::vector<RawVlr> records;
     if (h.minor < 4 || h.evlr_count == 0) return records;
     if (h.evlr_start < h.header_size || h.evlr_start > file.size() ||
@@ -419,7 +367,7 @@ std::vector<RawVlr> read_evlrs(InputFile& file, const LasHeader& h) {
             file.fail("extended VLR " + record_label(i, h.evlr_count, record.user_id, record.record_id) + " at byte " +
                       std::to_string(pos) + " declares " + std::to_string(length) +
                       " bytes and runs past the end of the file (truncated?)");
-        if (is_wanted_record(record)) {
+        if (keep_all || is_wanted_record(record)) {
             record.data = file.read(pos + kEvlrHeaderSize, static_cast<std::size_t>(length), "extended VLR");
             records.push_back(std::move(record));
         }
@@ -577,7 +525,7 @@ double choose_origin_axis(double offset, double lo, double hi) {
     return std::round((lo + hi) / 2);
 }
 
-Eigen::Vector3d choose_origin(InputFile& file, const LasHeader& h) {
+Eigen::Vector3d choose_origin(InputFile& file, const LasHeader& h, std::uint64_t first_record) {
     if (h.point_count == 0) return h.offset;
     Eigen::Vector3d lo = h.min, hi = h.max;
     // Header bounds are required by the specification but not always right; fall back to the
@@ -585,7 +533,7 @@ Eigen::Vector3d choose_origin(InputFile& file, const LasHeader& h) {
     const bool usable = lo.allFinite() && hi.allFinite() && (lo.array() <= hi.array()).all() &&
                         lo.cwiseAbs().maxCoeff() <= kMaxCoordinate && hi.cwiseAbs().maxCoeff() <= kMaxCoordinate;
     if (!usable) {
-        const Bytes first = file.read(h.offset_to_points, 12, "first point record");
+        const Bytes first = file.read(first_record, 12, "first point record");
         for (int k = 0; k < 3; ++k)
             lo[k] = hi[k] = load<std::int32_t>(first.data() + 4 * k) * h.scale[k] + h.offset[k];
     }
@@ -595,15 +543,18 @@ Eigen::Vector3d choose_origin(InputFile& file, const LasHeader& h) {
 }
 
 // Sizes the attribute vectors the point format has (and only those).
+// With `all_fields` false only positions, return numbers, classification and extras.
 void allocate_attributes(PointCloud& cloud, const PointFormat& format, const std::vector<ExtraField>& fields,
-                         std::size_t n) {
+                         std::size_t n, bool all_fields) {
     cloud.positions.resize(n);
-    cloud.intensity.resize(n);
     cloud.return_number.resize(n);
     cloud.number_of_returns.resize(n);
     cloud.classification.resize(n);
-    if (format.gps_offset >= 0) cloud.gps_time.resize(n);
-    if (format.rgb_offset >= 0) cloud.rgb.resize(n);
+    if (all_fields) {
+        cloud.intensity.resize(n);
+        if (format.gps_offset >= 0) cloud.gps_time.resize(n);
+        if (format.rgb_offset >= 0) cloud.rgb.resize(n);
+    }
     for (const ExtraField& f : fields) {
         cloud.extras.push_back(f.attribute);
         cloud.extras.back().values.resize(n);
@@ -614,13 +565,18 @@ struct PointDecoder {
     const PointFormat& format;
     Eigen::Vector3d scale, offset, origin;
     const std::vector<ExtraField>& fields;
+    bool all_fields = true;
+    const Box3d* bounds = nullptr;           // when set, inside[i] says whether point i lies in it
+    std::vector<std::uint8_t>* inside = nullptr;
 
     void decode(const std::uint8_t* record, std::size_t i, PointCloud& cloud) const {
+        Eigen::Vector3d global;
         for (int k = 0; k < 3; ++k) {
-            const double global = load<std::int32_t>(record + 4 * k) * scale[k] + offset[k];
-            cloud.positions[i][k] = static_cast<float>(global - origin[k]);
+            global[k] = load<std::int32_t>(record + 4 * k) * scale[k] + offset[k];
+            cloud.positions[i][k] = static_cast<float>(global[k] - origin[k]);
         }
-        cloud.intensity[i] = load<std::uint16_t>(record + 12);
+        if (bounds) (*inside)[i] = bounds->contains(global) ? 1 : 0;
+        if (all_fields) cloud.intensity[i] = load<std::uint16_t>(record + 12);
         const std::uint8_t returns = record[14];
         if (format.extended) {
             cloud.return_number[i] = returns & 0x0f;
@@ -631,8 +587,8 @@ struct PointDecoder {
             cloud.number_of_returns[i] = (returns >> 3) & 0x07;
             cloud.classification[i] = record[15] & 0x1f;  // upper bits are synthetic/key-point/withheld flags
         }
-        if (format.gps_offset >= 0) cloud.gps_time[i] = load<double>(record + format.gps_offset);
-        if (format.rgb_offset >= 0)
+        if (all_fields && format.gps_offset >= 0) cloud.gps_time[i] = load<double>(record + format.gps_offset);
+        if (all_fields && format.rgb_offset >= 0)
             for (int c = 0; c < 3; ++c) cloud.rgb[i][c] = load<std::uint16_t>(record + format.rgb_offset + 2 * c);
         for (std::size_t e = 0; e < fields.size(); ++e) {
             const ExtraField& f = fields[e];
@@ -642,26 +598,189 @@ struct PointDecoder {
     }
 };
 
-void read_points(InputFile& file, const LasHeader& h, const PointDecoder& decoder, PointCloud& cloud) {
+// ---------------------------------------------------------------------------------------------
+// Point records, uncompressed or LAZ
+
+// A LAS or LAZ file opened for reading points: header, records and, for LAZ, where the chunks are.
+struct LasSource {
+    LasHeader header;
+    std::vector<RawVlr> records;  // VLRs first (vlr_count of them), then EVLRs
+    std::size_t vlr_count = 0;
+    std::optional<laz::LaszipVlr> laz;
+    std::vector<laz::Chunk> chunks;  // LAZ: every chunk, in file order
+    std::optional<laz::CopcInfo> copc;
+};
+
+const RawVlr* find_record(const std::vector<RawVlr>& records, std::string_view user, std::uint16_t id) {
+    for (const RawVlr& r : records)
+        if (r.user_id == user && r.record_id == id) return &r;
+    return nullptr;
+}
+
+// Point data ends where the EVLRs start (LAS 1.4) or at the end of the file.
+std::uint64_t point_data_end(const InputFile& file, const LasHeader& h) {
+    if (h.minor >= 4 && h.evlr_count > 0 && h.evlr_start > h.offset_to_points && h.evlr_start <= file.size())
+        return h.evlr_start;
+    return file.size();
+}
+
+LasSource open_las(InputFile& file, bool keep_all_records) {
+    LasSource src;
+    src.header = read_header(file);
+    const LasHeader& h = src.header;
+    src.records = read_vlrs(file, h, keep_all_records);
+    src.vlr_count = src.records.size();
+    for (RawVlr& r : read_evlrs(file, h, keep_all_records)) src.records.push_back(std::move(r));
+    if (!h.compressed) return src;
+    const RawVlr* laszip = find_record(src.records, kLaszipUser, kLaszipRecord);
+    if (!laszip)
+        file.fail("the point format byte marks LAZ compression, but there is no LASzip VLR ('laszip encoded', record 22204)");
+    src.laz = laz::parse_laszip_vlr(laszip->data, h.point_format, h.record_length, file.name());
+    src.chunks = laz::read_chunk_table(file, *src.laz, h.offset_to_points, point_data_end(file, h), h.point_count,
+                                       h.record_length);
+    if (const RawVlr* info = find_record(src.records, kCopcUser, kCopcInfoRecord))
+        src.copc = laz::parse_copc_info(info->data, file.name());
+    return src;
+}
+
+// Where the first point record's bytes are: LAZ stores each chunk's first point raw.
+std::uint64_t first_record_offset(const LasSource& src) {
+    return src.chunks.empty() ? src.header.offset_to_points : src.chunks.front().offset;
+}
+
+// Receives `count` consecutive records starting at point `first`. LAZ chunks are decoded in
+// parallel, so a sink must accept calls for disjoint ranges from several threads.
+using RecordSink = std::function<void(std::size_t first, std::size_t count, const std::uint8_t* records)>;
+
+void read_uncompressed_records(InputFile& file, const LasHeader& h, const RecordSink& sink) {
     const std::size_t n = static_cast<std::size_t>(h.point_count);
-    const std::size_t per_chunk = std::max<std::size_t>(1, kChunkBytes / h.record_length);
+    const std::size_t per_block = std::max<std::size_t>(1, kChunkBytes / h.record_length);
     Bytes buffer;
-    for (std::size_t first = 0; first < n; first += per_chunk) {
-        const std::size_t count = std::min(per_chunk, n - first);
+    for (std::size_t first = 0; first < n; first += per_block) {
+        const std::size_t count = std::min(per_block, n - first);
         buffer.resize(count * h.record_length);
         file.read(h.offset_to_points + std::uint64_t{first} * h.record_length, buffer.size(), buffer.data(), "point data");
-        for (std::size_t j = 0; j < count; ++j) decoder.decode(buffer.data() + j * h.record_length, first + j, cloud);
+        sink(first, count, buffer.data());
     }
 }
 
-SourceFormat source_format_of(const LasHeader& h) {
+// Chunks are independent: TBB decodes them in parallel, each task holding one chunk's
+// compressed and decoded bytes, so memory stays bounded by (threads x chunk size).
+void decode_laz_chunks(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks,
+                       const laz::LayerSelection& selection, const RecordSink& sink) {
+    const std::uint16_t record_length = src.header.record_length;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        Bytes compressed, records;
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const laz::Chunk& chunk = chunks[i];
+            compressed.resize(static_cast<std::size_t>(chunk.bytes));
+            file.read(chunk.offset, compressed.size(), compressed.data(), "LAZ chunk " + std::to_string(i));
+            records.resize(static_cast<std::size_t>(chunk.count) * record_length);
+            laz::decode_chunk(*src.laz, record_length, compressed, static_cast<std::size_t>(chunk.count), records.data(),
+                              selection, file.name(), i);
+            sink(static_cast<std::size_t>(chunk.first_point), static_cast<std::size_t>(chunk.count), records.data());
+        }
+    });
+}
+
+void read_records(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks,
+                  const laz::LayerSelection& selection, const RecordSink& sink) {
+    if (src.header.compressed) decode_laz_chunks(file, src, chunks, selection, sink);
+    else read_uncompressed_records(file, src.header, sink);
+}
+
+// The COPC octree: levels and nodes for `info`, and the nodes a bounds query must decode
+// (renumbered so that their points are consecutive).
+std::vector<laz::Chunk> describe_copc(InputFile& file, const LasSource& src, const std::optional<Box3d>& bounds,
+                                      SourceFormat& source) {
+    const std::vector<laz::CopcNode> nodes = laz::read_copc_hierarchy(file, *src.copc);
+    std::vector<laz::Chunk> selected;
+    std::uint64_t first = 0;
+    source.copc_levels = 0;
+    for (const laz::CopcNode& node : nodes) {
+        source.copc_levels = std::max(source.copc_levels, node.level + 1);
+        if (bounds && !bounds->intersects(node.min, node.max)) continue;
+        laz::Chunk chunk = node.chunk;
+        chunk.first_point = first;
+        first += chunk.count;
+        selected.push_back(chunk);
+    }
+    source.copc_nodes = nodes.size();
+    source.copc_nodes_read = selected.size();
+    return selected;
+}
+
+SourceFormat source_format_of(const LasSource& src) {
+    const LasHeader& h = src.header;
     SourceFormat source;
     source.format = "las";
     source.version = "1." + std::to_string(h.minor);
     source.las_point_format = h.point_format;
     source.las_scale = h.scale;
     source.las_offset = h.offset;
+    if (src.laz) {
+        source.laz = true;
+        source.laz_chunk_size = src.laz->chunk_size;
+        source.laz_chunks = src.chunks.size();
+    }
     return source;
+}
+
+PointCloud read_las_from(InputFile& file, const CloudReadOptions& options) {
+    const LasSource src = open_las(file, false);
+    const LasHeader& header = src.header;
+    const PointFormat& format = kFormats[static_cast<std::size_t>(header.point_format)];
+    const std::vector<ExtraField> fields = find_extra_fields(file, src.records, format, header.record_length);
+
+    PointCloud cloud;
+    cloud.source = source_format_of(src);
+    cloud.georef = georeference_from(src.records);
+    cloud.origin = choose_origin(file, header, first_record_offset(src));
+    std::vector<laz::Chunk> chunks = src.chunks;
+    if (src.copc) {
+        std::vector<laz::Chunk> selected = describe_copc(file, src, options.bounds, cloud.source);
+        if (options.bounds) chunks = std::move(selected);  // only the nodes that meet the box
+    }
+    std::uint64_t n = header.point_count;
+    if (header.compressed) {
+        n = 0;
+        for (const laz::Chunk& c : chunks) n += c.count;
+    }
+    const bool all_fields = !options.xyz_classification_only;
+    allocate_attributes(cloud, format, fields, static_cast<std::size_t>(n), all_fields);
+    std::vector<std::uint8_t> inside;
+    if (options.bounds) inside.assign(static_cast<std::size_t>(n), 0);
+    const PointDecoder decoder{format, header.scale, header.offset, cloud.origin, fields, all_fields,
+                               options.bounds ? &*options.bounds : nullptr, &inside};
+    const laz::LayerSelection selection =
+        all_fields ? laz::LayerSelection::all() : laz::LayerSelection::xyz_classification(!fields.empty());
+    read_records(file, src, chunks, selection, [&](std::size_t first, std::size_t count, const std::uint8_t* records) {
+        for (std::size_t j = 0; j < count; ++j) decoder.decode(records + j * header.record_length, first + j, cloud);
+    });
+    if (options.bounds) {
+        cloud = cloud.subset(std::vector<bool>(inside.begin(), inside.end()));
+    }
+    return cloud;
+}
+
+LasRecords read_records_from(InputFile& file) {
+    const LasSource src = open_las(file, true);
+    const LasHeader& h = src.header;
+    LasRecords out;
+    out.header = h.raw;
+    out.minor = h.minor;
+    out.point_format = h.point_format;
+    out.record_length = h.record_length;
+    out.point_count = h.point_count;
+    out.compressed = h.compressed;
+    out.vlrs.assign(src.records.begin(), src.records.begin() + static_cast<std::ptrdiff_t>(src.vlr_count));
+    out.evlrs.assign(src.records.begin() + static_cast<std::ptrdiff_t>(src.vlr_count), src.records.end());
+    out.points.resize(static_cast<std::size_t>(h.point_count) * h.record_length);
+    read_records(file, src, src.chunks, laz::LayerSelection::all(),
+                 [&](std::size_t first, std::size_t count, const std::uint8_t* records) {
+                     std::memcpy(out.points.data() + first * h.record_length, records, count * h.record_length);
+                 });
+    return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1058,22 +1177,53 @@ Placement placement_of(const WritePlan& plan, std::size_t n, const std::string& 
 
 }  // namespace
 
-PointCloud read_las(const fs::path& path) {
+PointCloud read_las(const fs::path& path, const CloudReadOptions& options) {
     InputFile file(path);
-    const LasHeader header = read_header(file);
-    std::vector<RawVlr> records = read_vlrs(file, header);
-    for (RawVlr& r : read_evlrs(file, header)) records.push_back(std::move(r));
-    const PointFormat& format = kFormats[static_cast<std::size_t>(header.point_format)];
-    const std::vector<ExtraField> fields = find_extra_fields(file, records, format, header.record_length);
+    return read_las_from(file, options);
+}
 
-    PointCloud cloud;
-    cloud.source = source_format_of(header);
-    cloud.georef = georeference_from(records);
-    cloud.origin = choose_origin(file, header);
-    allocate_attributes(cloud, format, fields, static_cast<std::size_t>(header.point_count));
-    const PointDecoder decoder{format, header.scale, header.offset, cloud.origin, fields};
-    read_points(file, header, decoder, cloud);
-    return cloud;
+PointCloud read_las_buffer(std::span<const std::uint8_t> bytes, const std::string& name, const CloudReadOptions& options) {
+    InputFile file(bytes, name);
+    return read_las_from(file, options);
+}
+
+LasRecords read_las_records(const fs::path& path) {
+    InputFile file(path);
+    return read_records_from(file);
+}
+
+LasRecords read_las_records(std::span<const std::uint8_t> bytes, const std::string& name) {
+    InputFile file(bytes, name);
+    return read_records_from(file);
+}
+
+// The uncompressed twin: same header fields, minus the LAZ marks and the records that only
+// describe compressed data; offsets recomputed for the records that remain.
+void write_las_records(const LasRecords& records, const fs::path& path) {
+    auto describes_compression = [](const RawVlr& r) {
+        return (r.user_id == kLaszipUser && r.record_id == kLaszipRecord) || r.user_id == kCopcUser;
+    };
+    std::vector<RawVlr> vlrs, evlrs;
+    std::copy_if(records.vlrs.begin(), records.vlrs.end(), std::back_inserter(vlrs), [&](const RawVlr& r) { return !describes_compression(r); });
+    std::copy_if(records.evlrs.begin(), records.evlrs.end(), std::back_inserter(evlrs), [&](const RawVlr& r) { return !describes_compression(r); });
+    Bytes header = records.header;
+    std::uint64_t offset = header.size();
+    for (const RawVlr& r : vlrs) offset += kVlrHeaderSize + r.data.size();
+    if (offset > 0xFFFFFFFFull) throw Error::input(path.string(), "VLRs too large for a LAS header");
+    header[field::point_format] = static_cast<std::uint8_t>(records.point_format);
+    store<std::uint32_t>(header.data() + field::offset_to_points, static_cast<std::uint32_t>(offset));
+    store<std::uint32_t>(header.data() + field::vlr_count, static_cast<std::uint32_t>(vlrs.size()));
+    if (records.minor >= 4 && header.size() >= kHeaderSize14) {
+        const std::uint64_t evlr_start = evlrs.empty() ? 0 : offset + records.points.size();
+        store<std::uint64_t>(header.data() + field::evlr_start, evlr_start);
+        store<std::uint32_t>(header.data() + field::evlr_count, static_cast<std::uint32_t>(evlrs.size()));
+    }
+    write_atomically(path, [&](std::ostream& out) {
+        write_bytes(out, header);
+        write_records(out, vlrs, false);
+        write_bytes(out, records.points);
+        write_records(out, evlrs, true);
+    });
 }
 
 // Version and point format: the input's when the cloud came from LAS and the format still holds

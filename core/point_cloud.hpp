@@ -55,6 +55,14 @@ struct SourceFormat {
     Eigen::Vector3d las_scale{0.001, 0.001, 0.001};
     Eigen::Vector3d las_offset{0, 0, 0};
     std::size_t dropped_non_finite = 0; // points dropped because a coordinate was NaN/inf
+    // LAZ input (format stays "las": the points are LAS records once decoded).
+    bool laz = false;
+    std::uint32_t laz_chunk_size = 0;   // points per chunk; 0xFFFFFFFF = variable-size chunks
+    std::size_t laz_chunks = 0;
+    // COPC input: octree depth (levels) and nodes holding points; -1 when not COPC.
+    int copc_levels = -1;
+    std::size_t copc_nodes = 0;
+    std::size_t copc_nodes_read = 0;    // nodes decoded (fewer than copc_nodes under a bounds query)
 };
 
 struct PointCloud {
