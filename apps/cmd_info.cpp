@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 namespace treelobes::cli {
 
@@ -17,7 +18,12 @@ namespace {
 
 struct InfoOptions {
     std::vector<std::string> files;
+    std::string bounds;  // --bounds: describe only the points inside this box
 };
+
+std::string chunk_size_text(std::uint32_t chunk_size) {
+    return chunk_size == 0xFFFFFFFFu ? "variable" : std::to_string(chunk_size);
+}
 
 nlohmann::json to_json(const FileInfo& info) {
     nlohmann::json j = {{"path", info.path},
@@ -38,6 +44,14 @@ nlohmann::json to_json(const FileInfo& info) {
         j["total_length"] = info.total_length;
     }
     if (info.dropped_non_finite) j["dropped_non_finite"] = info.dropped_non_finite;
+    if (info.format == "laz") {
+        j["laz"] = {{"point_format", info.las_point_format}, {"chunks", info.laz_chunks}};
+        if (info.laz_chunk_size == 0xFFFFFFFFu) j["laz"]["chunk_size"] = "variable";
+        else j["laz"]["chunk_size"] = info.laz_chunk_size;
+    }
+    if (info.copc_levels >= 0)
+        j["copc"] = {{"levels", info.copc_levels}, {"nodes", info.copc_nodes}, {"nodes_read", info.copc_nodes_read}};
+    if (info.bounds_query) j["bounds_query"] = true;
     j["attributes"] = nlohmann::json::array();
     for (const auto& [name, type] : info.attributes) j["attributes"].push_back({{"name", name}, {"type", type}});
     j["crs"] = info.crs;
@@ -50,8 +64,16 @@ void print_human(const FileInfo& info) {
     if (!info.version.empty()) std::cout << " " << info.version;
     if (info.las_point_format >= 0) std::cout << ", point format " << info.las_point_format;
     std::cout << "\n";
+    if (info.format == "laz")
+        std::cout << "  LAZ (point format " << info.las_point_format << ", chunk size " << chunk_size_text(info.laz_chunk_size)
+                  << "), " << info.laz_chunks << (info.laz_chunks == 1 ? " chunk" : " chunks") << "\n";
+    if (info.copc_levels >= 0) {
+        std::cout << "  COPC octree: " << info.copc_levels << " levels, " << info.copc_nodes << " nodes";
+        if (info.bounds_query) std::cout << " (" << info.copc_nodes_read << " read for --bounds)";
+        std::cout << "\n";
+    }
     const char* noun = info.kind == "point cloud" ? "points" : info.kind == "mesh" ? "vertices" : "nodes";
-    std::cout << "  " << info.point_count << " " << noun;
+    std::cout << "  " << info.point_count << " " << noun << (info.bounds_query ? " inside --bounds" : "");
     if (info.kind == "mesh") std::cout << ", " << info.face_count << " faces";
     if (info.kind == "skeleton") std::cout << ", " << info.tip_count << " tips, total length " << info.total_length << " m";
     if (info.dropped_non_finite) std::cout << " (" << info.dropped_non_finite << " NaN/inf points dropped)";
@@ -71,9 +93,11 @@ void print_human(const FileInfo& info) {
 int run_info(const InfoOptions& options, const GlobalOptions& global) {
     nlohmann::json files = nlohmann::json::array();
     int exit_code = 0;
+    std::optional<Box3d> bounds;
+    if (!options.bounds.empty()) bounds = parse_bounds(options.bounds);
     for (const auto& file : options.files) {
         try {
-            const FileInfo info = describe_file(file);
+            const FileInfo info = describe_file(file, bounds);
             if (global.json) files.push_back(to_json(info));
             else print_human(info);
         } catch (const Error& e) {
@@ -90,8 +114,11 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
 
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<InfoOptions>();
-    CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, PLY, PCD, XYZ/CSV), meshes and skeletons");
+    CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes and skeletons");
     sub->add_option("files", options->files, "Files to describe")->required();
+    sub->add_option("--bounds", options->bounds,
+                    "Describe only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); "
+                    "COPC files read only the octree nodes that meet the box");
     sub->callback([options, &global, &job] { job = [options, &global] { return run_info(*options, global); }; });
 }
 

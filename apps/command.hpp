@@ -4,11 +4,17 @@
 // inside one error handler that maps treelobes::Error to exit codes.
 #pragma once
 
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <sstream>
 #include <string>
+#include <vector>
 
 namespace treelobes::cli {
 
@@ -36,7 +42,28 @@ inline CLI::Validator finite_number(bool zero_allowed) {
 inline const CLI::Validator PositiveNumber = finite_number(false);
 inline const CLI::Validator NonNegativeNumber = finite_number(true);
 
+// `--bounds minx,miny,minz,maxx,maxy,maxz` (3-D) or `minx,miny,maxx,maxy` (2-D: any z), in the
+// file's original coordinates. Throws Error(Usage) naming the flag.
+inline Box3d parse_bounds(const std::string& text) {
+    std::vector<double> v;
+    std::stringstream in(text);
+    for (std::string item; std::getline(in, item, ',');) {
+        double value = 0;
+        if (!CLI::detail::lexical_cast(item, value) || !std::isfinite(value))
+            throw Error::usage("--bounds: '" + item + "' is not a finite number");
+        v.push_back(value);
+    }
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    Box3d box;
+    if (v.size() == 6) box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    else if (v.size() == 4) box = {{v[0], v[1], -inf}, {v[2], v[3], inf}};
+    else throw Error::usage("--bounds takes minx,miny,minz,maxx,maxy,maxz or minx,miny,maxx,maxy, got '" + text + "'");
+    if ((box.min.array() > box.max.array()).any()) throw Error::usage("--bounds: a minimum exceeds its maximum in '" + text + "'");
+    return box;
+}
+
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_convert_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_reconstruct_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job);

@@ -34,6 +34,7 @@ int run(int argc, char** argv) {
 
     cli::Job job;
     cli::add_info_command(app, global, job);
+    cli::add_convert_command(app, global, job);
     cli::add_multires_command(app, global, job);
     cli::add_reconstruct_command(app, global, job);
     cli::add_eval_command(app, global, job);

@@ -680,29 +680,27 @@ public:
     }
 
     void decode(std::uint8_t* out, std::uint32_t& context) override {
-        if (context != current_) {
-            if (!contexts_[context]) create_context(context, contexts_[current_]->last);
-            current_ = context;
-        }
+        Last* last = &contexts_[current_]->last;
+        switch_context(context, last);
         Context& c = *contexts_[current_];
         if (changed_rgb_) {
             std::array<std::uint16_t, 3> rgb{};
-            decode_rgb(decoders_[0], c.rgb, c.last.rgb, rgb);
-            c.last.rgb = rgb;
+            decode_rgb(decoders_[0], c.rgb, last->rgb, rgb);
+            last->rgb = rgb;
         }
-        store_rgb(out, c.last.rgb);
+        store_rgb(out, last->rgb);
         if (!nir_) return;
         if (changed_nir_) {
             // NIR: which of its two bytes changed, then each changed byte modulo 256.
             const std::uint32_t used = decoders_[1].decode_symbol(c.nir_used);
-            const std::int32_t low = c.last.nir & 0xFF, high = c.last.nir >> 8;
+            const std::int32_t low = last->nir & 0xFF, high = last->nir >> 8;
             const std::int32_t new_low =
                 (used & 1) ? fold_u8(static_cast<std::int32_t>(decoders_[1].decode_symbol(c.nir_diff[0])) + low) : low;
             const std::int32_t new_high =
                 (used & 2) ? fold_u8(static_cast<std::int32_t>(decoders_[1].decode_symbol(c.nir_diff[1])) + high) : high;
-            c.last.nir = static_cast<std::uint16_t>(new_low | (new_high << 8));
+            last->nir = static_cast<std::uint16_t>(new_low | (new_high << 8));
         }
-        store<std::uint16_t>(out + 6, c.last.nir);
+        store<std::uint16_t>(out + 6, last->nir);
     }
 
 private:
@@ -719,6 +717,18 @@ private:
     void create_context(std::uint32_t channel, const Last& seed) {
         contexts_[channel] = std::make_unique<Context>();
         contexts_[channel]->last = seed;
+    }
+    // The channel's models always follow the point's channel, but its previous values only when
+    // the channel is new in the chunk (seeded from the previous point); on a return to a channel
+    // seen before, the reference encoder predicts from the previous point's values, so the
+    // decoder must too.
+    void switch_context(std::uint32_t context, Last*& last) {
+        if (context == current_) return;
+        current_ = context;
+        if (!contexts_[current_]) {
+            create_context(current_, *last);
+            last = &contexts_[current_]->last;
+        }
     }
 
     bool nir_, want_rgb_, want_nir_;
@@ -748,14 +758,20 @@ public:
     }
 
     void decode(std::uint8_t* out, std::uint32_t& context) override {
+        // Same context rule as RGB14: models of the point's channel, previous values of the
+        // previous point unless the channel is new in the chunk.
+        std::vector<std::uint8_t>* last = &contexts_[current_]->last;
         if (context != current_) {
-            if (!contexts_[context]) create_context(context, contexts_[current_]->last);
             current_ = context;
+            if (!contexts_[current_]) {
+                create_context(current_, *last);
+                last = &contexts_[current_]->last;
+            }
         }
         Context& c = *contexts_[current_];
         for (std::size_t i = 0; i < count_; ++i)
-            if (changed_[i]) c.last[i] = fold_u8(c.last[i] + static_cast<std::int32_t>(decoders_[i].decode_symbol(c.models[i])));
-        std::memcpy(out, c.last.data(), count_);
+            if (changed_[i]) (*last)[i] = fold_u8((*last)[i] + static_cast<std::int32_t>(decoders_[i].decode_symbol(c.models[i])));
+        std::memcpy(out, last->data(), count_);
     }
 
 private:

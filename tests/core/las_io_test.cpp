@@ -563,8 +563,8 @@ TEST_F(LasBadInput, HeaderFieldsOutOfRange) {
     bytes[104] = 11;
     expect_rejected(bytes, "point data format 11");
     bytes = good;
-    bytes[104] = 0x81;
-    expect_rejected(bytes, "LAZ");
+    bytes[104] = 0x81;  // marked LAZ but without the LASzip VLR that describes the compression
+    expect_rejected(bytes, "no LASzip VLR");
     bytes = good;
     poke<std::uint16_t>(bytes, 105, 10);
     expect_rejected(bytes, "record length 10");

@@ -1,0 +1,107 @@
+// `treelobes convert INPUT --out OUTPUT [--bounds BOX]`: any readable point cloud to LAS, PLY,
+// PCD or XYZ/CSV text (what `pdal translate` does for our users). LAS or LAZ to LAS without
+// --bounds copies the point records verbatim (LAZ gives its uncompressed twin, record for
+// record, with the same header fields, VLRs and EVLRs); every other conversion goes through the
+// point cloud and keeps its attributes, scale/offset and CRS as the writers do.
+#include "apps/command.hpp"
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+#include "core/las_io.hpp"
+#include "core/version.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+
+namespace treelobes::cli {
+
+namespace {
+
+struct ConvertOptions {
+    std::string input;
+    std::string out;
+    std::string bounds;
+};
+
+bool starts_with_lasf(const std::filesystem::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    char magic[4] = {};
+    in.read(magic, 4);
+    return in.gcount() == 4 && std::string(magic, 4) == "LASF";
+}
+
+struct ConvertResult {
+    std::size_t points = 0;
+    std::string method;  // "records" (verbatim point records) or "cloud"
+    std::string input_format;
+};
+
+ConvertResult copy_records(const std::filesystem::path& input, const std::filesystem::path& output) {
+    const LasRecords records = read_las_records(input);
+    write_las_records(records, output);
+    return {static_cast<std::size_t>(records.point_count), "records",
+            std::string(records.compressed ? "LAZ" : "LAS") + " 1." + std::to_string(records.minor) + ", point format " +
+                std::to_string(records.point_format)};
+}
+
+ConvertResult convert_cloud(const std::filesystem::path& input, const std::filesystem::path& output,
+                            const std::optional<Box3d>& bounds) {
+    CloudReadOptions options;
+    options.bounds = bounds;
+    const PointCloud cloud = read_point_cloud(input, options);
+    write_point_cloud(cloud, output);
+    std::string format = cloud.source.laz ? "LAZ" : cloud.source.format;
+    if (!cloud.source.version.empty()) format += " " + cloud.source.version;
+    return {cloud.size(), "cloud", format};
+}
+
+int run_convert(const ConvertOptions& options, const GlobalOptions& global) {
+    const std::filesystem::path input(options.input), output(options.out);
+    std::error_code ec;
+    if (std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
+        throw Error::usage("--out " + options.out + " is the input file; choose another output");
+    const std::string out_ext = file_extension(output);
+    if (out_ext == "laz") throw Error::usage("--out " + options.out + ": writing LAZ is not supported; write .las");
+    std::optional<Box3d> bounds;
+    if (!options.bounds.empty()) bounds = parse_bounds(options.bounds);
+
+    const std::string in_ext = file_extension(input);
+    const bool las_input = in_ext == "las" || in_ext == "laz" || (std::filesystem::is_regular_file(input, ec) && starts_with_lasf(input));
+    const ConvertResult result = las_input && out_ext == "las" && !bounds ? copy_records(input, output)
+                                                                          : convert_cloud(input, output, bounds);
+    if (global.json) {
+        std::cout << nlohmann::json{{"treelobes", kVersion},
+                                    {"input", options.input},
+                                    {"input_format", result.input_format},
+                                    {"output", options.out},
+                                    {"points", result.points},
+                                    {"method", result.method}}
+                         .dump(2)
+                  << "\n";
+    } else {
+        std::cout << options.input << " (" << result.input_format << ") -> " << options.out << ": " << result.points
+                  << " points" << (result.method == "records" ? ", point records copied verbatim" : "") << "\n";
+    }
+    return 0;
+}
+
+}  // namespace
+
+void add_convert_command(CLI::App& app, const GlobalOptions& global, Job& job) {
+    auto options = std::make_shared<ConvertOptions>();
+    CLI::App* sub = app.add_subcommand(
+        "convert", "Convert a point cloud (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV) to LAS, PLY, PCD or XYZ/CSV; LAZ to LAS "
+                   "gives the uncompressed file record for record");
+    sub->add_option("input", options->input, "Point cloud to read")->required();
+    sub->add_option("--out", options->out, "Output file; its extension picks the format (.las .ply .pcd .xyz .txt .csv)")
+        ->required();
+    sub->add_option("--bounds", options->bounds,
+                    "Keep only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); COPC files "
+                    "read only the octree nodes that meet the box");
+    sub->callback([options, &global, &job] { job = [options, &global] { return run_convert(*options, global); }; });
+}
+
+}  // namespace treelobes::cli
