@@ -208,8 +208,13 @@ IntegerDecompressor::IntegerDecompressor(ArithmeticDecoder& decoder, std::uint32
     }
     k_models_.reserve(contexts);
     for (std::uint32_t c = 0; c < contexts; ++c) k_models_.emplace_back(corr_bits_ + 1);
-    correctors_.reserve(corr_bits_);
-    for (std::uint32_t k = 1; k <= corr_bits_; ++k) correctors_.emplace_back(k <= bits_high_ ? 1u << k : 1u << bits_high_);
+    correctors_.resize(corr_bits_);
+}
+
+SymbolModel& IntegerDecompressor::corrector(std::uint32_t k) {
+    std::optional<SymbolModel>& model = correctors_[k - 1];
+    if (!model) model.emplace(k <= bits_high_ ? 1u << k : 1u << bits_high_);
+    return *model;
 }
 
 std::int32_t IntegerDecompressor::decompress(std::int32_t pred, std::uint32_t context) {
@@ -229,10 +234,10 @@ std::int32_t IntegerDecompressor::read_corrector(SymbolModel& model) {
     if (k_ >= 32) return corr_min_;
     std::int64_t c;
     if (k_ <= bits_high_) {
-        c = decoder_->decode_symbol(correctors_[k_ - 1]);
+        c = decoder_->decode_symbol(corrector(k_));
     } else {  // the high bits are modelled, the k - bits_high low bits are raw
         const std::uint32_t raw_bits = k_ - bits_high_;
-        const std::int64_t high = decoder_->decode_symbol(correctors_[k_ - 1]);
+        const std::int64_t high = decoder_->decode_symbol(corrector(k_));
         c = (high << raw_bits) | decoder_->read_bits(raw_bits);
     }
     // Class k holds the correctors with |c| in [2^(k-1), 2^k): offsets below 2^(k-1) are the

@@ -13,6 +13,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace treelobes::laz {
@@ -97,7 +98,11 @@ private:
     std::uint32_t k_ = 0;
     std::vector<SymbolModel> k_models_;      // one per context, corr_bits + 1 symbols
     BitModel zero_corrector_;                // k == 0: the corrector is 0 or 1
-    std::vector<SymbolModel> correctors_;    // class k = 1..corr_bits at index k - 1
+    // Class k = 1..corr_bits at index k - 1, created on first use: a fresh model's state is
+    // fixed, so creating it late decodes the same, and small chunks (COPC nodes) skip building
+    // models for classes they never see.
+    std::vector<std::optional<SymbolModel>> correctors_;
+    SymbolModel& corrector(std::uint32_t k);
 };
 
 }  // namespace treelobes::laz
