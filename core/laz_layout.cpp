@@ -117,7 +117,7 @@ std::vector<CopcNode> read_copc_hierarchy(InputFile& file, const CopcInfo& info)
     std::vector<CopcNode> nodes;
     std::vector<std::pair<std::uint64_t, std::uint64_t>> pending{{info.root_hierarchy_offset, info.root_hierarchy_size}};
     std::set<std::uint64_t> visited;  // a page listed twice (corrupt file) is read once: no cycles
-    std::uint64_t first_point = 0;
+    std::uint64_t first_point = 0, page_bytes = 0;
     while (!pending.empty()) {
         const auto [offset, size] = pending.back();
         pending.pop_back();
@@ -125,7 +125,11 @@ std::vector<CopcNode> read_copc_hierarchy(InputFile& file, const CopcInfo& info)
         if (size % kEntrySize != 0)
             file.fail("COPC hierarchy page at byte " + std::to_string(offset) + " is " + std::to_string(size) +
                       " bytes, not a multiple of 32");
-        if (size > file.size()) file.fail("COPC hierarchy page at byte " + std::to_string(offset) + " is larger than the file");
+        // Pages do not overlap, so together they fit in the file; more means a corrupt hierarchy
+        // that would otherwise make the reader go over the same bytes again and again.
+        page_bytes += size;
+        if (size > file.size() || page_bytes > file.size())
+            file.fail("COPC hierarchy pages at byte " + std::to_string(offset) + " add up to more than the file holds");
         const auto page = file.read(offset, static_cast<std::size_t>(size), "COPC hierarchy page");
         for (std::size_t pos = 0; pos < page.size(); pos += kEntrySize) {
             const std::uint8_t* e = page.data() + pos;
