@@ -22,7 +22,7 @@ struct EvalSkeletonOptions {
     std::string skeleton;
     std::string reference;
     std::string reference_kind = "auto";
-    std::string skeleton_kind = "skeleton";
+    std::string skeleton_kind = "auto";
     std::string samples_out;
     EvalOptions eval;
 };
@@ -108,11 +108,11 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     eval->require_subcommand(1);
     auto options = std::make_shared<EvalSkeletonOptions>();
     CLI::App* sub = eval->add_subcommand("skeleton", "Compare a skeleton PLY with a reference skeleton, TreeQSM cylinders or skeleton points");
-    sub->add_option("--skeleton", options->skeleton, "Skeleton PLY to score")->required();
-    sub->add_option("--reference", options->reference, "Skeleton PLY, TreeQSM cylinder table or x y z point list")->required();
+    sub->add_option("--skeleton", options->skeleton, "Skeleton PLY or QSM to score")->required();
+    sub->add_option("--reference", options->reference, "Skeleton PLY, QSM (TreeQSM cylinder table or SimpleForest/rTwig CSV) or x y z point list")->required();
     sub->add_option("--reference-kind", options->reference_kind, "auto, skeleton, treeqsm or points")
         ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}))->capture_default_str();
-    sub->add_option("--skeleton-kind", options->skeleton_kind, "skeleton (PLY), treeqsm or points: score other models too")
+    sub->add_option("--skeleton-kind", options->skeleton_kind, "auto, skeleton (PLY), treeqsm (TreeQSM table or SimpleForest/rTwig CSV) or points: score QSMs and other models too")
         ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}))->capture_default_str();
     sub->add_option("--sample-step", options->eval.sample_step, "Metres between samples along segments")
         ->check(cli::PositiveNumber)->capture_default_str();

@@ -38,7 +38,14 @@ nlohmann::json to_json(const FileInfo& info) {
         j["scale"] = {info.las_scale.x(), info.las_scale.y(), info.las_scale.z()};
         j["offset"] = {info.las_offset.x(), info.las_offset.y(), info.las_offset.z()};
     }
-    if (info.kind == "mesh") j["faces"] = info.face_count;
+    if (info.kind == "mesh" || info.kind == "city model") j["faces"] = info.face_count;
+    if (info.kind == "qsm") {
+        j["cylinders"] = info.object_count;
+        j["total_length"] = info.total_length;
+        j["volume"] = info.volume;
+    }
+    if (info.format == "glb") j["nodes"] = info.object_count;
+    if (info.kind == "city model") j["city_objects"] = info.object_count;
     if (info.kind == "skeleton") {
         j["tips"] = info.tip_count;
         j["total_length"] = info.total_length;
@@ -72,9 +79,13 @@ void print_human(const FileInfo& info) {
         if (info.bounds_query) std::cout << " (" << info.copc_nodes_read << " read for --bounds)";
         std::cout << "\n";
     }
-    const char* noun = info.kind == "point cloud" ? "points" : info.kind == "mesh" ? "vertices" : "nodes";
-    std::cout << "  " << info.point_count << " " << noun << (info.bounds_query ? " inside --bounds" : "");
-    if (info.kind == "mesh") std::cout << ", " << info.face_count << " faces";
+    const char* noun = info.kind == "point cloud" ? "points" : info.kind == "skeleton" ? "nodes" : "vertices";
+    if (info.kind == "qsm")
+        std::cout << "  " << info.object_count << " cylinders, total length " << info.total_length << " m, volume " << info.volume << " m3";
+    else std::cout << "  " << info.point_count << " " << noun << (info.bounds_query ? " inside --bounds" : "");
+    if (info.kind == "mesh" || info.kind == "city model") std::cout << ", " << info.face_count << " faces";
+    if (info.format == "glb") std::cout << ", " << info.object_count << " scene nodes";
+    if (info.kind == "city model") std::cout << ", " << info.object_count << " city objects";
     if (info.kind == "skeleton") std::cout << ", " << info.tip_count << " tips, total length " << info.total_length << " m";
     if (info.dropped_non_finite) std::cout << " (" << info.dropped_non_finite << " NaN/inf points dropped)";
     std::cout << "\n";
@@ -114,7 +125,7 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
 
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<InfoOptions>();
-    CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes and skeletons");
+    CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes (PLY, OBJ, OFF, glb), skeletons, QSMs and CityJSON");
     sub->add_option("files", options->files, "Files to describe")->required();
     sub->add_option("--bounds", options->bounds,
                     "Describe only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); "

@@ -1,15 +1,22 @@
 // `treelobes render INPUT... --out PREVIEW.png`: orthographic previews of point clouds, meshes
 // and skeletons, one panel per input, side by side, all panels in the same frame and scale.
+// --view front|side|top looks along +y, along -x or down; the panel takes the shape of the
+// subject seen that way, so it fills the frame. --color height|tree colours clouds by height or
+// by their treeID attribute, radius|order colours skeletons by radius or branch order (inputs
+// the colouring does not apply to keep their plain colour).
 #include "apps/command.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/file_info.hpp"
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
+#include "render/colour_map.hpp"
 #include "render/rasterizer.hpp"
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <iostream>
 #include <memory>
 #include <variant>
@@ -24,6 +31,8 @@ struct RenderOptions {
     int size = 800;             // panel height in pixels
     double azimuth = 0;         // degrees around the vertical axis
     double elevation = 10;      // degrees above the horizon
+    std::string view;           // front, side, top (overrides azimuth and elevation)
+    std::string colour = "plain";
 };
 
 using Drawable = std::variant<PointCloud, TriangleMesh, TreeGraph>;
@@ -55,17 +64,69 @@ void bounds_of(const Drawable& item, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
         item);
 }
 
-render::Image draw(const Drawable& item, const render::View& view, int width, int height) {
+// Value of each point in [0, 1] (height) or a colour per tree id.
+std::vector<render::Rgba> cloud_colours(const PointCloud& cloud, const std::string& colour, const std::string& path) {
+    std::vector<render::Rgba> colours;
+    if (colour == "height") {
+        float lo = std::numeric_limits<float>::max(), hi = std::numeric_limits<float>::lowest();
+        for (const auto& p : cloud.positions) lo = std::min(lo, p.z()), hi = std::max(hi, p.z());
+        for (const auto& p : cloud.positions) colours.push_back(render::ramp_colour((p.z() - lo) / std::max(1e-6f, hi - lo)));
+        return colours;
+    }
+    const auto tree_id = std::find_if(cloud.extras.begin(), cloud.extras.end(), [](const ExtraAttribute& a) {
+        std::string name = a.name;
+        std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return std::tolower(c); });
+        return name == "treeid" || name == "tree_id" || name == "scalar_treeid";
+    });
+    if (tree_id == cloud.extras.end()) throw Error::input(path, "--color tree needs a treeID attribute (LAS extra bytes or PLY scalar_treeID)");
+    for (double id : tree_id->values) colours.push_back(render::id_colour(static_cast<long long>(id)));
+    return colours;
+}
+
+std::vector<Eigen::Vector3d> world_points(const PointCloud& cloud) {
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(cloud.size());
+    for (const auto& p : cloud.positions) points.push_back(cloud.origin + p.cast<double>());
+    return points;
+}
+
+// Each edge coloured by its child node's radius (relative to the largest) or branch order.
+void draw_coloured_skeleton(render::Rasterizer& r, const TreeGraph& tree, const std::string& colour) {
+    const std::vector<int> orders = tree.branch_orders();
+    const int max_order = std::max(1, *std::max_element(orders.begin(), orders.end()));
+    float max_radius = 1e-9f;
+    for (const auto& n : tree.nodes) max_radius = std::max(max_radius, n.radius);
+    for (std::size_t i = 1; i < tree.size(); ++i) {
+        const auto& node = tree.nodes[i];
+        const double t = colour == "radius" ? node.radius / max_radius : static_cast<double>(orders[i]) / max_order;
+        r.draw_segment(tree.origin + tree.nodes[node.parent].position.cast<double>(), tree.origin + node.position.cast<double>(),
+                       render::ramp_colour(t));
+    }
+}
+
+render::Image draw(const Drawable& item, const std::string& path, const RenderOptions& options, const render::View& view,
+                   int width, int height) {
     render::Rasterizer r(width, height, view);
+    const std::string& colour = options.colour;
     std::visit(
         [&](const auto& thing) {
             using T = std::decay_t<decltype(thing)>;
-            if constexpr (std::is_same_v<T, PointCloud>) r.draw_points(thing, {40, 90, 40, 255}, 2);
-            else if constexpr (std::is_same_v<T, TriangleMesh>) r.draw_mesh(thing, {150, 110, 70, 255});
+            if constexpr (std::is_same_v<T, PointCloud>) {
+                if (colour == "height" || colour == "tree") r.draw_points(world_points(thing), cloud_colours(thing, colour, path), 2);
+                else r.draw_points(thing, {40, 90, 40, 255}, 2);
+            } else if constexpr (std::is_same_v<T, TriangleMesh>) r.draw_mesh(thing, {150, 110, 70, 255});
+            else if (colour == "radius" || colour == "order") draw_coloured_skeleton(r, thing, colour);
             else r.draw_skeleton(thing, {120, 30, 20, 255});
         },
         item);
     return r.image();
+}
+
+render::View make_view(const RenderOptions& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+    if (o.view == "front") return render::View::side(lo, hi, 0, 0);
+    if (o.view == "side") return render::View::side(lo, hi, 270, 0);
+    if (o.view == "top") return render::View::side(lo, hi, 0, 90);
+    return render::View::side(lo, hi, o.azimuth, o.elevation);
 }
 
 int run_render(const RenderOptions& options, const GlobalOptions& global) {
@@ -74,11 +135,11 @@ int run_render(const RenderOptions& options, const GlobalOptions& global) {
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
     for (const auto& item : items) bounds_of(item, lo, hi);
     if (!lo.allFinite() || (lo.array() > hi.array()).any()) throw Error::input(options.inputs.front(), "nothing to draw");
-    const render::View view = render::View::side(lo, hi, options.azimuth, options.elevation);
-    const int width = std::max(64, static_cast<int>(options.size * std::max(0.3, std::hypot(hi.x() - lo.x(), hi.y() - lo.y()) /
-                                                                              std::max(1e-6, hi.z() - lo.z()))));
+    const render::View view = make_view(options, lo, hi);
+    // The panel takes the subject's shape on the image, so it fills the frame.
+    const int width = std::clamp(static_cast<int>(std::lround(options.size * view.aspect())), 64, 4096);
     std::vector<render::Image> panels;
-    for (const auto& item : items) panels.push_back(draw(item, view, std::min(width, 4096), options.size));
+    for (std::size_t i = 0; i < items.size(); ++i) panels.push_back(draw(items[i], options.inputs[i], options, view, width, options.size));
     render::write_png(render::side_by_side(panels), options.out);
     if (global.json) std::cout << nlohmann::json{{"out", options.out}, {"panels", panels.size()}}.dump(2) << "\n";
     else std::cout << "wrote " << options.out << " (" << panels.size() << " panel(s))\n";
@@ -96,6 +157,10 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("--azimuth", options->azimuth, "View direction around the vertical axis, degrees")->capture_default_str();
     sub->add_option("--elevation", options->elevation, "View elevation above the horizon, degrees")
         ->check(CLI::Range(-90.0, 90.0))->capture_default_str();
+    sub->add_option("--view", options->view, "front (along +y), side (along -x) or top (down); overrides --azimuth/--elevation")
+        ->check(CLI::IsMember({"front", "side", "top"}));
+    sub->add_option("--color", options->colour, "plain; clouds: height or tree (treeID); skeletons: radius or order (branch order)")
+        ->check(CLI::IsMember({"plain", "height", "tree", "radius", "order"}))->capture_default_str();
     sub->callback([options, &global, &job] { job = [options, &global] { return run_render(*options, global); }; });
 }
 

@@ -15,9 +15,11 @@ set(TREELOBES_DEPENDS_synth core geometry config)
 set(TREELOBES_DEPENDS_lobes core geometry config lsystem reconstruct/reconstruct_tree.hpp)
 set(TREELOBES_DEPENDS_classify core geometry render
     reconstruct/reconstruct_tree.hpp reconstruct/preprocess.hpp reconstruct/skeleton.hpp reconstruct/allometry.hpp)
-set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct lobes classify synth render)
+# export reads our tree files (encode, lobes) and writes them for other tools.
+set(TREELOBES_DEPENDS_export core geometry encode lobes)
+set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct lobes classify synth render export)
 # Build order of the stage folders (each one CMake library target treelobes_<stage>).
-set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct synth lobes classify apps)
+set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct synth lobes classify export apps)
 
 # Fails with one message naming the file and the include when a source of `stage` (a folder of
 # `root`) includes "<folder>/..." that is neither the stage itself nor in its list. A folder with

@@ -3,10 +3,16 @@
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/mesh_io.hpp"
+#include "core/georef_sidecar.hpp"
 #include "core/ply_format.hpp"
+#include "core/qsm_io.hpp"
+#include "core/atomic_file.hpp"
 #include "core/skeleton_io.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace fs = std::filesystem;
@@ -84,13 +90,20 @@ FileInfo describe_cloud(const fs::path& path, const std::optional<Box3d>& bounds
     return info;
 }
 
+// Meshes in a local frame (OBJ, OFF, our exports) take the origin and CRS of their georef sidecar.
 FileInfo describe_mesh(const fs::path& path) {
-    const TriangleMesh mesh = read_mesh(path);
+    TriangleMesh mesh = read_mesh(path);
+    std::string crs;
+    if (const auto sidecar = read_georef_sidecar(path)) {
+        if (mesh.origin.isZero()) mesh.origin = sidecar->origin;
+        crs = sidecar->crs_wkt;
+    }
     FileInfo info;
     info.kind = "mesh";
     info.format = file_extension(path);
     info.point_count = mesh.vertex_count();
     info.face_count = mesh.face_count();
+    info.crs = crs;
     set_bounds(info, mesh.vertices, mesh.origin);
     return info;
 }
@@ -110,12 +123,156 @@ FileInfo describe_skeleton(const fs::path& path) {
     return info;
 }
 
+FileInfo describe_qsm(const fs::path& path) {
+    const QsmModel model = read_qsm(path);
+    FileInfo info;
+    info.kind = "qsm";
+    info.format = model.format;
+    info.object_count = model.cylinders.size();
+    info.total_length = model.total_length();
+    info.volume = model.volume();
+    info.bounds_min = info.bounds_max = model.cylinders.front().start;
+    for (const auto& c : model.cylinders)
+        for (const Eigen::Vector3d& p : {c.start, c.end()}) {
+            info.bounds_min = info.bounds_min.cwiseMin(p);
+            info.bounds_max = info.bounds_max.cwiseMax(p);
+        }
+    info.attributes = {{"radius", "float64"}, {"parent", "int"}, {"branch", "int"}, {"branch_order", "int"}};
+    return info;
+}
+
+std::uint32_t little_endian_u32(const std::string& bytes, std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(k)]);
+    return v;
+}
+
+// The JSON chunk of a .glb (glTF 2.0 §4.4), after checking the header and chunk lengths.
+nlohmann::json glb_json(const fs::path& path) {
+    const std::string name = path.string();
+    const std::string bytes = read_file(path);
+    if (bytes.size() < 20 || little_endian_u32(bytes, 0) != 0x46546C67) throw Error::input(name, "not a glTF binary (no glTF header)");
+    if (little_endian_u32(bytes, 4) != 2) throw Error::input(name, "glTF binary version " + std::to_string(little_endian_u32(bytes, 4)) + ", expected 2");
+    if (little_endian_u32(bytes, 8) != bytes.size()) throw Error::input(name, "glTF binary length does not match the file size (truncated?)");
+    const std::size_t json_length = little_endian_u32(bytes, 12);
+    if (little_endian_u32(bytes, 16) != 0x4E4F534A || 20 + json_length > bytes.size()) throw Error::input(name, "glTF binary has no valid JSON chunk");
+    try {
+        return nlohmann::json::parse(bytes.substr(20, json_length));
+    } catch (const nlohmann::json::exception& e) {
+        throw Error::input(name, std::string("glTF JSON chunk: ") + e.what());
+    }
+}
+
+// Counts and bounds of what the default scene shows (LOD 0), back in our z-up frame, plus the
+// origin of the georef sidecar.
+FileInfo describe_glb(const fs::path& path) {
+    const nlohmann::json doc = glb_json(path);
+    FileInfo info;
+    info.kind = "mesh";
+    info.format = "glb";
+    try {
+        info.version = doc.at("asset").at("version").get<std::string>();
+        const auto& scene = doc.at("scenes").at(doc.value("scene", 0));
+        Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
+        for (const auto& node_index : scene.value("nodes", nlohmann::json::array())) {
+            const auto& node = doc.at("nodes").at(node_index.get<std::size_t>());
+            ++info.object_count;
+            if (!node.contains("mesh")) continue;
+            Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+            if (node.contains("translation")) shift = {node["translation"][0].get<double>(), node["translation"][1].get<double>(), node["translation"][2].get<double>()};
+            for (const auto& primitive : doc.at("meshes").at(node.at("mesh").get<std::size_t>()).at("primitives")) {
+                const auto& position = doc.at("accessors").at(primitive.at("attributes").at("POSITION").get<std::size_t>());
+                info.point_count += position.at("count").get<std::size_t>();
+                if (primitive.contains("indices")) info.face_count += doc.at("accessors").at(primitive["indices"].get<std::size_t>()).at("count").get<std::size_t>() / 3;
+                for (int k = 0; k < 3; ++k) {
+                    lo[k] = std::min(lo[k], shift[k] + position.at("min").at(k).get<double>());
+                    hi[k] = std::max(hi[k], shift[k] + position.at("max").at(k).get<double>());
+                }
+            }
+        }
+        if (info.point_count > 0) {  // y-up (x, y, z) is our (x, -z, y)
+            info.bounds_min = {lo.x(), -hi.z(), lo.y()};
+            info.bounds_max = {hi.x(), -lo.z(), hi.y()};
+        }
+    } catch (const nlohmann::json::exception& e) {
+        throw Error::input(path.string(), std::string("glTF JSON lacks what a scene needs: ") + e.what());
+    }
+    if (const auto sidecar = read_georef_sidecar(path)) {
+        info.bounds_min += sidecar->origin;
+        info.bounds_max += sidecar->origin;
+        info.crs = sidecar->crs_wkt;
+    }
+    return info;
+}
+
+// A surface is an array of rings and a ring an array of vertex indices.
+void count_surfaces(const nlohmann::json& boundaries, std::size_t& surfaces) {
+    if (!boundaries.is_array() || boundaries.empty()) return;
+    if (boundaries[0].is_array() && !boundaries[0].empty() && boundaries[0][0].is_number()) {
+        ++surfaces;
+        return;
+    }
+    for (const auto& b : boundaries) count_surfaces(b, surfaces);
+}
+
+FileInfo describe_cityjson(const fs::path& path) {
+    nlohmann::json doc;
+    try {
+        doc = nlohmann::json::parse(read_file(path));
+    } catch (const nlohmann::json::exception& e) {
+        throw Error::input(path.string(), std::string("not JSON: ") + e.what());
+    }
+    FileInfo info;
+    info.kind = "city model";
+    info.format = "cityjson";
+    try {
+        info.version = doc.at("version").get<std::string>();
+        const auto& scale = doc.at("transform").at("scale");
+        const auto& translate = doc.at("transform").at("translate");
+        const auto& vertices = doc.at("vertices");
+        info.point_count = vertices.size();
+        for (std::size_t i = 0; i < vertices.size(); ++i)
+            for (int k = 0; k < 3; ++k) {
+                const double v = translate.at(k).get<double>() + scale.at(k).get<double>() * vertices[i].at(k).get<double>();
+                info.bounds_min[k] = i == 0 ? v : std::min(info.bounds_min[k], v);
+                info.bounds_max[k] = i == 0 ? v : std::max(info.bounds_max[k], v);
+            }
+        for (const auto& [id, object] : doc.at("CityObjects").items()) {
+            ++info.object_count;
+            for (const auto& geometry : object.value("geometry", nlohmann::json::array()))
+                count_surfaces(geometry.value("boundaries", nlohmann::json::array()), info.face_count);
+        }
+        if (doc.contains("metadata")) info.crs = doc["metadata"].value("referenceSystem", "");
+    } catch (const nlohmann::json::exception& e) {
+        throw Error::input(path.string(), std::string("CityJSON lacks ") + e.what());
+    }
+    return info;
+}
+
+bool is_cityjson(const fs::path& path) {
+    const std::string name = path.filename().string();
+    return file_extension(path) == "json" && name.find(".georef.json") == std::string::npos;
+}
+
+// QSMs: a SimpleForest/rTwig header, or TreeQSM's 15 columns (fewer could be an XYZ cloud with
+// colours and normals).
+bool is_qsm_text(const fs::path& path) {
+    const std::string ext = file_extension(path);
+    if ((ext != "txt" && ext != "csv") || !fs::is_regular_file(path)) return false;
+    std::size_t columns = 0;
+    const QsmFileKind kind = detect_qsm_file(path, &columns);
+    return kind == QsmFileKind::Csv || (kind == QsmFileKind::TreeQsm && columns == 15);
+}
+
 }  // namespace
 
 FileInfo describe_file(const fs::path& path, const std::optional<Box3d>& bounds) {
     const std::string ext = file_extension(path);
     FileInfo info;
     if (ext == "obj" || ext == "off" || ext == "stl") info = describe_mesh(path);
+    else if (ext == "glb") info = describe_glb(path);
+    else if (is_cityjson(path)) info = describe_cityjson(path);
+    else if (is_qsm_text(path)) info = describe_qsm(path);
     else if (ext == "ply" && fs::is_regular_file(path)) {
         const std::string kind = ply_kind(path);
         info = kind == "mesh" ? describe_mesh(path) : kind == "skeleton" ? describe_skeleton(path) : describe_cloud(path, bounds);

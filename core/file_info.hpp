@@ -1,4 +1,5 @@
-// What `treelobes info` reports about a file: its kind (point cloud, mesh, skeleton), format,
+// What `treelobes info` reports about a file: its kind (point cloud, mesh, skeleton, QSM, city
+// model), format,
 // counts, bounds in original coordinates, attributes and CRS.
 #pragma once
 
@@ -17,7 +18,7 @@ namespace treelobes {
 
 struct FileInfo {
     std::string path;
-    std::string kind;     // "point cloud", "mesh" or "skeleton"
+    std::string kind;     // "point cloud", "mesh", "skeleton", "qsm" or "city model"
     std::string format;   // "las", "ply", "pcd", "xyz", "obj", ...
     std::string version;  // LAS "1.2", PLY "binary_little_endian", ...
     int las_point_format = -1;
@@ -29,7 +30,9 @@ struct FileInfo {
     std::string crs;
     std::size_t face_count = 0;  // meshes
     std::size_t tip_count = 0;   // skeletons
-    double total_length = 0.0;   // skeletons, metres
+    double total_length = 0.0;   // skeletons and QSMs, metres
+    std::size_t object_count = 0;  // QSM cylinders, glTF scene nodes (trees), CityJSON city objects
+    double volume = 0.0;           // QSMs: sum of cylinder volumes, cubic metres
     // LAZ input: format is "laz"; chunk size (0xFFFFFFFF = variable) and chunk count.
     std::uint32_t laz_chunk_size = 0;
     std::size_t laz_chunks = 0;

@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
 #include "core/ply_format.hpp"
+#include "core/qsm_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/union_find.hpp"
@@ -111,27 +112,19 @@ std::vector<std::vector<double>> read_table(const fs::path& path) {
     return rows;
 }
 
-SkeletonGraph treeqsm_graph(const std::vector<std::vector<double>>& rows, const std::string& name) {
-    if (rows.front().size() < 8) throw Error::input(name, "a TreeQSM cylinder table needs at least 8 columns");
+// One segment per cylinder; a child cylinder is linked (without length) to its parent's end.
+SkeletonGraph qsm_graph(const QsmModel& model) {
     SkeletonGraph g;
     g.kind = "treeqsm";
-    const bool has_order = rows.front().size() >= 14;
     double stem_radius = 0;
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-        const auto& c = rows[i];
-        const Eigen::Vector3d start(c[2], c[3], c[4]), axis(c[5], c[6], c[7]);
-        if (!(c[0] >= 0) || !(c[1] >= 0) || axis.norm() < 1e-9)
-            throw Error::input(name, "cylinder " + std::to_string(i + 1) + ": negative radius/length or zero axis");
+    for (const auto& c : model.cylinders) {
         const int a = static_cast<int>(g.vertices.size());
-        g.vertices.push_back(start);
-        g.vertices.push_back(start + axis.normalized() * c[1]);
-        g.radius.insert(g.radius.end(), 2, static_cast<float>(c[0]));
+        g.vertices.push_back(c.start);
+        g.vertices.push_back(c.end());
+        g.radius.insert(g.radius.end(), 2, static_cast<float>(c.radius));
         g.edges.emplace_back(a, a + 1);
-        // Column 9 is the parent cylinder (1-based, 0 = none).
-        const double parent = c[8];
-        if (parent >= 1 && parent <= static_cast<double>(rows.size()) && parent != static_cast<double>(i + 1))
-            g.links.emplace_back(a, 2 * (static_cast<int>(parent) - 1) + 1);
-        if (!has_order || c[13] == 0) stem_radius = std::max(stem_radius, c[0]);
+        if (c.parent >= 0) g.links.emplace_back(a, 2 * c.parent + 1);
+        if (c.branch_order == 0) stem_radius = std::max(stem_radius, c.radius);
     }
     g.trunk_radius = stem_radius;
     return g;
@@ -340,9 +333,8 @@ SkeletonGraph read_skeleton_graph(const fs::path& path, const std::string& kind)
     const bool ply_file = file_extension(path) == "ply";
     if (kind == "skeleton" || (kind == "auto" && ply_file)) return read_ply_graph(path);
     if (ply_file) throw Error::input(path.string(), "a PLY file can only be read as a skeleton");
-    const auto rows = read_table(path);
-    const bool cylinders = kind == "treeqsm" || (kind == "auto" && rows.front().size() >= 8);
-    return cylinders ? treeqsm_graph(rows, path.string()) : point_list_graph(rows, path.string());
+    if (kind == "treeqsm" || (kind == "auto" && detect_qsm_file(path) != QsmFileKind::None)) return qsm_graph(read_qsm(path));
+    return point_list_graph(read_table(path), path.string());
 }
 
 SkeletonComparison compare_skeletons(const SkeletonGraph& ours, const SkeletonGraph& ref, const EvalOptions& o) {

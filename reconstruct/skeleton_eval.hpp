@@ -3,9 +3,9 @@
 // References come in three kinds:
 //   skeleton  skeleton PLY (vertex x y z [radius], edge vertex1 vertex2); any number of
 //             connected pieces (peers' skeletons are forests), vertex 0 taken as the root;
-//   treeqsm   TreeQSM 2.x cylinder table, whitespace separated, no header: radius, length,
+//   treeqsm   a QSM (core/qsm_io.hpp): TreeQSM cylinder table (no header: radius, length,
 //             start x y z, axis x y z, parent, extension, added, unmodified radius, branch,
-//             branch order, position in branch (metres);
+//             branch order, position in branch) or SimpleForest/rTwig CSV (metres);
 //   points    a dense list of skeleton points "x y z" (WoodSKE), commas or whitespace.
 // Both sides are sampled every `sample_step` along their segments (points are used as they are)
 // and distances are measured from each sample to the nearest segment (or point) of the other.

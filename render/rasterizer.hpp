@@ -26,6 +26,8 @@ struct View {
     // and `elevation_deg` above the horizon.
     static View side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azimuth_deg = 0,
                      double elevation_deg = 10);
+    // Width / height of the box [lo, hi] on the image: a panel of this shape is filled by it.
+    double aspect() const;
 };
 
 class Rasterizer {

@@ -2,6 +2,7 @@
 # Installs the Debian packages treelobes needs (only those missing), configures and builds.
 # Idempotent: a second run installs nothing and rebuilds only what changed.
 # Usage: scripts/setup.sh            (build dir: ./build, binary: build/bin/treelobes)
+# Also installs the npm validators of the export tests under tools/validators (npm ci).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -23,6 +24,18 @@ if [ ${#missing[@]} -gt 0 ]; then
   [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+# The official validators the export tests run (Khronos glTF-Validator, ajv for the CityJSON
+# schemas): npm packages pinned by tools/validators/package-lock.json, installed in that folder.
+if command -v npm >/dev/null 2>&1; then
+  if [ ! -f tools/validators/node_modules/.package-lock.json ] ||
+     [ tools/validators/package-lock.json -nt tools/validators/node_modules/.package-lock.json ]; then
+    echo "setup: installing the export validators (npm ci in tools/validators)" >&2
+    (cd tools/validators && npm ci --no-audit --no-fund --loglevel=error)
+  fi
+else
+  echo "setup: npm not found: the glTF/CityJSON validator tests will fail until node and npm are installed" >&2
 fi
 
 BUILD_DIR=${TREELOBES_BUILD_DIR:-build}
