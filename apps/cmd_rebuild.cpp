@@ -64,7 +64,7 @@ struct RebuildCliOptions {
     double budget_kb = 60;
     std::string leaf_materials;
     double dbf6_resolution = 5.0;
-    std::size_t compare_samples = 100000;
+    std::size_t compare_samples = 20000;
     int image_height = 800;
     ReconstructOptions stage;
     lobes::LobeOptions lobes;
@@ -392,7 +392,7 @@ int run_rebuild(RebuildCliOptions& o, const GlobalOptions& global) {
 
 void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<RebuildCliOptions>();
-    o->synthesis.max_triangles = 500000;
+    o->synthesis.max_triangles = 200000;
     o->flags.species = "auto";
     CLI::App* sub = app.add_subcommand("rebuild", "A heavy polygonal tree (OBJ/PLY/OFF/STL) in, a light lobe-based tree (.tlobe, .dbf6) out, with a fidelity report");
     sub->add_option("mesh", o->input, "Tree model: .obj (materials/groups name bark and leaves), .ply, .off, .stl")->required();

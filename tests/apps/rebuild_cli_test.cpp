@@ -25,7 +25,7 @@ std::filesystem::path small_tree_obj(const TempDir& dir) {
     return dir / "palm_3_mesh.obj";
 }
 
-const char* kFastRebuild = " --samples 20000 --compare-samples 4000 --max-triangles 20000 --image-height 160";
+const char* kFastRebuild = " --samples 20000 --compare-samples 2000 --max-triangles 20000 --image-height 160";
 
 }  // namespace
 
