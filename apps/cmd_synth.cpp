@@ -62,6 +62,7 @@ struct TreeFlags {
     double height = 0;
     double ground_margin = 2.0;
     bool no_mesh = false;
+    std::string mesh_format = "ply";
 };
 
 struct DatasetFlags {
@@ -230,7 +231,7 @@ TreeResult make_tree(const SpeciesProfile& profile, std::uint64_t seed, const Sy
     write_skeleton_ply(tree.skeleton, stem.string() + "_skeleton.ply");
     std::optional<synth::TreeMesh> tree_mesh;
     if (mesh || f.preview) tree_mesh = synth::tree_mesh(tree);
-    if (mesh) write_mesh(tree_mesh->combined(), stem.string() + "_mesh.ply");
+    if (mesh) write_named_mesh(tree_mesh->named(), stem.string() + "_mesh." + t.mesh_format);
 
     const synth::Scene scene = synth::single_tree_scene(std::move(tree), t.ground_margin, seed);
     synth::ScanSummary scan;
@@ -277,7 +278,7 @@ int run_tree(SynthFlags f, const TreeFlags& t, const GlobalOptions& global) {
     summary["outputs"] = json::array();
     for (const std::string& suffix : {"." + f.cloud_format, std::string("_skeleton.ply"), std::string("_truth.json")})
         summary["outputs"].push_back((folder / (name + suffix)).string());
-    if (!t.no_mesh) summary["outputs"].push_back((folder / (name + "_mesh.ply")).string());
+    if (!t.no_mesh) summary["outputs"].push_back((folder / (name + "_mesh." + t.mesh_format)).string());
     if (f.preview) {
         summary["outputs"].push_back((folder / (name + "_mesh.png")).string());
         summary["outputs"].push_back((folder / (name + "_scan.png")).string());
@@ -466,6 +467,8 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     tree_cmd->add_option("--height", tree->height, "Tree height, m (default: drawn from the species' range)");
     tree_cmd->add_option("--ground-margin", tree->ground_margin, "Ground scanned beyond the crown, m");
     tree_cmd->add_flag("--no-mesh", tree->no_mesh, "Do not write the tree mesh");
+    tree_cmd->add_option("--mesh-format", tree->mesh_format, "Tree mesh file: ply (geometry) or obj (objects, groups and materials: bark / leaf)")
+        ->check(CLI::IsMember({"ply", "obj"}))->capture_default_str();
     tree_cmd->add_flag("--preview", tree_flags->preview, "Also write <name>_mesh.png, <name>_scan.png and both side by side, <name>_preview.png");
     tree_cmd->add_option("--preview-height", tree_flags->preview_height, "Height of the preview PNGs, pixels")->check(CLI::Range(64, 4096));
     add_common_flags(tree_cmd, *tree_flags);

@@ -44,6 +44,7 @@ int run(int argc, char** argv) {
     cli::add_classify_command(app, global, job);
     cli::add_lobes_commands(app, global, job);
     cli::add_export_command(app, global, job);
+    cli::add_rebuild_command(app, global, job);
 
     try {
         app.parse(argc, argv);

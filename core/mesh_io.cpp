@@ -1,18 +1,19 @@
-// Mesh files through OpenMesh (PLY, OBJ, OFF, STL, OM). Points are read in double precision
-// so georeferenced meshes keep their precision; the origin is moved into TriangleMesh::origin.
+// Mesh files: OBJ through core/obj_mesh_io.cpp (face names), PLY, OFF, STL and OM through
+// OpenMesh. Points are read in double precision so georeferenced meshes keep their precision;
+// the origin is moved into TriangleMesh::origin.
 #include "core/mesh_io.hpp"
 
 #include "core/atomic_file.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
+#include "core/obj_mesh_io.hpp"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <array>
-#include <cmath>
 
 namespace fs = std::filesystem;
 
@@ -37,32 +38,24 @@ void silence_openmesh() {
 }
 
 Eigen::Vector3d origin_for(const PolyMesh& mesh) {
-    Eigen::Vector3d origin = Eigen::Vector3d::Zero();
-    if (mesh.n_vertices() == 0) return origin;
+    if (mesh.n_vertices() == 0) return Eigen::Vector3d::Zero();
     const auto& p = mesh.point(*mesh.vertices_begin());
-    for (int k = 0; k < 3; ++k)
-        if (std::abs(p[k]) >= 1e4) origin[k] = std::round(p[k] / 1000.0) * 1000.0;
-    return origin;
+    return mesh_origin_for(Eigen::Vector3d(p[0], p[1], p[2]));
 }
 
-}  // namespace
-
-TriangleMesh read_mesh(const fs::path& path) {
+// PLY, OFF, STL, OM. OpenMesh gives non-manifold faces their own vertex copies and skips
+// faces with a repeated corner or a corner index out of range.
+NamedMesh read_with_openmesh(const fs::path& path) {
     const std::string name = path.string();
-    std::error_code ec;
-    if (!fs::exists(path, ec)) throw Error::input(name, "no such file");
-    if (fs::is_directory(path, ec)) throw Error::input(name, "is a directory, expected a mesh file");
-    if (fs::file_size(path, ec) == 0) throw Error::input(name, "empty file");
-    if (!is_mesh_extension(file_extension(path)))
-        throw Error::input(name, "unknown mesh format (expected .ply, .obj, .off, .stl)");
-
     silence_openmesh();
     PolyMesh mesh;
     OpenMesh::IO::Options options;
     if (!OpenMesh::IO::read_mesh(mesh, name, options))
         throw Error::input(name, "cannot read mesh (malformed or truncated file)");
 
-    TriangleMesh out;
+    NamedMesh named;
+    named.report.format = file_extension(path);
+    TriangleMesh& out = named.mesh;
     out.origin = origin_for(mesh);
     out.vertices.reserve(mesh.n_vertices());
     for (const auto& v : mesh.vertices()) {
@@ -74,9 +67,30 @@ TriangleMesh read_mesh(const fs::path& path) {
     for (const auto& f : mesh.faces()) {  // fan triangulation of polygons
         std::vector<int> corners;
         for (const auto& v : mesh.fv_range(f)) corners.push_back(v.idx());
+        if (corners.size() > 3) ++named.report.polygons_split;
         for (std::size_t k = 1; k + 1 < corners.size(); ++k) out.faces.push_back({corners[0], corners[k], corners[k + 1]});
     }
-    return out;
+    return named;
+}
+
+}  // namespace
+
+NamedMesh read_named_mesh(const fs::path& path) {
+    const std::string name = path.string();
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw Error::input(name, "no such file");
+    if (fs::is_directory(path, ec)) throw Error::input(name, "is a directory, expected a mesh file");
+    if (fs::file_size(path, ec) == 0) throw Error::input(name, "empty file");
+    const std::string ext = file_extension(path);
+    if (!is_mesh_extension(ext)) throw Error::input(name, "unknown mesh format (expected .obj, .ply, .off, .stl)");
+    return ext == "obj" ? read_obj(path) : read_with_openmesh(path);
+}
+
+TriangleMesh read_mesh(const fs::path& path) { return read_named_mesh(path).mesh; }
+
+void write_named_mesh(const NamedMesh& mesh, const fs::path& path) {
+    if (file_extension(path) == "obj") write_obj(mesh, path);
+    else write_mesh(mesh.mesh, path);
 }
 
 void write_mesh(const TriangleMesh& mesh, const fs::path& path) {

@@ -11,6 +11,15 @@
 
 namespace treelobes::lobes {
 
+// Mean, median, 95th percentile and maximum of a list of distances (all 0 for an empty list):
+// one direction of a Metro-style surface comparison (Cignoni et al. 1998), whose maximum is
+// that direction's Hausdorff distance.
+struct DistanceSummary {
+    std::size_t count = 0;
+    double mean = 0, median = 0, p95 = 0, max = 0;
+};
+DistanceSummary summarise_distances(std::vector<float> distances);
+
 class MeshDistance {
 public:
     explicit MeshDistance(const TriangleMesh& mesh);  // Error(Usage) for a mesh without faces

@@ -167,4 +167,20 @@ std::size_t Rasterizer::covered_pixels() const {
     return static_cast<std::size_t>(std::count_if(depth_.begin(), depth_.end(), [](double z) { return std::isfinite(z); }));
 }
 
+std::vector<bool> Rasterizer::coverage() const {
+    std::vector<bool> mask(depth_.size());
+    for (std::size_t i = 0; i < depth_.size(); ++i) mask[i] = std::isfinite(depth_[i]);
+    return mask;
+}
+
+double silhouette_iou(const std::vector<bool>& a, const std::vector<bool>& b) {
+    if (a.size() != b.size()) throw Error(ExitCode::Internal, "silhouette_iou: masks of different sizes");
+    std::size_t both = 0, either = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        both += a[i] && b[i];
+        either += a[i] || b[i];
+    }
+    return either == 0 ? 1.0 : static_cast<double>(both) / static_cast<double>(either);
+}
+
 }  // namespace treelobes::render

@@ -44,6 +44,8 @@ public:
     const Image& image() const { return image_; }
     // Number of pixels written at least once (coverage checks in tests).
     std::size_t covered_pixels() const;
+    // Per pixel (row-major), whether anything was drawn there: the silhouette of what was drawn.
+    std::vector<bool> coverage() const;
 
 private:
     Eigen::Vector3d project(const Eigen::Vector3d& world) const;  // pixel x, pixel y, depth
@@ -55,6 +57,10 @@ private:
     Eigen::Vector3d right_, up_, forward_, centre_;
     double scale_ = 1.0;  // pixels per metre
 };
+
+// Intersection over union of two silhouettes of the same size (1 when both are empty); compares
+// the outlines of two models drawn with the same view (`treelobes rebuild`).
+double silhouette_iou(const std::vector<bool>& a, const std::vector<bool>& b);
 
 // Multiplies an RGB colour by a light factor in [0, 1] (alpha unchanged).
 Rgba shade(Rgba colour, double light);

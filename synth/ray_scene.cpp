@@ -39,14 +39,19 @@ T* new_buffer(RTCDevice device, RTCGeometry geometry, RTCBufferType type, RTCFor
     return static_cast<T*>(data);
 }
 
+// Scene meshes carry no species: typical near-infrared reflectances of bark and leaves.
+constexpr float kMeshBarkReflectance = 0.35f;
+constexpr float kMeshLeafReflectance = 0.45f;
+
 }  // namespace
 
 struct RayScene::Impl {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     unsigned curves = RTC_INVALID_GEOMETRY_ID, leaves = RTC_INVALID_GEOMETRY_ID;
-    unsigned ground = RTC_INVALID_GEOMETRY_ID, understory = RTC_INVALID_GEOMETRY_ID;
+    unsigned ground = RTC_INVALID_GEOMETRY_ID, understory = RTC_INVALID_GEOMETRY_ID, meshes = RTC_INVALID_GEOMETRY_ID;
     std::vector<Label> curve_labels, leaf_labels;
+    std::vector<std::uint8_t> mesh_wood;  // per triangle of `meshes`
     std::vector<float> bark, foliage;  // reflectance per tree
     std::size_t primitives = 0;
 
@@ -115,6 +120,36 @@ struct RayScene::Impl {
         return attach(g);
     }
 
+    // All scene meshes as one triangle geometry, each triangle labelled wood or leaf.
+    void add_meshes(const Scene& s) {
+        std::size_t vertex_count = 0, face_count = 0;
+        for (const auto& m : s.meshes) {
+            if (m.wood.size() != m.mesh.faces.size()) throw Error(ExitCode::Internal, "scene mesh: one wood label per face expected");
+            vertex_count += m.mesh.vertices.size();
+            face_count += m.mesh.faces.size();
+        }
+        if (face_count == 0) return;
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vertices = new_buffer<float[3]>(device, g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, vertex_count);
+        auto* index = new_buffer<unsigned[3]>(device, g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, face_count);
+        std::size_t v = 0, f = 0;
+        for (const auto& m : s.meshes) {
+            const Eigen::Vector3f offset = (m.mesh.origin - s.origin).cast<float>();
+            const auto base = static_cast<unsigned>(v);
+            for (const auto& p : m.mesh.vertices) {
+                const Eigen::Vector3f q = offset + p;
+                vertices[v][0] = q.x(), vertices[v][1] = q.y(), vertices[v][2] = q.z();
+                ++v;
+            }
+            for (std::size_t k = 0; k < m.mesh.faces.size(); ++k, ++f) {
+                for (int c = 0; c < 3; ++c) index[f][c] = base + static_cast<unsigned>(m.mesh.faces[k][c]);
+                mesh_wood.push_back(m.wood[k]);
+            }
+        }
+        primitives += face_count;
+        meshes = attach(g);
+    }
+
     void add_ground(const Heightfield& h) {
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         const std::size_t cells = static_cast<std::size_t>(h.nx - 1) * (h.ny - 1);
@@ -161,6 +196,7 @@ RayScene::RayScene(const Scene& s) : impl_(std::make_unique<Impl>()) {
     if (!s.understory.empty())
         m.understory = m.add_blades({{&s.understory, s.understory_shape, -1, Eigen::Vector3f::Zero()}}, nullptr);
     if (s.ground) m.add_ground(*s.ground);
+    m.add_meshes(s);
 
     rtcCommitScene(m.scene);
     if (rtcGetDeviceError(m.device) != RTC_ERROR_NONE) embree_failed(m.device, "building the ray-tracing scene");
@@ -203,6 +239,10 @@ bool RayScene::intersect(const Eigen::Vector3f& origin, const Eigen::Vector3f& d
         hit.tree = label.tree;
         hit.internode = label.internode;
         hit.reflectance = m.foliage[static_cast<std::size_t>(label.tree)];
+    } else if (r.hit.geomID == m.meshes) {
+        const bool wood = m.mesh_wood[r.hit.primID] != 0;
+        hit.surface = wood ? Surface::Wood : Surface::Leaf;
+        hit.reflectance = wood ? kMeshBarkReflectance : kMeshLeafReflectance;
     } else if (r.hit.geomID == m.understory) {
         hit.surface = Surface::Understory;
         hit.reflectance = 0.5f;

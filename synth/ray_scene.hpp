@@ -1,7 +1,8 @@
 // Ray casting against a synth::Scene with Intel Embree 3 (kept inside ray_scene.cpp).
 // Branches are traced as Embree round linear curves, one cone segment per internode with the
-// true radii at both ends (exact tubes, no tessellation), leaves as quads and the ground as
-// triangles; every hit says which tree, which internode and what kind of surface it struck.
+// true radii at both ends (exact tubes, no tessellation), leaves as quads, the ground and scene
+// meshes (CG tree models, labelled wood/leaf per face) as triangles; every hit says which tree,
+// which internode and what kind of surface it struck.
 #pragma once
 
 #include "synth/scene.hpp"

@@ -133,6 +133,10 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> Scene::bounds() const {
     }
     for (const auto& leaf : understory)
         for (const auto& c : leaf_corners(leaf, understory_shape)) extend(c.cast<double>());
+    for (const auto& m : meshes) {
+        const Eigen::Vector3d offset = m.mesh.origin - origin;
+        for (const auto& v : m.mesh.vertices) extend(offset + v.cast<double>());
+    }
     if (lo.x() > hi.x()) throw Error::usage("the scene to scan is empty");
     return {lo, hi};
 }

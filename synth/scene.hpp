@@ -2,6 +2,7 @@
 // all in one local frame (metres) with a double-precision origin for georeferenced output.
 #pragma once
 
+#include "core/triangle_mesh.hpp"
 #include "synth/grow.hpp"
 
 #include <Eigen/Core>
@@ -34,12 +35,21 @@ struct Heightfield {
 Heightfield make_ground(double x0, double y0, double x1, double y1, double slope_deg, double aspect_deg, double roughness_m,
                         std::uint64_t seed, double cell = 0.5);
 
+// A triangle mesh in the scene, such as a CG tree model to be scanned (synth/mesh_sampling.hpp):
+// its vertices are placed at mesh.origin + vertex in world coordinates; wood[f] is 1 for a
+// bark face and 0 for a leaf face.
+struct SceneMesh {
+    TriangleMesh mesh;
+    std::vector<std::uint8_t> wood;
+};
+
 struct Scene {
     Eigen::Vector3d origin{0, 0, 0};     // added to every output position
     std::vector<PlacedTree> trees;
     std::optional<Heightfield> ground;   // class 2
     std::vector<Leaf> understory;        // low vegetation blades in the scene frame (class 3)
     LeafShape understory_shape = LeafShape::Broad;
+    std::vector<SceneMesh> meshes;       // class 5 (tree), labelled wood/leaf per face, tree id 0
 
     // Bounding box of everything in the scene frame.
     std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds() const;

@@ -22,6 +22,15 @@ TriangleMesh TreeMesh::combined() const {
     return all;
 }
 
+NamedMesh TreeMesh::named() const {
+    NamedMesh out;
+    out.mesh = combined();
+    out.names = {{"bark", "branches", "tree"}, {"leaf", "leaves", "tree"}};
+    out.face_names.assign(wood.faces.size(), 0);
+    out.face_names.resize(out.mesh.faces.size(), 1);
+    return out;
+}
+
 TreeMesh tree_mesh(const SyntheticTree& tree, const TreeMeshOptions& options) {
     TreeMesh mesh;
     mesh.wood = build_branch_mesh(tree.skeleton, options.branches);

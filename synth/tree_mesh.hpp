@@ -2,6 +2,7 @@
 // cylinders with smooth joints) plus one quad (two triangles) per leaf.
 #pragma once
 
+#include "core/mesh_io.hpp"
 #include "geometry/branch_mesh.hpp"
 #include "synth/grow.hpp"
 
@@ -19,6 +20,10 @@ struct TreeMesh {
     TriangleMesh wood;
     TriangleMesh leaves;
     TriangleMesh combined() const;  // wood first, then leaves
+    // The combined mesh with the names a CG tree model gives its parts (object "tree"; group
+    // "branches" with material "bark", group "leaves" with material "leaf"), for OBJ output
+    // that `treelobes rebuild` labels by name.
+    NamedMesh named() const;
 };
 
 TreeMesh tree_mesh(const SyntheticTree& tree, const TreeMeshOptions& options = {});

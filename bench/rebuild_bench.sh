@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# `treelobes rebuild` on heavy polygonal trees, the experiment of Livny et al. 2011, §7 (Xfrog
+# models sampled into points and rebuilt as lobe-based trees: 56 MB -> 60 kB for a tree,
+# 47 MB -> 45 kB for a shrub). The heavy trees are `treelobes synth tree` meshes written as OBJ
+# with bark/leaf materials (dense leaf geometry, up to 250 000 leaves), one per species.
+# Prints per species: input MB and triangles, .tlobe and .dbf6 kB, compression factor (input /
+# .tlobe), symmetric mean / p95 / Hausdorff distances original <-> rebuilt in % of the bounding-box
+# diagonal, silhouette IoU (front, side, top), leaf area ratio rebuilt / original, rebuild wall
+# and CPU time and peak memory; then the paper's figures.
+# Usage: bench/rebuild_bench.sh [BUILD_DIR] [OUT_DIR] [SPECIES...]   (default: all 12 species)
+# Extra rebuild flags: REBUILD_FLAGS="--scan tls --samples 300000" bench/rebuild_bench.sh
+set -euo pipefail
+here=$(cd "$(dirname "$0")/.." && pwd)
+build=${1:-$here/build}
+out=${2:-/tmp/treelobes_rebuild_bench}
+bin=$build/bin/treelobes
+mkdir -p "$out"
+species=(mahogany bischofia_polycarpa delonix lagerstroemia ailanthus_altissima palm terminalia pine willow ficus_virens birch oak)
+if [ $# -gt 2 ]; then species=("${@:3}"); fi
+printf '%-20s %8s %9s %8s %7s %7s %7s %7s %7s %5s %5s %5s %6s %7s %7s %7s\n' \
+  species in_MB triangles tlobe_kB dbf6_kB factor mean_% p95_% haus_% iouF iouS iouT leafA time_s cpu_s peak_MB
+for s in "${species[@]}"; do
+  if [ ! -s "$out/${s}_1_mesh.obj" ]; then
+    "$bin" synth tree --species "$s" --out "$out" --seed 1 --mesh-format obj --angular-step 1 --log-level error > /dev/null
+  fi
+  # shellcheck disable=SC2086
+  "$bin" rebuild "$out/${s}_1_mesh.obj" --out "$out/$s" --species "$s" --log-level error ${REBUILD_FLAGS:-} > /dev/null
+  python3 - "$out/$s/report.json" "$s" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+z, f = r["sizes"], r["fidelity"]
+sym, iou = f["symmetric"], f["silhouette_iou"]
+ratio = f["leaf_area"]["ratio"]
+print("%-20s %8.1f %9d %8.1f %7.1f %7.0f %7.2f %7.2f %7.2f %5.2f %5.2f %5.2f %6s %7.1f %7.1f %7.0f" % (
+    sys.argv[2], z["original_bytes"] / 1e6, r["input_mesh"]["triangles"], z["tlobe_bytes"] / 1e3, z["dbf6_bytes"] / 1e3,
+    z["compression_factor"], 100 * sym["mean_of_diagonal"], 100 * sym["p95_of_diagonal"], 100 * sym["max_of_diagonal"],
+    iou["front"], iou["side"], iou["top"], "-" if ratio is None else "%.2f" % ratio, r["seconds"]["total"], r["seconds"]["cpu"], r["peak_memory_mb"]))
+PY
+done
+printf '%-20s %8.1f %9s %8.1f %7s %7.0f\n' "paper: Xfrog tree" 56 - 60 - 933
+printf '%-20s %8.1f %9s %8.1f %7s %7.0f\n' "paper: Xfrog shrub" 47 - 45 - 1044

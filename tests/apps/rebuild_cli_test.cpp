@@ -1,0 +1,109 @@
+// `treelobes rebuild` end to end on a small leafy synthetic tree exported as OBJ with bark and
+// leaf materials: every output, a sane report, the comparison PNG's size; broken meshes exit 2
+// with one line, bad options exit 1.
+#include "core/atomic_file.hpp"
+#include "render/image.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+
+using namespace treelobes;
+using test::quoted;
+using test::run_cli;
+using test::TempDir;
+
+namespace {
+
+// A 6 m palm with a few thousand leaves, written as <dir>/palm_3_mesh.obj.
+std::filesystem::path small_tree_obj(const TempDir& dir) {
+    const auto r = run_cli("synth tree --species palm --seed 3 --height 6 --max-leaves 4000 --angular-step 0.5 --mesh-format obj --out " +
+                           quoted(dir.path()));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return dir / "palm_3_mesh.obj";
+}
+
+const char* kFastRebuild = " --samples 20000 --compare-samples 2000 --max-triangles 20000 --image-height 160";
+
+}  // namespace
+
+TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
+    TempDir in, out;
+    const auto mesh = small_tree_obj(in);
+    const auto r = run_cli("rebuild " + quoted(mesh) + " --out " + quoted(out.path()) + " --species palm" + kFastRebuild + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("rebuild: sampling"), std::string::npos) << "progress goes to stderr";
+    const auto report = nlohmann::json::parse(read_file(out / "report.json"));
+    EXPECT_EQ(nlohmann::json::parse(r.out), report);
+    for (const char* file : {"palm_3_mesh.tlobe", "palm_3_mesh.dbf6", "palm_3_mesh_rebuilt.ply", "palm_3_mesh_skeleton.ply",
+                             "palm_3_mesh_samples.ply", "palm_3_mesh_compare.png"})
+        EXPECT_GT(std::filesystem::file_size(out / file), 0u) << file;
+
+    const auto& labels = report["input_mesh"]["labels"];
+    EXPECT_GT(labels["leaf_by_name"].get<int>(), 1000);  // material "leaf"
+    EXPECT_GT(labels["wood_by_name"].get<int>(), 1000);  // material "bark"
+    EXPECT_EQ(labels["wood_by_geometry"].get<int>() + labels["leaf_by_geometry"].get<int>(), 0);
+    EXPECT_EQ(report["samples"]["points"], 20000);
+    EXPECT_GT(report["samples"]["leaf"].get<int>(), 0);
+    EXPECT_EQ(report["species"]["patches"], "palm");
+    const auto& sizes = report["sizes"];
+    EXPECT_EQ(sizes["original_bytes"].get<double>(), static_cast<double>(std::filesystem::file_size(mesh)));
+    EXPECT_EQ(sizes["tlobe_bytes"].get<double>(), static_cast<double>(std::filesystem::file_size(out / "palm_3_mesh.tlobe")));
+    EXPECT_LE(sizes["tlobe_bytes"].get<double>(), 60000);
+    EXPECT_NEAR(sizes["compression_factor"].get<double>(), sizes["original_bytes"].get<double>() / sizes["tlobe_bytes"].get<double>(), 0.1);
+    EXPECT_GT(sizes["compression_factor"].get<double>(), 10);
+    const auto& symmetric = report["fidelity"]["symmetric"];
+    EXPECT_GT(symmetric["mean"].get<double>(), 0);
+    EXPECT_LT(symmetric["mean_of_diagonal"].get<double>(), 0.1);  // the rebuilt tree stands where the original stood
+    EXPECT_LE(symmetric["mean"].get<double>(), symmetric["max"].get<double>());
+    for (const char* view : {"front", "side", "top"}) {
+        const double iou = report["fidelity"]["silhouette_iou"][view].get<double>();
+        EXPECT_GT(iou, 0.1) << view;  // overlapping outlines (the palm's synthesized fronds are far larger: docs/rebuild.md)
+        EXPECT_LE(iou, 1.0) << view;
+    }
+    EXPECT_GT(report["fidelity"]["leaf_area"]["original_m2"].get<double>(), 0);
+    EXPECT_GT(report["rebuilt"]["triangles"].get<int>(), 0);
+    EXPECT_LE(report["rebuilt"]["triangles"].get<int>(), 20000);
+    EXPECT_GT(report["seconds"]["total"].get<double>(), 0);
+
+    const render::Image png = render::read_png(out / "palm_3_mesh_compare.png");
+    EXPECT_EQ(png.height, 160);
+    EXPECT_EQ(png.width % 3, 0);  // three panels of one size
+    EXPECT_GE(png.width, 3 * 40);
+}
+
+TEST(RebuildCli, SameInputSameOutputs) {
+    TempDir in, a, b;
+    const auto mesh = small_tree_obj(in);
+    const std::string args = " --scan tls --samples 8000 --compare-samples 2000 --max-triangles 8000 --image-height 100";
+    ASSERT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(a.path()) + args).exit_code, 0);
+    ASSERT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(b.path()) + args + " --threads 1").exit_code, 0);
+    for (const char* file : {"palm_3_mesh.tlobe", "palm_3_mesh.dbf6", "palm_3_mesh_rebuilt.ply", "palm_3_mesh_compare.png"})
+        EXPECT_EQ(read_file(a / file), read_file(b / file)) << file;
+}
+
+TEST(RebuildCli, BrokenMeshesExitTwoWithOneLine) {
+    TempDir dir, out;
+    const std::pair<const char*, const char*> cases[] = {
+        {"truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2"},
+        {"nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"},
+        {"no_triangles.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"},
+        {"empty.obj", ""},
+        {"flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"},
+        {"points.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"},
+    };
+    for (const auto& [name, text] : cases) {
+        test::write_text(dir / name, text);
+        const auto r = run_cli("rebuild " + quoted(dir / name) + " --out " + quoted(out.path()));
+        EXPECT_EQ(r.exit_code, 2) << name << ": " << r.err;
+        const std::string last = r.err.substr(r.err.rfind("treelobes: error:") == std::string::npos ? 0 : r.err.rfind("treelobes: error:"));
+        EXPECT_NE(last.find(name), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(last.begin(), last.end(), '\n'), 1) << r.err;
+    }
+    EXPECT_EQ(run_cli("rebuild " + quoted(dir / "absent.obj") + " --out " + quoted(out.path())).exit_code, 2);
+    EXPECT_EQ(run_cli("rebuild " + quoted(dir / "nan.obj") + " --out " + quoted(out.path()) + " --scan lidar").exit_code, 1);
+    EXPECT_EQ(run_cli("rebuild " + quoted(dir / "nan.obj") + " --out " + quoted(out.path()) + " --species oak_tree").exit_code, 1);
+    EXPECT_EQ(run_cli("rebuild " + quoted(dir / "nan.obj") + " --out " + quoted(out.path()) + " --scan tls --density 10").exit_code, 1);
+}
