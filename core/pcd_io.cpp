@@ -1,6 +1,7 @@
 // PCD through PCL's reader and writer. Fields x y z are required; intensity, rgb/rgba and
 // label map to the standard attributes; every other single-valued field becomes an extra.
 #include "core/atomic_file.hpp"
+#include "core/attribute_value.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
@@ -75,9 +76,9 @@ void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, c
     values.reserve(kept.size());
     for (std::size_t i : kept) values.push_back(field_value(blob, f, i));
     if (f.name == "intensity") {
-        for (double v : values) cloud.intensity.push_back(static_cast<std::uint16_t>(std::clamp(v, 0.0, 65535.0)));
+        for (double v : values) cloud.intensity.push_back(attribute_value<std::uint16_t>(v));
     } else if (f.name == "classification") {
-        for (double v : values) cloud.classification.push_back(static_cast<std::uint8_t>(std::clamp(v, 0.0, 255.0)));
+        for (double v : values) cloud.classification.push_back(attribute_value<std::uint8_t>(v));
     } else {
         cloud.extras.push_back({f.name, attribute_type(f.datatype), "", std::nullopt, std::move(values)});
     }
@@ -88,6 +89,9 @@ void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, c
 PointCloud read_pcd(const fs::path& path) {
     const std::string name = path.string();
     pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // errors become our one-line message
+    // PCL's reader dereferences a null pointer on an empty file (found by fuzz/pcd_fuzz.cpp).
+    std::error_code error;
+    if (fs::file_size(path, error) == 0 && !error) throw Error::input(name, "file is empty, expected a PCD header");
     pcl::PCLPointCloud2 blob;
     pcl::PCDReader reader;
     if (reader.read(name, blob) < 0) throw Error::input(name, "cannot read PCD (malformed or truncated file)");
