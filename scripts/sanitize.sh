@@ -7,7 +7,7 @@
 #   scripts/sanitize.sh tsan   build-tsan (clang, ThreadSanitizer): only the test programs of the
 #                              parallel code (kNN, neighbour graph and Dijkstra in reconstruct,
 #                              JointBoost training and the evaluation splits in classify, scan
-#                              simulation in synth), CLI tests left out
+#                              simulation in synth, forest coding in encode), CLI tests left out
 #   scripts/sanitize.sh        both
 # Any sanitizer report fails the test that triggered it.
 set -euo pipefail
@@ -18,7 +18,7 @@ export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export TSAN_OPTIONS=${TSAN_OPTIONS:-halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/scripts/tsan.supp}
 
-TSAN_TESTS=(reconstruct_test classify_jointboost_test classify_evaluation_test synth_test)
+TSAN_TESTS=(reconstruct_test classify_jointboost_test classify_evaluation_test synth_test encode_compression_test)
 
 run_asan() {
   build_sanitized all
