@@ -13,6 +13,8 @@
 
 #include <array>
 #include <cmath>
+#include <fstream>
+#include <string>
 
 namespace fs = std::filesystem;
 
@@ -45,6 +47,20 @@ Eigen::Vector3d origin_for(const PolyMesh& mesh) {
     return origin;
 }
 
+// OpenMesh's PLY reader loops forever on a header that never ends (found by
+// fuzz/mesh_fuzz.cpp), so the header must reach its end_header line within 64 kB.
+void check_ply_header_ends(const fs::path& path, const std::string& name) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    std::size_t read = 0;
+    while (read < 65536 && std::getline(in, line)) {
+        read += line.size() + 1;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line == "end_header") return;
+    }
+    throw Error::input(name, "PLY header has no end_header line");
+}
+
 }  // namespace
 
 TriangleMesh read_mesh(const fs::path& path) {
@@ -55,6 +71,8 @@ TriangleMesh read_mesh(const fs::path& path) {
     if (fs::file_size(path, ec) == 0) throw Error::input(name, "empty file");
     if (!is_mesh_extension(file_extension(path)))
         throw Error::input(name, "unknown mesh format (expected .ply, .obj, .off, .stl)");
+
+    if (file_extension(path) == "ply") check_ply_header_ends(path, name);
 
     silence_openmesh();
     PolyMesh mesh;

@@ -14,6 +14,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -84,6 +87,29 @@ void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, c
     }
 }
 
+// PCL's reader dereferences null pointers on headers without their FIELDS, SIZE or TYPE lines
+// (found by fuzz/pcd_fuzz.cpp), so the header is checked first: every required keyword once,
+// FIELDS, SIZE, TYPE (and COUNT) with the same number of entries.
+void check_pcd_header(const fs::path& path, const std::string& name) {
+    std::ifstream in(path, std::ios::binary);
+    std::map<std::string, std::size_t> entries;  // keyword -> values on its line
+    std::string line;
+    for (int lines = 0; lines < 64 && std::getline(in, line); ++lines) {
+        std::istringstream words(line);
+        std::string keyword, value;
+        if (!(words >> keyword) || keyword[0] == '#') continue;
+        std::size_t count = 0;
+        while (words >> value) ++count;
+        entries[keyword] = count;
+        if (keyword == "DATA") break;
+    }
+    for (const char* keyword : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
+        if (!entries.count(keyword)) throw Error::input(name, std::string("PCD header has no ") + keyword + " line");
+    const std::size_t fields = entries["FIELDS"];
+    if (fields == 0 || entries["SIZE"] != fields || entries["TYPE"] != fields || (entries.count("COUNT") && entries["COUNT"] != fields))
+        throw Error::input(name, "PCD header: FIELDS, SIZE, TYPE and COUNT list different numbers of entries");
+}
+
 }  // namespace
 
 PointCloud read_pcd(const fs::path& path) {
@@ -92,6 +118,7 @@ PointCloud read_pcd(const fs::path& path) {
     // PCL's reader dereferences a null pointer on an empty file (found by fuzz/pcd_fuzz.cpp).
     std::error_code error;
     if (fs::file_size(path, error) == 0 && !error) throw Error::input(name, "file is empty, expected a PCD header");
+    check_pcd_header(path, name);
     pcl::PCLPointCloud2 blob;
     pcl::PCDReader reader;
     if (reader.read(name, blob) < 0) throw Error::input(name, "cannot read PCD (malformed or truncated file)");

@@ -218,3 +218,18 @@ TEST(Pcd, EmptyFileIsBadInputNotACrash) {
     write_text(dir / "empty.pcd", "");
     EXPECT_EQ(error_code_of([&] { read_pcd(dir / "empty.pcd"); }), ExitCode::InvalidInput);
 }
+
+// Fuzzing found both: PCL's PCD reader crashed on a header without its FIELDS line, OpenMesh's
+// PLY reader never returned on a header without end_header.
+TEST(Pcd, HeaderWithoutFieldsIsBadInputNotACrash) {
+    TempDir dir;
+    write_text(dir / "nofields.pcd", "# .PCD v0.7\nVERSION 0.7\nFIEL S x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                                     "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    EXPECT_EQ(error_code_of([&] { read_pcd(dir / "nofields.pcd"); }), ExitCode::InvalidInput);
+}
+
+TEST(MeshRead, PlyHeaderWithoutEndIsBadInputNotAHang) {
+    TempDir dir;
+    write_text(dir / "open.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n0 0 0\n");
+    EXPECT_EQ(error_code_of([&] { read_mesh(dir / "open.ply"); }), ExitCode::InvalidInput);
+}
