@@ -25,6 +25,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace treelobes::cli {
@@ -47,6 +48,8 @@ struct EncodeCliOptions {
     int lods = 1;
     std::string coder = "best";
     bool stats = false;
+    // Given on the command line (otherwise a decoded skeleton's recorded values apply).
+    bool resolution_given = false, internode_length_given = false, radius_unit_given = false;
 };
 
 struct DecodeFileCliOptions {
@@ -77,25 +80,6 @@ struct DecodeCliOptions {
     std::string out;
 };
 
-// "10,9,5" -> {10, 9, 5}; blanks around values are allowed, an empty text is an empty list.
-std::vector<int> parse_radii(const std::string& text) {
-    std::vector<int> radii;
-    std::stringstream stream(text);
-    std::string item;
-    while (std::getline(stream, item, ',')) {
-        const auto first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
-        const std::string value = first == std::string::npos ? "" : item.substr(first, last - first + 1);
-        int radius = 0;
-        const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), radius);
-        if (value.empty() || error != std::errc() || end != value.data() + value.size() || radius < 0)
-            throw Error::input("--radii", "value " + std::to_string(radii.size() + 1) + " ('" + value +
-                                              "') is not a non-negative integer");
-        radii.push_back(radius);
-    }
-    if (!text.empty() && text.back() == ',') throw Error::input("--radii", "trailing comma after the last radius");
-    return radii;
-}
-
 std::string join_radii(const std::vector<int>& radii) {
     std::string text;
     for (std::size_t i = 0; i < radii.size(); ++i) text += (i ? "," : "") + std::to_string(radii[i]);
@@ -112,18 +96,24 @@ double parse_internode_length(const std::string& text) {
     return value;
 }
 
-EncodeOptions encode_options_of(const EncodeCliOptions& options) {
+// Options given on the command line win; otherwise the parameters a decoded skeleton recorded
+// (so encode -> decode -> encode reproduces the code), otherwise the defaults.
+EncodeOptions encode_options_of(const EncodeCliOptions& options, const std::optional<CodeParameters>& recorded = {}) {
     EncodeOptions encode_options;
-    encode_options.resolution = options.resolution;
-    encode_options.internode_length = parse_internode_length(options.internode_length);
-    encode_options.radius_unit = options.radius_unit;
+    if (!options.resolution_given && !recorded)
+        throw Error::usage("--resolution is required: " + options.skeleton + " records no chain-code resolution");
+    encode_options.resolution = options.resolution_given ? options.resolution : recorded->resolution;
+    encode_options.internode_length = options.internode_length_given || !recorded
+                                          ? parse_internode_length(options.internode_length)
+                                          : recorded->internode_length;
+    encode_options.radius_unit = options.radius_unit_given || !recorded ? options.radius_unit : recorded->radius_unit;
     encode_options.kind = options.f6 ? CodeKind::F6 : CodeKind::DBF6;
     return encode_options;
 }
 
-TreeFileOptions file_options_of(const EncodeCliOptions& options) {
+TreeFileOptions file_options_of(const EncodeCliOptions& options, const std::optional<CodeParameters>& recorded = {}) {
     TreeFileOptions file_options;
-    file_options.encode = encode_options_of(options);
+    file_options.encode = encode_options_of(options, recorded);
     file_options.lods = options.lods;
     file_options.coder = parse_coder(options.coder);
     return file_options;
@@ -135,10 +125,14 @@ bool has_extension(const fs::path& path, const std::string& extension) {
     return ext == extension;
 }
 
-// A skeleton PLY, or the main skeleton of a lobe-based tree (.tlobe).
-TreeGraph read_tree_input(const fs::path& path) {
+// A skeleton PLY, or the main skeleton of a lobe-based tree (.tlobe). `recorded` receives the
+// chain-code parameters a decoded skeleton PLY records.
+TreeGraph read_tree_input(const fs::path& path, std::optional<CodeParameters>* recorded = nullptr) {
     if (has_extension(path, ".tlobe")) return lobes::read_tlobe(path).skeleton;
-    return read_skeleton_ply(path);
+    std::vector<std::string> comments;
+    TreeGraph tree = read_skeleton_ply(path, &comments);
+    if (recorded) *recorded = find_code_parameters(comments, path.string());
+    return tree;
 }
 
 nlohmann::json lod_stats_json(const StoredTree& tree, const std::vector<StreamSizes>& sizes) {
@@ -169,8 +163,9 @@ void print_lod_stats(const StoredTree& tree, const std::vector<StreamSizes>& siz
 }
 
 int run_encode_file(const EncodeCliOptions& options, const GlobalOptions& global) {
-    const TreeGraph tree = read_tree_input(options.skeleton);
-    const StoredTree stored = store_tree(tree, file_options_of(options), options.skeleton);
+    std::optional<CodeParameters> recorded;
+    const TreeGraph tree = read_tree_input(options.skeleton, &recorded);
+    const StoredTree stored = store_tree(tree, file_options_of(options, recorded), options.skeleton);
     std::vector<StreamSizes> sizes;
     const std::vector<std::uint8_t> bytes = write_tree_file_bytes(stored, &sizes);
     write_file_atomically(options.out, std::string(bytes.begin(), bytes.end()));
@@ -306,8 +301,9 @@ int run_encode_forest(const EncodeCliOptions& options, const GlobalOptions& glob
 int run_encode(const EncodeCliOptions& options, const GlobalOptions& global) {
     if (!options.forest.empty()) return run_encode_forest(options, global);
     if (!options.out.empty()) return run_encode_file(options, global);
-    const TreeGraph tree = read_tree_input(options.skeleton);
-    const EncodeOptions encode_options = encode_options_of(options);
+    std::optional<CodeParameters> recorded;
+    const TreeGraph tree = read_tree_input(options.skeleton, &recorded);
+    const EncodeOptions encode_options = encode_options_of(options, recorded);
     const EncodedTree encoded = encode_tree(tree, encode_options, options.skeleton);
 
     const SymbolCounts counts = count_symbols(encoded.code.symbols);
@@ -360,7 +356,7 @@ ChainCode code_from_options(const std::string& symbols, const std::string& radii
     ChainCode code;
     code.kind = kind;
     code.symbols = symbols;
-    code.radii = parse_radii(radii);
+    code.radii = parse_radius_list(radii, "--radii");
     return code;
 }
 
@@ -412,7 +408,8 @@ int run_decode(const DecodeCliOptions& options, const GlobalOptions& global) {
     geometry.radius_unit = options.radius_unit;
     geometry.root_radius = options.root_radius >= 0 ? options.root_radius : (code.radii.empty() ? 0 : code.radii[0]);
     const TreeGraph tree = decode_tree(code, geometry, "--code");
-    write_skeleton_ply(tree, options.out, !options.ascii);
+    write_skeleton_ply(tree, options.out, !options.ascii,
+                       {code_parameters_comment({options.resolution, options.internode_length, options.radius_unit})});
 
     const SymbolCounts counts = count_symbols(code.symbols);
     if (global.json) {
@@ -437,7 +434,14 @@ bool is_forest_file(const fs::path& path) {
     return file.gcount() == 4 && std::string(magic, 4) == "DBFF";
 }
 
-void write_tree_output(const TreeGraph& tree, const fs::path& out, bool ascii) { write_skeleton_ply(tree, out, !ascii); }
+// A decoded skeleton records the parameters of its code (tree_code.hpp CodeParameters).
+void write_tree_output(const TreeGraph& tree, const fs::path& out, bool ascii, const CodeParameters& code) {
+    write_skeleton_ply(tree, out, !ascii, {code_parameters_comment(code)});
+}
+
+CodeParameters code_parameters_of(const StoredTree& tree) {
+    return {tree.resolution, tree.internode_length, tree.radius_unit};
+}
 
 int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& global) {
     ForestReader forest{fs::path(options.input)};
@@ -450,6 +454,7 @@ int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& 
     }
     // Everything is decoded before anything is written: a damaged tree leaves no partial output.
     std::vector<TreeGraph> trees;
+    std::vector<CodeParameters> parameters;
     nlohmann::json written = nlohmann::json::array();
     std::size_t internodes = 0;
     for (std::size_t i : selected) {
@@ -457,13 +462,14 @@ int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& 
         const StoredTree stored = forest.read(i, options.lod, &sizes);
         trees.push_back(place_tree(decode_stored_tree(stored, options.lod, options.input + ": tree " + std::to_string(i)),
                                    forest.entry(i)));
+        parameters.push_back(code_parameters_of(stored));
         internodes += sizes[static_cast<std::size_t>(options.lod)].internodes;
         nlohmann::json item = {{"tree", i}, {"name", forest.entry(i).name}, {"nodes", trees.back().size()}};
         if (options.stats) item["lods"] = lod_stats_json(stored, sizes);
         written.push_back(item);
     }
     if (options.tree >= 0) {
-        write_tree_output(trees[0], options.out, options.ascii);
+        write_tree_output(trees[0], options.out, options.ascii, parameters[0]);
         written[0]["out"] = options.out;
     } else {
         // One skeleton PLY per tree in the --out directory, named by index and tree name.
@@ -473,7 +479,7 @@ int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& 
             std::snprintf(prefix, sizeof prefix, "%05zu", selected[k]);
             const std::string name = forest.entry(selected[k]).name;
             const fs::path out = fs::path(options.out) / (std::string(prefix) + (name.empty() ? "" : "_" + name) + ".ply");
-            write_tree_output(trees[k], out, options.ascii);
+            write_tree_output(trees[k], out, options.ascii, parameters[k]);
             written[k]["out"] = out.string();
         }
     }
@@ -496,7 +502,7 @@ int run_decode_file(const DecodeFileCliOptions& options, const GlobalOptions& gl
     std::vector<StreamSizes> sizes;
     const StoredTree stored = read_tree_file(options.input, options.lod, &sizes);
     const TreeGraph tree = decode_stored_tree(stored, options.lod, options.input);
-    write_tree_output(tree, options.out, options.ascii);
+    write_tree_output(tree, options.out, options.ascii, code_parameters_of(stored));
     const StreamSizes& level = sizes[static_cast<std::size_t>(options.lod)];
     if (global.json) {
         nlohmann::json j = {{"treelobes", kVersion},
@@ -531,15 +537,19 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     skeleton->excludes(forest);
     forest->excludes(skeleton);
     auto* out = sub->add_option("--out", options->out, "Output .dbf6 file (one tree) or .forest file (--forest)");
-    sub->add_option("--resolution", options->resolution, "Voxels per internode length (r of Eq. 2)")
-        ->required()
-        ->check(cli::PositiveNumber);
-    sub->add_option("--internode-length", options->internode_length,
-                    "Internode length l in metres, or 'auto' for the median edge length (per tree)")
-        ->capture_default_str();
-    sub->add_option("--radius-unit", options->radius_unit, "Metres per radius step of the radius list")
-        ->capture_default_str()
-        ->check(cli::PositiveNumber);
+    auto* resolution = sub->add_option("--resolution", options->resolution,
+                                       "Voxels per internode length (r of Eq. 2); required unless the skeleton is a "
+                                       "decoded one, which records r, l and the radius unit of its code")
+                           ->check(cli::PositiveNumber);
+    auto* internode_length = sub->add_option("--internode-length", options->internode_length,
+                                             "Internode length l in metres, or 'auto' for the median edge length (per "
+                                             "tree; a decoded skeleton's recorded l when not given)")
+                                 ->capture_default_str();
+    auto* radius_unit = sub->add_option("--radius-unit", options->radius_unit,
+                                        "Metres per radius step of the radius list (a decoded skeleton's recorded unit "
+                                        "when not given)")
+                            ->capture_default_str()
+                            ->check(cli::PositiveNumber);
     sub->add_flag("--f6", options->f6, "Plain F6 code instead of the differential DBF6");
     auto* print = sub->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
     auto* lods = sub->add_option("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
@@ -550,8 +560,12 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
                       ->check(CLI::IsMember({"ic", "best"}));
     sub->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");
     print->excludes(out);
-    sub->callback([options, skeleton, forest, out, lods, coder, &global, &job] {
+    sub->callback([options, skeleton, forest, out, lods, coder, resolution, internode_length, radius_unit, &global, &job] {
         if (skeleton->count() == 0 && forest->count() == 0) throw CLI::RequiredError("skeleton or --forest");
+        if (forest->count() && resolution->count() == 0) throw CLI::RequiredError("--resolution (with --forest)");
+        options->resolution_given = resolution->count() > 0;
+        options->internode_length_given = internode_length->count() > 0;
+        options->radius_unit_given = radius_unit->count() > 0;
         if (forest->count() && out->count() == 0) throw CLI::RequiredError("--out (with --forest)");
         if (out->count() == 0 && (lods->count() || coder->count()))
             throw CLI::ValidationError("--lods/--coder", "apply to files: give --out");

@@ -20,6 +20,7 @@
 #include "core/laz_chunk.hpp"
 #include "core/laz_layout.hpp"
 #include "core/little_endian.hpp"
+#include "core/memory_limit.hpp"
 #include "core/log.hpp"
 #include "core/version.hpp"
 
@@ -39,6 +40,7 @@
 #include <tbb/parallel_for.h>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -165,6 +167,14 @@ bool is_unsigned_type(AttributeType t) {
 }
 bool is_float_type(AttributeType t) { return t == AttributeType::Float32 || t == AttributeType::Float64; }
 
+// A scale factor or offset for a message: "0.001", "1e+300" (std::to_string would print 300
+// digits, or 0.000000 for a tiny scale).
+std::string number_text(double value) {
+    std::ostringstream text;
+    text << value;
+    return text.str();
+}
+
 std::string printable(const std::uint8_t* p, std::size_t size) {
     std::string out;
     static constexpr char hex[] = "0123456789abcdef";
@@ -247,14 +257,14 @@ void check_scale_offset(const InputFile& file, const LasHeader& h) {
     static constexpr const char* axes[] = {"x", "y", "z"};
     for (int k = 0; k < 3; ++k) {
         if (!std::isfinite(h.scale[k]) || h.scale[k] == 0)
-            file.fail(std::string(axes[k]) + " scale factor is " + std::to_string(h.scale[k]) +
+            file.fail(std::string(axes[k]) + " scale factor is " + number_text(h.scale[k]) +
                       ", expected a non-zero finite number such as 0.01 or 0.001");
         if (!std::isfinite(h.offset[k]))
             file.fail(std::string(axes[k]) + " offset is not a finite number");
         // Any 32-bit record must give a coordinate that float local positions can hold.
         if (std::abs(h.scale[k]) * 2147483648.0 + std::abs(h.offset[k]) > kMaxCoordinate)
-            file.fail(std::string(axes[k]) + " scale " + std::to_string(h.scale[k]) + " and offset " +
-                      std::to_string(h.offset[k]) + " give coordinates beyond 1e30, expected metre-range values");
+            file.fail(std::string(axes[k]) + " scale " + number_text(h.scale[k]) + " and offset " +
+                      number_text(h.offset[k]) + " give coordinates beyond 1e30, expected metre-range values");
     }
 }
 
@@ -423,8 +433,8 @@ ExtraField parse_descriptor(const InputFile& file, const std::uint8_t* d, std::s
     if (options & kScale) f.scale = load<double>(d + 112);
     if (options & kOffset) f.add = load<double>(d + 136);
     if (!std::isfinite(f.scale) || f.scale == 0 || !std::isfinite(f.add))
-        file.fail("Extra Bytes attribute '" + f.attribute.name + "' has scale " + std::to_string(f.scale) + " and offset " +
-                  std::to_string(f.add) + ", expected a finite non-zero scale and a finite offset");
+        file.fail("Extra Bytes attribute '" + f.attribute.name + "' has scale " + number_text(f.scale) + " and offset " +
+                  number_text(f.add) + ", expected a finite non-zero scale and a finite offset");
     f.scaled = f.scale != 1.0 || f.add != 0.0;
     // Scaled integers hold real numbers in memory; keeping the integer type would round them
     // away on write (ExtraAttribute has no scale of its own).
@@ -540,6 +550,15 @@ Eigen::Vector3d choose_origin(InputFile& file, const LasHeader& h, std::uint64_t
     Eigen::Vector3d origin;
     for (int k = 0; k < 3; ++k) origin[k] = choose_origin_axis(h.offset[k], lo[k], hi[k]);
     return origin;
+}
+
+// Bytes a PointCloud holds per point of this format: position, intensity, returns and class,
+// GPS time and colour when the format has them, one double per extra-bytes field.
+std::uint64_t cloud_bytes_per_point(const PointFormat& format, const std::vector<ExtraField>& fields) {
+    std::uint64_t bytes = sizeof(Eigen::Vector3f) + sizeof(std::uint16_t) + 3 * sizeof(std::uint8_t);
+    if (format.gps_offset >= 0) bytes += sizeof(double);
+    if (format.rgb_offset >= 0) bytes += 3 * sizeof(std::uint16_t);
+    return bytes + fields.size() * sizeof(double);
 }
 
 // Sizes the attribute vectors the point format has (and only those).
@@ -731,6 +750,8 @@ PointCloud read_las_from(InputFile& file, const CloudReadOptions& options) {
     const LasHeader& header = src.header;
     const PointFormat& format = kFormats[static_cast<std::size_t>(header.point_format)];
     const std::vector<ExtraField> fields = find_extra_fields(file, src.records, format, header.record_length);
+    check_memory_estimate(header.point_count * cloud_bytes_per_point(format, fields), file.name(),
+                          "the header's " + std::to_string(header.point_count) + " points");
 
     PointCloud cloud;
     cloud.source = source_format_of(src);

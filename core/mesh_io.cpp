@@ -14,6 +14,9 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <array>
+#include <cmath>
+#include <fstream>
+#include <string>
 
 namespace fs = std::filesystem;
 
@@ -43,10 +46,25 @@ Eigen::Vector3d origin_for(const PolyMesh& mesh) {
     return mesh_origin_for(Eigen::Vector3d(p[0], p[1], p[2]));
 }
 
+// OpenMesh's PLY reader loops forever on a header that never ends (found by
+// fuzz/mesh_fuzz.cpp), so the header must reach its end_header line within 64 kB.
+void check_ply_header_ends(const fs::path& path, const std::string& name) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    std::size_t read = 0;
+    while (read < 65536 && std::getline(in, line)) {
+        read += line.size() + 1;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line == "end_header") return;
+    }
+    throw Error::input(name, "PLY header has no end_header line");
+}
+
 // PLY, OFF, STL, OM. OpenMesh gives non-manifold faces their own vertex copies and skips
 // faces with a repeated corner or a corner index out of range.
 NamedMesh read_with_openmesh(const fs::path& path) {
     const std::string name = path.string();
+    if (file_extension(path) == "ply") check_ply_header_ends(path, name);
     silence_openmesh();
     PolyMesh mesh;
     OpenMesh::IO::Options options;

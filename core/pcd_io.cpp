@@ -1,6 +1,7 @@
 // PCD through PCL's reader and writer. Fields x y z are required; intensity, rgb/rgba and
 // label map to the standard attributes; every other single-valued field becomes an extra.
 #include "core/atomic_file.hpp"
+#include "core/attribute_value.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
@@ -13,6 +14,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -75,12 +79,35 @@ void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, c
     values.reserve(kept.size());
     for (std::size_t i : kept) values.push_back(field_value(blob, f, i));
     if (f.name == "intensity") {
-        for (double v : values) cloud.intensity.push_back(static_cast<std::uint16_t>(std::clamp(v, 0.0, 65535.0)));
+        for (double v : values) cloud.intensity.push_back(attribute_value<std::uint16_t>(v));
     } else if (f.name == "classification") {
-        for (double v : values) cloud.classification.push_back(static_cast<std::uint8_t>(std::clamp(v, 0.0, 255.0)));
+        for (double v : values) cloud.classification.push_back(attribute_value<std::uint8_t>(v));
     } else {
         cloud.extras.push_back({f.name, attribute_type(f.datatype), "", std::nullopt, std::move(values)});
     }
+}
+
+// PCL's reader dereferences null pointers on headers without their FIELDS, SIZE or TYPE lines
+// (found by fuzz/pcd_fuzz.cpp), so the header is checked first: every required keyword once,
+// FIELDS, SIZE, TYPE (and COUNT) with the same number of entries.
+void check_pcd_header(const fs::path& path, const std::string& name) {
+    std::ifstream in(path, std::ios::binary);
+    std::map<std::string, std::size_t> entries;  // keyword -> values on its line
+    std::string line;
+    for (int lines = 0; lines < 64 && std::getline(in, line); ++lines) {
+        std::istringstream words(line);
+        std::string keyword, value;
+        if (!(words >> keyword) || keyword[0] == '#') continue;
+        std::size_t count = 0;
+        while (words >> value) ++count;
+        entries[keyword] = count;
+        if (keyword == "DATA") break;
+    }
+    for (const char* keyword : {"FIELDS", "SIZE", "TYPE", "WIDTH", "HEIGHT", "POINTS", "DATA"})
+        if (!entries.count(keyword)) throw Error::input(name, std::string("PCD header has no ") + keyword + " line");
+    const std::size_t fields = entries["FIELDS"];
+    if (fields == 0 || entries["SIZE"] != fields || entries["TYPE"] != fields || (entries.count("COUNT") && entries["COUNT"] != fields))
+        throw Error::input(name, "PCD header: FIELDS, SIZE, TYPE and COUNT list different numbers of entries");
 }
 
 }  // namespace
@@ -88,6 +115,10 @@ void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, c
 PointCloud read_pcd(const fs::path& path) {
     const std::string name = path.string();
     pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // errors become our one-line message
+    // PCL's reader dereferences a null pointer on an empty file (found by fuzz/pcd_fuzz.cpp).
+    std::error_code error;
+    if (fs::file_size(path, error) == 0 && !error) throw Error::input(name, "file is empty, expected a PCD header");
+    check_pcd_header(path, name);
     pcl::PCLPointCloud2 blob;
     pcl::PCDReader reader;
     if (reader.read(name, blob) < 0) throw Error::input(name, "cannot read PCD (malformed or truncated file)");

@@ -1,6 +1,7 @@
 // Point clouds as PLY: the `vertex` element with x y z (float or double, any property order)
 // and scalar fields. CloudCompare writes and reads per-point scalar fields as `scalar_<name>`;
 // we read both `scalar_<name>` and bare names and write `scalar_<name>`.
+#include "core/attribute_value.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
@@ -31,7 +32,7 @@ template <typename T>
 std::vector<T> cast_values(const std::vector<double>& values, const std::vector<std::size_t>& kept) {
     std::vector<T> out;
     out.reserve(kept.size());
-    for (std::size_t i : kept) out.push_back(static_cast<T>(std::clamp<double>(values[i], 0.0, 65535.0)));
+    for (std::size_t i : kept) out.push_back(attribute_value<T>(values[i]));
     return out;
 }
 
@@ -60,9 +61,8 @@ void store_property(const ply::Property& p, const std::vector<std::size_t>& kept
 void store_colour(const std::vector<const ply::Property*>& colour, const std::vector<std::size_t>& kept, PointCloud& cloud) {
     if (!colour[0] || !colour[1] || !colour[2]) return;
     for (std::size_t i : kept)
-        cloud.rgb.push_back({static_cast<std::uint16_t>(std::clamp(colour[0]->values[i], 0.0, 65535.0)),
-                             static_cast<std::uint16_t>(std::clamp(colour[1]->values[i], 0.0, 65535.0)),
-                             static_cast<std::uint16_t>(std::clamp(colour[2]->values[i], 0.0, 65535.0))});
+        cloud.rgb.push_back({attribute_value<std::uint16_t>(colour[0]->values[i]), attribute_value<std::uint16_t>(colour[1]->values[i]),
+                             attribute_value<std::uint16_t>(colour[2]->values[i])});
 }
 
 ply::Property scalar(const std::string& name, AttributeType type, std::vector<double> values) {

@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/memory_limit.hpp"
 
 #include <bit>
 #include <charconv>
@@ -209,6 +210,14 @@ std::size_t minimum_item_size(const Element& element, bool ascii) {
     return size;
 }
 
+// Bytes one item of the element takes once read: a double per scalar property, a vector per
+// list (its values come on top, bounded by the file size).
+std::uint64_t held_item_size(const Element& element) {
+    std::uint64_t size = 0;
+    for (const auto& p : element.properties) size += p.is_list ? sizeof(std::vector<double>) : sizeof(double);
+    return size;
+}
+
 template <typename Cursor>
 void read_body(Cursor& cursor, File& file, bool ascii, const std::string& name) {
     for (auto& element : file.elements) {
@@ -217,6 +226,8 @@ void read_body(Cursor& cursor, File& file, bool ascii, const std::string& name) 
             throw Error::input(name, "PLY header declares " + std::to_string(element.count) + " " + element.name +
                                          " items, more than the file can hold");
         if (item == 0 && element.count > 0) throw Error::input(name, "PLY element '" + element.name + "' has no properties");
+        check_memory_estimate(element.count * held_item_size(element), name,
+                              "the header's " + std::to_string(element.count) + " " + element.name + " items");
         for (auto& p : element.properties) {
             if (p.is_list) p.lists.resize(element.count);
             else p.values.resize(element.count);

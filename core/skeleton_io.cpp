@@ -38,9 +38,10 @@ std::vector<std::vector<int>> adjacency_from_edges(const ply::Element& edges, st
 
 }  // namespace
 
-TreeGraph read_skeleton_ply(const fs::path& path) {
+TreeGraph read_skeleton_ply(const fs::path& path, std::vector<std::string>* comments) {
     const std::string name = path.string();
     const ply::File file = ply::read(path);
+    if (comments) *comments = file.comments;
     const ply::Element* vertex = file.find("vertex");
     if (!vertex || vertex->count == 0) throw Error::input(name, "skeleton PLY has no vertices");
     const auto* x = find_any(*vertex, {"x"});
@@ -87,12 +88,13 @@ TreeGraph read_skeleton_ply(const fs::path& path) {
     return tree;
 }
 
-void write_skeleton_ply(const TreeGraph& tree, const fs::path& path, bool binary) {
+void write_skeleton_ply(const TreeGraph& tree, const fs::path& path, bool binary, const std::vector<std::string>& comments) {
     tree.validate(path.string());
     ply::File file;
     file.format = binary ? "binary_little_endian" : "ascii";
     file.comments.push_back("treelobes skeleton: vertex 0 is the root, edges are parent -> child, main child first");
     write_origin_comment(tree.origin, file.comments);
+    file.comments.insert(file.comments.end(), comments.begin(), comments.end());
 
     ply::Element vertex;
     vertex.name = "vertex";

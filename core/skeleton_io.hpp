@@ -9,10 +9,16 @@
 #include "core/tree_graph.hpp"
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 namespace treelobes {
 
-TreeGraph read_skeleton_ply(const std::filesystem::path& path);
-void write_skeleton_ply(const TreeGraph& tree, const std::filesystem::path& path, bool binary = true);
+// `comments` receives the header comments (the origin comment included) when given.
+TreeGraph read_skeleton_ply(const std::filesystem::path& path, std::vector<std::string>* comments = nullptr);
+// `comments` are added to the header after the origin (decode records the chain code's
+// parameters this way, encode/tree_code.hpp code_parameters_comment).
+void write_skeleton_ply(const TreeGraph& tree, const std::filesystem::path& path, bool binary = true,
+                        const std::vector<std::string>& comments = {});
 
 }  // namespace treelobes

@@ -5,6 +5,7 @@
 // "//X,Y,Z,..."; any first line whose first field is not a number counts as a header). Named
 // columns intensity/classification/red/green/blue map to the standard attributes, any other
 // column becomes a float64 extra attribute (without a header: "column_4", "column_5", ...).
+#include "core/attribute_value.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/atomic_file.hpp"
@@ -12,8 +13,8 @@
 
 #include <algorithm>
 #include <charconv>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <optional>
 #include <string_view>
@@ -155,14 +156,13 @@ struct Columns {
 void store_attributes(const Layout& layout, Columns& c, PointCloud& cloud) {
     auto to_u16 = [](const std::vector<double>& v) {
         std::vector<std::uint16_t> out(v.size());
-        for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<std::uint16_t>(std::clamp(v[i], 0.0, 65535.0));
+        for (std::size_t i = 0; i < v.size(); ++i) out[i] = attribute_value<std::uint16_t>(v[i]);
         return out;
     };
     if (!c.intensity.empty()) cloud.intensity = to_u16(c.intensity);
     if (!c.classification.empty()) {
         cloud.classification.resize(c.classification.size());
-        for (std::size_t i = 0; i < c.classification.size(); ++i)
-            cloud.classification[i] = static_cast<std::uint8_t>(std::clamp(c.classification[i], 0.0, 255.0));
+        for (std::size_t i = 0; i < c.classification.size(); ++i) cloud.classification[i] = attribute_value<std::uint8_t>(c.classification[i]);
     }
     if (!c.red.empty() && c.red.size() == c.green.size() && c.red.size() == c.blue.size()) {
         const auto r = to_u16(c.red), g = to_u16(c.green), b = to_u16(c.blue);

@@ -3,6 +3,8 @@
 #include "core/error.hpp"
 
 #include <algorithm>
+#include <sstream>
+#include <charconv>
 #include <cstdint>
 #include <cstdlib>
 
@@ -72,6 +74,25 @@ bool valid_symbols(const std::string& symbols, std::size_t& internodes) {
 }
 
 }  // namespace
+
+// "10,9,5" -> {10, 9, 5}; blanks around values are allowed, an empty text is an empty list.
+std::vector<int> parse_radius_list(const std::string& text, const std::string& context) {
+    std::vector<int> radii;
+    std::stringstream stream(text);
+    std::string item;
+    while (std::getline(stream, item, ',')) {
+        const auto first = item.find_first_not_of(" \t"), last = item.find_last_not_of(" \t");
+        const std::string value = first == std::string::npos ? "" : item.substr(first, last - first + 1);
+        int radius = 0;
+        const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), radius);
+        if (value.empty() || error != std::errc() || end != value.data() + value.size() || radius < 0)
+            throw Error::input(context, "value " + std::to_string(radii.size() + 1) + " ('" + value +
+                                            "') is not a non-negative integer");
+        radii.push_back(radius);
+    }
+    if (!text.empty() && text.back() == ',') throw Error::input(context, "trailing comma after the last radius");
+    return radii;
+}
 
 std::size_t check_symbols(const std::string& symbols, const std::string& context) {
     if (std::size_t internodes = 0; valid_symbols(symbols, internodes)) return internodes;

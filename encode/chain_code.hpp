@@ -70,6 +70,11 @@ std::string write_symbols(const std::vector<Internode>& internodes, CodeKind kin
 // its lateral. Throws Error(InvalidInput) naming `context` and the 1-based character otherwise.
 std::size_t check_symbols(const std::string& symbols, const std::string& context);
 
+// A radius list as text, "10,9,5" -> {10, 9, 5} (blanks around values allowed, empty text: no
+// radii). Throws Error(InvalidInput) naming `context` and the value that is not a
+// non-negative integer.
+std::vector<int> parse_radius_list(const std::string& text, const std::string& context);
+
 // Parses a checked code and its radii back into internodes with absolute moves. Throws
 // Error(InvalidInput) for any defect of check_symbols, a radius list whose length differs from
 // the internode count, negative radii, or moves beyond kMaxVoxelCoordinate.

@@ -3,9 +3,12 @@
 #include "core/error.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <numeric>
+#include <sstream>
 
 namespace treelobes::encode {
 
@@ -77,6 +80,48 @@ std::vector<std::vector<int>> coding_order(const TreeGraph& tree, const std::vec
         order[node] = std::move(children);
     }
     return order;
+}
+
+// Nodes whose internode the decoder would read as a multi-way fork code (contracted_internodes):
+// the first vertex of a branch (a child of the root, or a lateral in coding order) that lies
+// in its parent's voxel and is not a tip.
+std::vector<bool> nodes_read_as_forks(const TreeGraph& tree, const std::vector<Voxel>& voxels,
+                                      const std::vector<std::vector<int>>& order) {
+    std::vector<bool> read_as_fork(tree.size(), false);
+    for (std::size_t node = 0; node < tree.size(); ++node)
+        for (int child : order[node]) {
+            const bool branch_start = node == 0 || child != order[node][0];
+            read_as_fork[child] = branch_start && voxels[child] == voxels[node] && !tree.nodes[child].children.empty();
+        }
+    return read_as_fork;
+}
+
+// The tree without the `dropped` nodes, their children attached to the nearest kept ancestor.
+// Kept nodes keep their relative order (coding_order breaks ties by index); `source` (node ->
+// input node) is updated alike.
+TreeGraph without_nodes(const TreeGraph& tree, const std::vector<bool>& dropped, std::vector<int>& source) {
+    std::vector<int> index(tree.size(), -1);
+    std::vector<int> kept_source;
+    for (std::size_t i = 0; i < tree.size(); ++i)
+        if (!dropped[i]) {
+            index[i] = static_cast<int>(kept_source.size());
+            kept_source.push_back(source[i]);
+        }
+    TreeGraph out;
+    out.origin = tree.origin;
+    out.nodes.resize(kept_source.size());
+    for (std::size_t i = 0; i < tree.size(); ++i) {
+        if (dropped[i]) continue;
+        TreeNode& node = out.nodes[static_cast<std::size_t>(index[i])];
+        node.position = tree.nodes[i].position;
+        node.radius = tree.nodes[i].radius;
+        int parent = tree.nodes[i].parent;
+        while (parent >= 0 && dropped[static_cast<std::size_t>(parent)]) parent = tree.nodes[static_cast<std::size_t>(parent)].parent;
+        node.parent = parent < 0 ? -1 : index[static_cast<std::size_t>(parent)];
+        if (node.parent >= 0) out.nodes[static_cast<std::size_t>(node.parent)].children.push_back(index[i]);
+    }
+    source = std::move(kept_source);
+    return out;
 }
 
 // Pseudocode 1 with the multi-way fork rule: builds the internode stream of one tree.
@@ -248,6 +293,40 @@ int quantize_radius(float radius, double radius_unit) {
     return static_cast<int>(std::round(static_cast<double>(radius) / radius_unit));
 }
 
+namespace {
+
+constexpr std::string_view kCodeComment = "treelobes_code";
+
+// Shortest decimal that reads back as the same double.
+std::string exact_decimal(double value) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+    return {text, end};
+}
+
+}  // namespace
+
+std::string code_parameters_comment(const CodeParameters& p) {
+    return std::string(kCodeComment) + " resolution " + exact_decimal(p.resolution) + " internode_length " +
+           exact_decimal(p.internode_length) + " radius_unit " + exact_decimal(p.radius_unit);
+}
+
+std::optional<CodeParameters> find_code_parameters(const std::vector<std::string>& comments, const std::string& context) {
+    for (const std::string& comment : comments) {
+        std::istringstream words(comment);
+        std::string keyword, r, l, u;
+        CodeParameters p;
+        if (!(words >> keyword) || keyword != kCodeComment) continue;
+        if (!(words >> r >> p.resolution >> l >> p.internode_length >> u >> p.radius_unit) || r != "resolution" ||
+            l != "internode_length" || u != "radius_unit" || !(std::isfinite(p.resolution) && p.resolution > 0) ||
+            !(std::isfinite(p.internode_length) && p.internode_length > 0) || !(std::isfinite(p.radius_unit) && p.radius_unit > 0))
+            throw Error::input(context, "malformed header comment '" + comment +
+                                            "', expected 'treelobes_code resolution R internode_length L radius_unit U'");
+        return p;
+    }
+    return std::nullopt;
+}
+
 double median_internode_length(const TreeGraph& tree, const std::string& context) {
     std::vector<float> lengths;
     for (std::size_t i = 1; i < tree.size(); ++i)
@@ -274,13 +353,31 @@ EncodedTree encode_tree(const TreeGraph& tree, const EncodeOptions& options, con
     encoded.geometry.root_position = tree.nodes[0].position;
     encoded.geometry.origin = tree.origin;
 
-    const std::vector<Voxel> voxels = voxelize_tree(tree, encoded.geometry.voxel_size, context);
-    const std::vector<int> radii = quantize_radii(tree, options.radius_unit, context);
+    // A vertex that a decoder would merge into its parent (its internode reads as a fork code) is
+    // merged before coding, repeatedly (the merge can put the next vertex of the branch in the
+    // same place): the code then decodes to exactly the tree it codes, and encoding the decoded
+    // tree gives the same code again.
+    TreeGraph coded = tree;
+    std::vector<int> input_node(tree.size());
+    std::iota(input_node.begin(), input_node.end(), 0);
+    std::vector<Voxel> voxels;
+    std::vector<int> radii;
+    std::vector<std::vector<int>> order;
+    for (;;) {
+        voxels = voxelize_tree(coded, encoded.geometry.voxel_size, context);
+        radii = quantize_radii(coded, options.radius_unit, context);
+        order = coding_order(coded, voxels, radii);
+        const std::vector<bool> merged = nodes_read_as_forks(coded, voxels, order);
+        if (std::find(merged.begin(), merged.end(), true) == merged.end()) break;
+        coded = without_nodes(coded, merged, input_node);
+    }
     encoded.geometry.root_radius = radii[0];
 
     std::vector<int> sources;
-    encoded.internodes = StreamBuilder(tree, voxels, radii, coding_order(tree, voxels, radii)).build(sources);
+    encoded.internodes = StreamBuilder(coded, voxels, radii, std::move(order)).build(sources);
     encoded.decoded_to_source = decoded_sources(encoded.internodes, sources);
+    for (int& node : encoded.decoded_to_source)
+        if (node >= 0) node = input_node[static_cast<std::size_t>(node)];
     encoded.code.kind = options.kind;
     encoded.code.symbols = write_symbols(encoded.internodes, options.kind);
     encoded.code.radii.reserve(encoded.internodes.size());

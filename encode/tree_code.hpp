@@ -12,12 +12,16 @@
 // encoding again reproduces the code exactly. Multi-way forks with k laterals: when the first
 // lateral starts, one zero-length internode per remaining sibling is emitted (empty move, 6,
 // carrying the first lateral's radius) and the sibling is queued. A root with several children
-// starts with one such zero-length internode carrying the trunk's radius.
+// starts with one such zero-length internode carrying the trunk's radius. A branch's first
+// vertex that falls into its parent's voxel and is not a tip is merged into the parent before
+// coding (its zero-length internode would read as such a fork code), so every code decodes to
+// exactly the tree it codes and encode -> decode -> encode is the identity on codes.
 #pragma once
 
 #include "core/tree_graph.hpp"
 #include "encode/chain_code.hpp"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +69,20 @@ TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const
 // every value; errors name internodes instead of characters).
 TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& geometry,
                             const std::string& context = "chain code");
+
+// The parameters a decoded skeleton records in its PLY header (comment "treelobes_code
+// resolution R internode_length L radius_unit U", shortest decimals that read back exactly), so
+// that `encode` can use them when no option overrides them: encode -> decode -> encode with
+// the same options then reproduces the code byte for byte.
+struct CodeParameters {
+    double resolution = 0.0;
+    double internode_length = 0.0;
+    double radius_unit = 0.0;
+};
+std::string code_parameters_comment(const CodeParameters& parameters);
+// The parameters of the first such comment; none when there is none. Throws Error(InvalidInput)
+// naming `context` for a comment whose values are not positive finite numbers.
+std::optional<CodeParameters> find_code_parameters(const std::vector<std::string>& comments, const std::string& context);
 
 // Median length of the non-zero edges: the internode length l of a resampled skeleton.
 // Throws Error(InvalidInput) when the tree has no edge of positive length.

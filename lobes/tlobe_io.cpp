@@ -18,6 +18,9 @@ namespace {
 constexpr std::array<char, 4> kMagic{'T', 'L', 'O', 'B'};
 constexpr std::size_t kHeaderSize = 20;
 constexpr std::size_t kMaxPayload = std::size_t{1} << 30;  // 1 GiB: anything larger is not a .tlobe
+// Deflate cannot expand data by more than about 1032:1 (zlib's technical details), so a
+// header claiming more is refused before the payload buffer is allocated.
+constexpr std::uint64_t kMaxInflateRatio = 1032;
 
 void put_u32(std::string& s, std::size_t at, std::uint32_t v) {
     for (int i = 0; i < 4; ++i) s[at + i] = static_cast<char>(v >> (8 * i));
@@ -172,14 +175,19 @@ LobeTree decode_tlobe(std::string_view file, const std::string& name) {
     const std::uint32_t raw_size = get_u32(file, 8), packed_size = get_u32(file, 12);
     if (packed_size != file.size() - kHeaderSize) throw Error::input(name, "truncated .tlobe file (payload size mismatch)");
     if (get_u32(file, 16) != file_crc(file)) throw Error::input(name, "corrupt .tlobe file (CRC-32 mismatch)");
-    if (raw_size > kMaxPayload) throw Error::input(name, "implausible .tlobe payload size");
+    if (raw_size > kMaxPayload || raw_size > kMaxInflateRatio * packed_size + 64)
+        throw Error::input(name, "implausible .tlobe payload size (" + std::to_string(raw_size) + " bytes claimed from " +
+                                     std::to_string(packed_size) + " compressed bytes)");
     std::string raw(raw_size, '\0');
     uLongf unpacked = raw_size;
     if (uncompress(reinterpret_cast<Bytef*>(raw.data()), &unpacked, reinterpret_cast<const Bytef*>(file.data() + kHeaderSize),
                    packed_size) != Z_OK ||
         unpacked != raw_size)
         throw Error::input(name, "corrupt .tlobe payload (inflate failed)");
+    return decode_tlobe_payload(raw, name);
+}
 
+LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name) {
     ByteReader in(raw, name);
     LobeTree tree;
     Eigen::Vector3d origin;

@@ -37,6 +37,9 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {})
 // Parses a file's bytes; any inconsistency throws Error(InvalidInput) naming `name`.
 // Decoded lobes have origin 0 (the tree's frame), the skeleton the stored origin.
 LobeTree decode_tlobe(std::string_view bytes, const std::string& name);
+// The inflated payload behind the header, size and CRC checks (what decode_tlobe parses once
+// they pass; fuzz/ feeds it directly so that mutations reach the parser). Same errors.
+LobeTree decode_tlobe_payload(std::string_view payload, const std::string& name);
 
 void write_tlobe(const LobeTree& tree, const std::filesystem::path& path, const TlobeOptions& options = {});
 LobeTree read_tlobe(const std::filesystem::path& path);

@@ -2,6 +2,8 @@
 # Installs the Debian packages treelobes needs (only those missing), configures and builds.
 # Idempotent: a second run installs nothing and rebuilds only what changed.
 # Usage: scripts/setup.sh            (build dir: ./build, binary: build/bin/treelobes)
+#        scripts/setup.sh --hardening-tools   only the compilers and runtimes of the sanitizer
+#                                             and fuzz builds (scripts/sanitize.sh, scripts/fuzz.sh)
 # Also installs the npm validators of the export tests under tools/validators (npm ci).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,20 +16,32 @@ PACKAGES=(
   libbz2-dev liblzma-dev libzstd-dev libbrotli-dev
 )
 
-missing=()
-for package in "${PACKAGES[@]}"; do
-  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  echo "setup: installing ${missing[*]}" >&2
-  SUDO=""
-  [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# clang with its sanitizer runtimes and libFuzzer: only the hardening builds use them.
+HARDENING_PACKAGES=(clang libclang-rt-14-dev libfuzzer-14-dev)
+
+install_missing() {
+  local missing=()
+  for package in "$@"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+  done
+  if [ ${#missing[@]} -gt 0 ]; then
+    echo "setup: installing ${missing[*]}" >&2
+    local sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+  fi
+}
+
+if [ "${1:-}" = "--hardening-tools" ]; then
+  install_missing "${HARDENING_PACKAGES[@]}"
+  exit 0
 fi
+install_missing "${PACKAGES[@]}"
 
 # The official validators the export tests run (Khronos glTF-Validator, ajv for the CityJSON
 # schemas): npm packages pinned by tools/validators/package-lock.json, installed in that folder.
+command -v npm >/dev/null 2>&1 || install_missing nodejs npm
 if command -v npm >/dev/null 2>&1; then
   if [ ! -f tools/validators/node_modules/.package-lock.json ] ||
      [ tools/validators/package-lock.json -nt tools/validators/node_modules/.package-lock.json ]; then

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
@@ -194,4 +195,41 @@ TEST(PcdIo, RoundTripWithIntensityAndExtras) {
     write_text(dir / "bad.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
                                 "WIDTH 100\nHEIGHT 1\nPOINTS 100\nDATA binary\nabc");
     EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "bad.pcd"); }), ExitCode::InvalidInput);
+}
+
+// Fuzzing found these (UBSan: a NaN or out-of-range double cast to an integer attribute;
+// ASan: PCL's reader crashing on an empty file). Attributes clamp, NaN is "no value" (0).
+TEST(PlyCloud, NanAndOutOfRangeIntegerAttributesClamp) {
+    TempDir dir;
+    write_text(dir / "a.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                              "property float z\nproperty float intensity\nproperty float classification\n"
+                              "property float red\nproperty float green\nproperty float blue\nend_header\n"
+                              "0 0 0 nan 300 -5 nan 70000\n1 1 1 12.7 2 1 2 3\n");
+    const PointCloud cloud = read_ply_cloud(dir / "a.ply");
+    ASSERT_EQ(cloud.size(), 2u);
+    EXPECT_EQ(cloud.intensity, (std::vector<std::uint16_t>{0, 12}));
+    EXPECT_EQ(cloud.classification, (std::vector<std::uint8_t>{255, 2}));
+    ASSERT_EQ(cloud.rgb.size(), 2u);
+    EXPECT_EQ(cloud.rgb[0], (std::array<std::uint16_t, 3>{0, 0, 65535}));
+}
+
+TEST(Pcd, EmptyFileIsBadInputNotACrash) {
+    TempDir dir;
+    write_text(dir / "empty.pcd", "");
+    EXPECT_EQ(error_code_of([&] { read_pcd(dir / "empty.pcd"); }), ExitCode::InvalidInput);
+}
+
+// Fuzzing found both: PCL's PCD reader crashed on a header without its FIELDS line, OpenMesh's
+// PLY reader never returned on a header without end_header.
+TEST(Pcd, HeaderWithoutFieldsIsBadInputNotACrash) {
+    TempDir dir;
+    write_text(dir / "nofields.pcd", "# .PCD v0.7\nVERSION 0.7\nFIEL S x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                                     "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    EXPECT_EQ(error_code_of([&] { read_pcd(dir / "nofields.pcd"); }), ExitCode::InvalidInput);
+}
+
+TEST(MeshRead, PlyHeaderWithoutEndIsBadInputNotAHang) {
+    TempDir dir;
+    write_text(dir / "open.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n0 0 0\n");
+    EXPECT_EQ(error_code_of([&] { read_mesh(dir / "open.ply"); }), ExitCode::InvalidInput);
 }

@@ -4,7 +4,10 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 using namespace treelobes;
 using treelobes::test::TempDir;
@@ -120,4 +123,20 @@ TEST(CloudIo, DamagedLazAndUnknownFormatsAreRejectedClearly) {
     EXPECT_NE(message.find("shorter than the 227-byte LAS header"), std::string::npos) << message;
     write_text(dir / "a.foo", "hello");
     EXPECT_EQ(read_error_code(dir / "a.foo"), ExitCode::InvalidInput);
+}
+
+// Fuzzing found it (UBSan: nan outside the range of unsigned short): a NaN attribute value is
+// "no value" and becomes 0; out-of-range values clamp.
+TEST(TextCloud, NanAndOutOfRangeAttributesBecomeValidIntegers) {
+    TempDir dir;
+    write_text(dir / "a.xyz", "x y z intensity classification red green blue\n"
+                              "1 2 3 nan nan nan nan nan\n"
+                              "4 5 6 70000 -3 1e300 -1e300 12\n");
+    const PointCloud cloud = read_text_cloud(dir / "a.xyz");
+    ASSERT_EQ(cloud.size(), 2u);
+    EXPECT_EQ(cloud.intensity, (std::vector<std::uint16_t>{0, 65535}));
+    EXPECT_EQ(cloud.classification, (std::vector<std::uint8_t>{0, 0}));
+    ASSERT_EQ(cloud.rgb.size(), 2u);
+    EXPECT_EQ(cloud.rgb[0], (std::array<std::uint16_t, 3>{0, 0, 0}));
+    EXPECT_EQ(cloud.rgb[1], (std::array<std::uint16_t, 3>{65535, 0, 12}));
 }

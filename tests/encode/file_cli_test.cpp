@@ -159,3 +159,27 @@ TEST(FileCli, BadOptionsExitWithOne) {
     EXPECT_EQ(run_cli("decode " + quoted(dir / "t.dbf6") + " --tree 0 --out " + quoted(dir / "x.ply")).exit_code, 1);
     EXPECT_EQ(run_cli("decode " + quoted(dir / "t.dbf6")).exit_code, 1);  // --out is required
 }
+
+// encode -> decode -> encode with the same options gives the same file: the decoded PLY records
+// r, l and the radius unit, and encode takes them when no option overrides them (so even
+// without --resolution).
+TEST(FileCli, EncodeDecodeEncodeReproducesTheFile) {
+    const std::filesystem::path data = treelobes::test::source_dir() / "data/synthetic";
+    for (const std::string skeleton : {"birch_3_skeleton.ply", "lagerstroemia_2_skeleton.ply", "palm_1_skeleton.ply",
+                                       "tile/skeletons/tree_1.ply", "tile/skeletons/tree_4.ply"}) {
+        SCOPED_TRACE(skeleton);
+        TempDir dir;
+        const std::string options = " --resolution 4 --lods 2";
+        ASSERT_EQ(run_cli("encode " + quoted(data / skeleton) + options + " --out " + quoted(dir / "a.dbf6")).exit_code, 0);
+        ASSERT_EQ(run_cli("decode " + quoted(dir / "a.dbf6") + " --out " + quoted(dir / "a.ply")).exit_code, 0);
+        ASSERT_EQ(run_cli("encode " + quoted(dir / "a.ply") + options + " --out " + quoted(dir / "b.dbf6")).exit_code, 0);
+        EXPECT_TRUE(read_bytes(dir / "a.dbf6") == read_bytes(dir / "b.dbf6"));
+        ASSERT_EQ(run_cli("encode " + quoted(dir / "a.ply") + " --lods 2 --out " + quoted(dir / "c.dbf6")).exit_code, 0);
+        EXPECT_TRUE(read_bytes(dir / "a.dbf6") == read_bytes(dir / "c.dbf6"));
+    }
+    // A skeleton that records nothing still needs --resolution (one line, exit 1).
+    TempDir dir;
+    const auto r = run_cli("encode " + quoted(data / "palm_1_skeleton.ply") + " --out " + quoted(dir / "x.dbf6"));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.err.find("--resolution is required"), std::string::npos) << r.err;
+}

@@ -1,0 +1,9 @@
+// PCD clouds (ascii and binary; core/pcd_io.cpp over PCL's reader).
+#include "core/cloud_io.hpp"
+#include "fuzz_support.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    const auto path = treelobes::fuzz::input_file(treelobes::fuzz::as_text(data, size), "pcd");
+    treelobes::fuzz::expect_only_input_errors([&] { treelobes::read_pcd(path); });
+    return 0;
+}
