@@ -96,7 +96,9 @@ TEST(ClassifyCrown, SixPointCrownStillHasHeightWidthAndIntensity) {
     int missing_shape = 0;
     for (std::size_t f = 0; f < v.size(); ++f) {
         if (catalogue[f].group != "airborne" && catalogue[f].group != "scan") missing_shape += std::isnan(v[f]);
-        if (catalogue[f].group == "scan") EXPECT_TRUE(std::isfinite(v[f]));
+        if (catalogue[f].group == "scan") {
+            EXPECT_TRUE(std::isfinite(v[f]));
+        }
     }
     EXPECT_EQ(missing_shape, static_cast<int>(std::count_if(catalogue.begin(), catalogue.end(), [](const FeatureInfo& f) {
                   return f.group != "airborne" && f.group != "scan";

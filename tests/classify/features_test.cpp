@@ -232,8 +232,11 @@ TEST(ClassifyFeatures, DeterministicAndSkeletonGroupCanBeSkipped) {
     ASSERT_EQ(without.size(), catalogue.size());
     int skeleton_nonzero = 0;
     for (std::size_t f = 0; f < catalogue.size(); ++f) {
-        if (catalogue[f].group == "skeleton") EXPECT_EQ(without[f], 0.0) << catalogue[f].name;
-        else EXPECT_TRUE(same_vector({without[f]}, {species_vectors()[2][f]})) << catalogue[f].name;
+        if (catalogue[f].group == "skeleton") {
+            EXPECT_EQ(without[f], 0.0) << catalogue[f].name;
+        } else {
+            EXPECT_TRUE(same_vector({without[f]}, {species_vectors()[2][f]})) << catalogue[f].name;
+        }
         skeleton_nonzero += catalogue[f].group == "skeleton" && species_vectors()[2][f] != 0.0;
     }
     // The pine (branches in whorls) fills the skeleton group; the palm's skeleton is a bare trunk.
@@ -255,7 +258,9 @@ TEST(ClassifyFeatures, PlausibleValuesForAKnownTree) {
     EXPECT_NEAR(zhist, 1.0, 1e-9);
     const auto& catalogue = feature_catalogue();
     for (std::size_t f = 0; f < v.size(); ++f)
-        if (catalogue[f].group != "airborne") EXPECT_TRUE(std::isfinite(v[f])) << catalogue[f].name;
+        if (catalogue[f].group != "airborne") {
+            EXPECT_TRUE(std::isfinite(v[f])) << catalogue[f].name;
+        }
 }
 
 TEST(ClassifyFeatures, RejectsCloudsThatAreNotTrees) {
