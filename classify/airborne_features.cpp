@@ -1,6 +1,5 @@
-// Airborne group: what an airborne laser scanner sees of a crown at a few points per m^2 (Lim et
-// al. 2003 and the ALS species literature use the same families): the height above the lowest
-// ground return and the crown's width, the share of points per height layer (density profile),
+// Airborne group: what an airborne laser scanner sees of a crown at a few points per m^2: the
+// height above the lowest ground return and the crown's width, the share of points per height layer (density profile),
 // intensity (normalised within the clip: against the ground returns of the same clip, which share
 // the flight, the range and the gain, and against the crown's own median), returns (single, first
 // and last returns per height layer: how far the pulses get into the crown), the crown-top

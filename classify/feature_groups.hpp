@@ -91,7 +91,8 @@ void compute_scan(std::size_t input_points, float crown_radius, FeatureSink& out
 // The airborne group reads the crown with its attributes (intensity, returns, colours) and the
 // clip's ground returns: computed for every tree, however few points it has.
 struct AirborneInput {
-    const PointCloud* crown = nullptr;
+    const PointCloud* crown = nullptr;      // the crown, or `thinned` (see airborne_input in features.cpp)
+    std::shared_ptr<const PointCloud> thinned;
     std::optional<float> ground_z;          // lowest ground return, when the clip has ground returns
     std::size_t ground_returns = 0;
     double ground_intensity = 0;            // median intensity of the ground returns (0: none)

@@ -243,6 +243,16 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
 detail::AirborneInput airborne_input(const PointCloud& clip, const CrownExtraction& extraction) {
     detail::AirborneInput in;
     in.crown = &extraction.crown;
+    // Airborne crowns have hundreds to thousands of points; a dense terrestrial scan is thinned
+    // evenly for this group (its shares, quantiles and raster tops do not need more points).
+    constexpr std::size_t kAirbornePoints = 20000;
+    if (extraction.crown.size() > kAirbornePoints) {
+        std::vector<std::size_t> every;
+        const double step = static_cast<double>(extraction.crown.size()) / kAirbornePoints;
+        for (std::size_t i = 0; i < kAirbornePoints; ++i) every.push_back(static_cast<std::size_t>(i * step));
+        in.thinned = std::make_shared<const PointCloud>(extraction.crown.subset(every));
+        in.crown = in.thinned.get();
+    }
     in.ground_z = extraction.ground_z;
     in.ground_returns = extraction.counts.ground;
     if (clip.intensity.size() == clip.size() && clip.classification.size() == clip.size()) {
