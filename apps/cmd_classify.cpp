@@ -80,6 +80,15 @@ std::vector<BatchInput> batch_inputs(const std::vector<std::string>& files, cons
     return inputs;
 }
 
+// "removed before the features: ..." from crown_counts_json.
+std::string removed_line(const json& removed) {
+    return "  removed before the features: " + std::to_string(removed["ground"].get<long>()) + " ground, " +
+           std::to_string(removed["understorey"].get<long>()) + " understorey, " + std::to_string(removed["high_outliers"].get<long>()) +
+           " high outliers, " + std::to_string(removed["noise"].get<long>()) + " noise points of " +
+           std::to_string(removed["points"].get<long>()) + "; " + std::to_string(removed["trees_without_shape_features"].get<long>()) +
+           " trees too small for the shape groups (those features missing)\n";
+}
+
 // ---------------------------------------------------------------- features
 struct FeaturesCommand {
     std::vector<std::string> inputs;
@@ -102,11 +111,12 @@ int run_features(const FeaturesCommand& c, const GlobalOptions& global) {
                           {"features", batch.table.cols()},  {"failed", batch.failures.size()}, {"points", batch.points},
                           {"seconds", batch.seconds},        {"feature_seconds_per_tree", batch.feature_seconds / batch.table.rows()},
                           {"cpu_seconds_per_tree", batch.cpu_seconds / batch.table.rows()},
+                          {"removed", json::parse(crown_counts_json(batch.crowns))},
                           {"out", c.out}};
     print(summary, global,
           std::to_string(batch.table.rows()) + " trees x " + std::to_string(batch.table.cols()) + " features -> " + c.out +
               (batch.failures.empty() ? "" : " (" + std::to_string(batch.failures.size()) + " failed, see failures.jsonl)") +
-              format(" (%.1f s)\n", batch.seconds));
+              format(" (%.1f s)\n", batch.seconds) + removed_line(summary["removed"]));
     return batch.failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
 }
 
@@ -238,6 +248,10 @@ int run_predict(const PredictCommand& c, const GlobalOptions& global) {
 // ---------------------------------------------------------------- evaluate
 struct EvaluateCommand {
     std::vector<std::string> datasets;
+    std::string train_dataset, test_dataset;  // --train / --test: one experiment instead of random splits
+    bool no_class_weights = false;
+    std::string level = "species";            // or "genus": train and test on genus labels
+    std::vector<std::string> groups;          // feature groups the classifiers see (empty: all)
     std::string out;
     std::string features;       // reuse a feature table instead of computing it
     bool no_xgboost = false;
@@ -282,6 +296,23 @@ void discover(const fs::path& dir, const std::string& prefix, std::vector<BatchI
     }
 }
 
+// The columns of `table` whose catalogue group is one of `groups` (docs/features.md); the scan
+// descriptor stays (it routes, it is not a tree feature).
+FeatureTable only_groups(const FeatureTable& table, const std::vector<std::string>& groups, const std::string& context) {
+    std::map<std::string, std::string> group_of;
+    std::set<std::string> known;
+    for (const auto& info : feature_catalogue()) group_of[info.name] = info.group, known.insert(info.group);
+    for (const auto& g : groups)
+        if (!known.count(g)) throw Error::usage("--groups: no feature group '" + g + "' (see docs/features.md)");
+    std::vector<std::string> names;
+    for (const auto& name : table.feature_names) {
+        const auto it = group_of.find(name);
+        if (is_scan_descriptor(name) || (it != group_of.end() && std::count(groups.begin(), groups.end(), it->second)))
+            names.push_back(name);
+    }
+    return table.select_columns(names, context);
+}
+
 NamedClassifier jointboost_classifier(const JointBoostOptions& base) {
     return {"JointBoost", [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test,
                                  std::uint64_t seed) {
@@ -316,20 +347,34 @@ NamedClassifier xgboost_classifier(const XGBoostOptions& base) {
 }
 
 int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
+    const bool transfer = !c.train_dataset.empty() || !c.test_dataset.empty();
+    if (transfer && (c.train_dataset.empty() || c.test_dataset.empty() || !c.datasets.empty()))
+        throw Error::usage("classify evaluate: give DATASET... (random splits) or both --train DATASET and --test DATASET");
+    if (!transfer && c.datasets.empty()) throw Error::usage("classify evaluate: give DATASET... or --train DATASET --test DATASET");
+    if (transfer && !c.features.empty()) throw Error::usage("classify evaluate: --features cannot be used with --train/--test");
+    std::vector<std::string> datasets = c.datasets;
+    if (transfer) datasets = {c.train_dataset, c.test_dataset};
     std::vector<BatchInput> inputs;
     std::vector<TreeLabel> labels;
-    for (const auto& d : c.datasets)
-        discover(d, c.datasets.size() > 1 ? fs::path(d).lexically_normal().filename().string() + "/" : "", inputs, labels);
+    // Ids carry the dataset folder's name when there are several folders (train/ and test/ with --train/--test).
+    for (std::size_t k = 0; k < datasets.size(); ++k) {
+        std::string prefix;
+        if (transfer) prefix = k == 0 ? "train/" : "test/";
+        else if (datasets.size() > 1) prefix = fs::path(datasets[k]).lexically_normal().filename().string() + "/";
+        discover(datasets[k], prefix, inputs, labels);
+    }
     // Dataset folders that are not tiles have no site groups of their own.
     FeatureTable table;
     std::vector<BatchFailure> failures;
-    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion}, {"datasets", c.datasets}, {"baseline", xgboost_version()}};
+    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion}, {"datasets", datasets}, {"baseline", xgboost_version()},
+                  {"class_weights", c.no_class_weights ? "none" : "balanced"}};
     if (!c.features.empty()) {
         table = read_feature_csv(c.features);
         extra["features_file"] = c.features;
     } else {
         FeatureBatch batch = compute_feature_batch(inputs, c.flags.options());
-        if (batch.table.rows() == 0) throw Error::input(c.datasets.front(), "no tree gave features");
+        if (batch.table.rows() == 0) throw Error::input(datasets.front(), "no tree gave features");
+        const std::string crowns = crown_counts_csv(batch);
         table = std::move(batch.table);
         failures = std::move(batch.failures);
         fs::create_directories(c.out);
@@ -338,6 +383,20 @@ int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
         extra["feature_seconds_total"] = batch.seconds;
         extra["feature_cpu_seconds_per_tree"] = batch.cpu_seconds / static_cast<double>(table.rows());
         extra["points"] = batch.points;
+        extra["removed"] = json::parse(crown_counts_json(batch.crowns));
+        write_file_atomically(fs::path(c.out) / "crowns.csv", crowns);
+    }
+    if (c.level == "genus")
+        for (auto& l : labels) {
+            if (l.scientific_name.empty())
+                throw Error::input(datasets.front(), "--level genus needs a scientific_name (or genus) column in labels.csv; tree '" +
+                                                         l.id + "' has none");
+            l.species = genus_of(l.scientific_name);
+        }
+    extra["level"] = c.level;
+    if (!c.groups.empty()) {
+        table = only_groups(table, c.groups, datasets.front());
+        extra["feature_groups"] = c.groups;
     }
     // Only labelled trees that gave features take part.
     std::set<std::string> have(table.ids.begin(), table.ids.end());
@@ -350,23 +409,42 @@ int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
     for (std::size_t r = 0; r < table.rows(); ++r)
         if (labelled.count(table.ids[r])) rows.push_back(r);
     table = table.select_rows(rows);
-    LabelledSet set = make_labelled_set(table, used, c.datasets.front());
+    LabelledSet set = make_labelled_set(table, used, datasets.front());
     if (!c.layout.empty()) {
         set.positions = planting_layout(set.labels, static_cast<int>(set.classes.size()), c.layout == "grouped", c.spacing, c.options.seed);
         extra["layout"] = {{"planting", c.layout}, {"spacing_m", c.spacing}};
     }
 
-    std::vector<NamedClassifier> classifiers = {jointboost_classifier(c.jointboost)};
-    if (!c.no_xgboost) classifiers.push_back(xgboost_classifier(c.xgboost));
+    JointBoostOptions jointboost = c.jointboost;
+    XGBoostOptions xgboost = c.xgboost;
+    jointboost.balance_classes = xgboost.balance_classes = !c.no_class_weights;
+    std::vector<NamedClassifier> classifiers = {jointboost_classifier(jointboost)};
+    if (!c.no_xgboost) classifiers.push_back(xgboost_classifier(xgboost));
     EvaluationOptions options = c.options;
     options.site_split = !c.no_site_split;
-    const EvaluationReport report = evaluate(set, classifiers, options);
+    EvaluationReport report;
+    if (transfer) {
+        std::vector<std::size_t> train_rows, test_rows;
+        for (std::size_t r = 0; r < set.features.rows(); ++r)
+            (set.features.ids[r].rfind("train/", 0) == 0 ? train_rows : test_rows).push_back(r);
+        report = evaluate_train_test(set, classifiers, train_rows, test_rows, options);
+        std::set<std::string> trained, untrained;
+        for (auto r : train_rows) trained.insert(set.classes[set.labels[r]]);
+        for (auto r : test_rows)
+            if (!trained.count(set.classes[set.labels[r]])) untrained.insert(set.classes[set.labels[r]]);
+        extra["test_species_not_trained"] = untrained;
+        if (!untrained.empty()) log_warn("species of the test set that the training set lacks (always wrong): " + std::to_string(untrained.size()));
+    } else {
+        report = evaluate(set, classifiers, options);
+    }
     extra["trees"] = set.labels.size();
     extra["failed"] = failures.size();
     write_report(report, options, c.out, extra.dump());
     if (!failures.empty()) write_failures(failures, fs::path(c.out) / "features.csv");
     json summary = json::parse(read_file(fs::path(c.out) / "summary.json"));
-    print(summary, global, report_summary(report) + "\nreport -> " + c.out + "\n");
+    print(summary, global,
+          report_summary(report) + (extra.contains("removed") ? "\n" + removed_line(extra["removed"]) : std::string()) + "\nreport -> " +
+              c.out + "\n");
     return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
 }
 
@@ -402,6 +480,8 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
                 "Boost the final model again on all training trees instead of averaging the cross-validation runs");
     t->add_flag("--average-scores{false}", train->options.average_probabilities,
                 "The fold ensemble averages its members' scores H instead of their probabilities");
+    t->add_flag("--no-class-weights{false}", train->options.balance_classes,
+                "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
     t->callback([train, &global, &job] { job = [train, &global] { return run_train(*train, global); }; });
 
     auto predict = std::make_shared<PredictCommand>();
@@ -419,7 +499,21 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
 
     auto evaluate = std::make_shared<EvaluateCommand>();
     CLI::App* e = classify->add_subcommand("evaluate", "The paper's protocol (50/50 splits), site split, voting, XGBoost baseline");
-    e->add_option("datasets", evaluate->datasets, "`synth dataset` folders (labels.csv) or folders of `synth tile` outputs")->required();
+    e->add_option("datasets", evaluate->datasets, "`synth dataset` folders (labels.csv) or folders of `synth tile` outputs");
+    e->add_option("--train", evaluate->train_dataset, "Train on this dataset folder (with --test: one experiment, no random splits)");
+    e->add_option("--test", evaluate->test_dataset, "Test on this dataset folder (with --train)");
+    e->add_option("--groups", evaluate->groups,
+                  "Feature groups the classifiers see (default all; e.g. --groups airborne for sparse airborne crowns)")
+        ->delimiter(',');
+    e->add_option("--train-fraction", evaluate->options.train_fraction, "Share of each species that trains in a random split")
+        ->check(CLI::Range(0.05, 0.95))
+        ->capture_default_str();
+    e->add_option("--level", evaluate->level,
+                  "Classes to train and test: species, or genus (the first word of labels.csv's scientific_name)")
+        ->check(CLI::IsMember({"species", "genus"}))
+        ->capture_default_str();
+    e->add_flag("--no-class-weights", evaluate->no_class_weights,
+                "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
     e->add_option("--out,-o", evaluate->out, "Report folder")->required();
     e->add_option("--splits", evaluate->options.splits, "Random 50/50 splits")->check(CLI::Range(1, 100000))->capture_default_str();
     e->add_option("--seed", evaluate->options.seed, "Seed of the splits")->capture_default_str();

@@ -43,6 +43,29 @@ Eigen::Vector2d mean_position(const PointCloud& cloud) {
 
 }  // namespace
 
+std::string crown_counts_json(const std::vector<CrownCounts>& crowns) {
+    std::size_t input = 0, noise = 0, ground = 0, outliers = 0, understorey = 0, without_ground = 0, without_shape = 0;
+    for (const auto& c : crowns) {
+        input += c.input, noise += c.noise, ground += c.ground, outliers += c.high_outliers, understorey += c.understorey;
+        without_ground += !c.ground_found, without_shape += !c.shape_features;
+    }
+    return "{\"points\": " + std::to_string(input) + ", \"noise\": " + std::to_string(noise) + ", \"ground\": " +
+           std::to_string(ground) + ", \"high_outliers\": " + std::to_string(outliers) + ", \"understorey\": " +
+           std::to_string(understorey) + ", \"trees_without_ground_returns\": " + std::to_string(without_ground) +
+           ", \"trees_without_shape_features\": " + std::to_string(without_shape) + "}";
+}
+
+std::string crown_counts_csv(const FeatureBatch& batch) {
+    std::string csv = "id,points,noise,ground,high_outliers,understorey,ground_found,shape_features\n";
+    for (std::size_t r = 0; r < batch.crowns.size(); ++r) {
+        const CrownCounts& c = batch.crowns[r];
+        csv += batch.table.ids[r] + "," + std::to_string(c.input) + "," + std::to_string(c.noise) + "," + std::to_string(c.ground) +
+               "," + std::to_string(c.high_outliers) + "," + std::to_string(c.understorey) + "," + (c.ground_found ? "1" : "0") +
+               "," + (c.shape_features ? "1" : "0") + "\n";
+    }
+    return csv;
+}
+
 FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const FeatureOptions& options) {
     const auto start = std::chrono::steady_clock::now();
     const std::clock_t cpu_start = std::clock();
@@ -56,6 +79,7 @@ FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const 
         std::vector<std::string> ids;
         std::vector<std::vector<double>> rows;
         std::vector<Eigen::Vector2d> positions;
+        std::vector<CrownCounts> crowns;
         std::vector<BatchFailure> failures;
         std::size_t points = 0;
         double seconds = 0;
@@ -78,7 +102,9 @@ FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const 
         for (const auto& tree : trees) {
             try {
                 const auto t0 = std::chrono::steady_clock::now();
-                r.rows.push_back(compute_features(tree.cloud, options, tree.id));
+                CrownCounts crown;
+                r.rows.push_back(compute_features(tree.cloud, options, tree.id, nullptr, &crown));
+                r.crowns.push_back(crown);
                 r.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                 r.ids.push_back(tree.id);
                 r.positions.push_back(mean_position(tree.cloud));
@@ -95,6 +121,7 @@ FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const 
         for (std::size_t i = 0; i < r.ids.size(); ++i) {
             batch.table.add_row(r.ids[i], r.rows[i]);
             batch.positions.push_back(r.positions[i]);
+            batch.crowns.push_back(r.crowns[i]);
         }
         for (auto& f : r.failures) {
             log_warn(f.id + ": " + f.reason);

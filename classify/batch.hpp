@@ -29,6 +29,7 @@ struct BatchFailure {
 struct FeatureBatch {
     FeatureTable table;                      // rows in input order (trees by ascending id)
     std::vector<Eigen::Vector2d> positions;  // per row: mean x, y of the tree's points (original coordinates)
+    std::vector<CrownCounts> crowns;         // per row: what the crown extraction removed
     std::vector<BatchFailure> failures;
     std::size_t points = 0;
     double seconds = 0;
@@ -36,6 +37,11 @@ struct FeatureBatch {
                                              // parallel, so on a loaded machine this exceeds the CPU time
     double cpu_seconds = 0;                  // process CPU time of the whole batch, all threads (reading included)
 };
+
+// Totals of the crown extraction over the rows, as JSON text ({"ground": ..., ...}) for summaries.
+std::string crown_counts_json(const std::vector<CrownCounts>& crowns);
+// Per row: id,points,noise,ground,high_outliers,understorey,ground_found,shape_features.
+std::string crown_counts_csv(const FeatureBatch& batch);
 
 FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const FeatureOptions& options);
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <ctime>
 #include <map>
 #include <mutex>
@@ -35,7 +36,20 @@ LabelledSet make_labelled_set(const FeatureTable& features, const std::vector<Tr
         for (const auto& l : rows) set.positions.emplace_back(*l.x, *l.y);
     if (groups)
         for (const auto& l : rows) set.groups.push_back(l.group);
+    std::vector<std::string> genus(set.classes.size());
+    bool any_genus = false;
+    for (std::size_t r = 0; r < rows.size(); ++r)
+        if (genus[set.labels[r]].empty() && !rows[r].scientific_name.empty())
+            genus[set.labels[r]] = genus_of(rows[r].scientific_name), any_genus = true;
+    if (any_genus) set.class_genus = std::move(genus);
     return set;
+}
+
+std::string genus_of(const std::string& scientific_name) {
+    const auto begin = scientific_name.find_first_not_of(" \t\"");
+    if (begin == std::string::npos) return "";
+    const auto end = scientific_name.find_first_of(" \t\"", begin);
+    return scientific_name.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
 }
 
 std::vector<Eigen::Vector2d> planting_layout(const std::vector<int>& labels, int classes, bool grouped, double spacing_m,
@@ -60,6 +74,77 @@ std::vector<Eigen::Vector2d> planting_layout(const std::vector<int>& labels, int
 namespace {
 
 int argmax(const std::vector<double>& p) { return static_cast<int>(std::max_element(p.begin(), p.end()) - p.begin()); }
+
+// Agreement figures of a confusion matrix [true][predicted]: tree accuracy, mean recall over the
+// classes that were tested, macro-F1 over those classes and Cohen's kappa.
+struct Agreement {
+    double accuracy = 0, average_rate = 0, macro_f1 = 0, kappa = 0;
+};
+
+Agreement agreement(const std::vector<std::vector<double>>& confusion) {
+    const std::size_t k = confusion.size();
+    std::vector<double> rows(k, 0), cols(k, 0);
+    double total = 0, diagonal = 0;
+    for (std::size_t t = 0; t < k; ++t)
+        for (std::size_t p = 0; p < k; ++p) rows[t] += confusion[t][p], cols[p] += confusion[t][p], total += confusion[t][p];
+    Agreement a;
+    if (total <= 0) return a;
+    int tested = 0;
+    double expected = 0;
+    for (std::size_t c = 0; c < k; ++c) {
+        diagonal += confusion[c][c];
+        expected += rows[c] * cols[c] / (total * total);
+        if (rows[c] <= 0) continue;
+        ++tested;
+        const double recall = confusion[c][c] / rows[c], precision = cols[c] > 0 ? confusion[c][c] / cols[c] : 0.0;
+        a.average_rate += recall;
+        a.macro_f1 += precision + recall > 0 ? 2 * precision * recall / (precision + recall) : 0.0;
+    }
+    a.accuracy = diagonal / total;
+    a.average_rate /= tested, a.macro_f1 /= tested;
+    a.kappa = expected < 1 ? (a.accuracy - expected) / (1 - expected) : 0.0;
+    return a;
+}
+
+// Macro-F1, kappa and, when the classes have genera, the genus-level figures of `s`.
+void add_agreement(Scores& s, const std::vector<std::string>& class_genus) {
+    const Agreement species = agreement(s.confusion);
+    s.macro_f1 = species.macro_f1, s.kappa = species.kappa;
+    if (class_genus.empty()) return;
+    std::set<std::string> distinct(class_genus.begin(), class_genus.end());
+    s.genera.assign(distinct.begin(), distinct.end());
+    std::vector<std::size_t> index;
+    for (const auto& g : class_genus) index.push_back(std::lower_bound(s.genera.begin(), s.genera.end(), g) - s.genera.begin());
+    std::vector<std::vector<double>> collapsed(s.genera.size(), std::vector<double>(s.genera.size(), 0.0));
+    for (std::size_t t = 0; t < s.confusion.size(); ++t)
+        for (std::size_t p = 0; p < s.confusion.size(); ++p) collapsed[index[t]][index[p]] += s.confusion[t][p];
+    const Agreement genus = agreement(collapsed);
+    s.genus_level = true;
+    s.genus_tree_accuracy = genus.accuracy, s.genus_average_rate = genus.average_rate;
+    s.genus_macro_f1 = genus.macro_f1, s.genus_kappa = genus.kappa;
+}
+
+// Empty when every group shares species with the others (enough for a site split), else why not.
+std::string site_split_obstacle(const LabelledSet& set, const std::vector<std::string>& groups, double min_shared) {
+    for (const auto& g : groups) {
+        std::set<int> elsewhere;
+        for (std::size_t r = 0; r < set.labels.size(); ++r)
+            if (set.groups[r] != g) elsewhere.insert(set.labels[r]);
+        std::size_t trees = 0, shared = 0;
+        for (std::size_t r = 0; r < set.labels.size(); ++r)
+            if (set.groups[r] == g) ++trees, shared += elsewhere.count(set.labels[r]);
+        const double share = trees ? static_cast<double>(shared) / static_cast<double>(trees) : 0.0;
+        if (share < min_shared) {
+            char text[256];
+            std::snprintf(text, sizeof(text),
+                          "not run: only %.0f %% of the trees of group '%s' are of species that the other groups have (needs %.0f %%); "
+                          "a site split would test species never trained",
+                          100 * share, g.c_str(), 100 * min_shared);
+            return text;
+        }
+    }
+    return "";
+}
 
 // Accumulates the scores of one classifier over experiments.
 class ScoreAccumulator {
@@ -248,6 +333,13 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
     }
     std::vector<ScoreAccumulator> site_acc(classifiers.size(), ScoreAccumulator(classes, set.labels.size()));
     if (groups.size() >= 2) {
+        report.site_split_note = site_split_obstacle(set, groups, options.site_split_min_shared);
+        if (!report.site_split_note.empty()) {
+            log_info("site split " + report.site_split_note);
+            groups.clear();
+        }
+    }
+    if (groups.size() >= 2) {
         report.site_groups = groups;
         Progress site_progress("classify evaluate: site split", groups.size());
         for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -264,7 +356,41 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
         ClassifierReport r;
         r.name = classifiers[k].name;
         r.random_splits = random_acc[k].scores(set.labels, train_counts);
-        if (groups.size() >= 2) r.site_split = site_acc[k].scores(set.labels, {});
+        add_agreement(r.random_splits, set.class_genus);
+        if (groups.size() >= 2) {
+            r.site_split = site_acc[k].scores(set.labels, {});
+            add_agreement(r.site_split, set.class_genus);
+        }
+        report.classifiers.push_back(std::move(r));
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+}
+
+EvaluationReport evaluate_train_test(const LabelledSet& set, const std::vector<NamedClassifier>& classifiers,
+                                     const std::vector<std::size_t>& train, const std::vector<std::size_t>& test,
+                                     const EvaluationOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    const int classes = static_cast<int>(set.classes.size());
+    std::set<int> trained;
+    for (auto r : train) trained.insert(set.labels[r]);
+    if (trained.size() < 2) throw Error::input("", "the training set needs at least two species, got " + std::to_string(trained.size()));
+    if (test.empty()) throw Error::input("", "the test set has no labelled tree");
+    EvaluationReport report;
+    report.mode = "train_test";
+    report.classes = set.classes;
+    report.tree_ids = set.features.ids;
+    report.tree_labels = set.labels;
+    report.tree_groups = set.groups;
+    std::vector<int> train_counts(classes, 0);
+    for (auto r : train) ++train_counts[set.labels[r]];
+    for (const auto& classifier : classifiers) {
+        ScoreAccumulator acc(classes, set.labels.size());
+        score_experiment(set, test, run_experiment(set, classifier.run, train, test, synth::stream_seed(options.seed, 0)), options, acc);
+        ClassifierReport r;
+        r.name = classifier.name;
+        r.random_splits = acc.scores(set.labels, train_counts);
+        add_agreement(r.random_splits, set.class_genus);
         report.classifiers.push_back(std::move(r));
     }
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -29,6 +29,7 @@ struct LabelledSet {
     std::vector<std::string> classes;        // class names (sorted)
     std::vector<Eigen::Vector2d> positions;  // per row, or empty
     std::vector<std::string> groups;         // per row ("" = none), or empty
+    std::vector<std::string> class_genus;    // per class: its genus ("" = unknown), or empty
 };
 
 // Rows and labels joined by id; classes are the sorted distinct species. Throws Error::input
@@ -66,6 +67,10 @@ struct EvaluationOptions {
     std::uint64_t seed = 1;
     VotingOptions voting;
     bool site_split = true;   // leave-one-group-out when the set has two or more groups
+    // ... and when every group shares species with the others: at least this share of each
+    // group's trees belongs to species that the other groups also have (otherwise a group's test
+    // trees are of species never trained, and the split can only report 0 %).
+    double site_split_min_shared = 0.5;
 };
 
 struct Scores {
@@ -74,6 +79,14 @@ struct Scores {
     std::vector<int> species_train;            // per class: training trees per split
     double average_rate = 0;                   // mean of species_rate (paper's figure)
     double tree_accuracy = 0;                  // correct / all test predictions
+    // From the confusion matrix (all test trees of all splits): macro-F1 (mean over the species of
+    // 2PR / (P + R)) and Cohen's kappa ((p_o - p_e) / (1 - p_e), agreement beyond chance).
+    double macro_f1 = 0, kappa = 0;
+    // The same predictions at genus level (species mapped to their genus; sets with genera only):
+    // tree accuracy, mean per-genus recognition rate, macro-F1 and kappa.
+    bool genus_level = false;
+    std::vector<std::string> genera;
+    double genus_tree_accuracy = 0, genus_average_rate = 0, genus_macro_f1 = 0, genus_kappa = 0;
     std::vector<std::vector<double>> confusion;  // [true][predicted] counts over all splits
     // Confidence rule h1 > factor h2 on the classifier's own predictions.
     double confident_fraction = 0, confident_accuracy = 0, unconfident_accuracy = 0;
@@ -101,11 +114,23 @@ struct EvaluationReport {
     std::vector<std::string> tree_groups;  // per row, or empty
     std::vector<ClassifierReport> classifiers;
     std::vector<std::string> site_groups;
+    std::string site_split_note;           // why the site split did not run ("" when it ran or was not asked)
+    std::string mode = "random_splits";    // or "train_test": one experiment, a training set against a test set
     double seconds = 0;
 };
 
 // Throws Error::input when a species has fewer than 2 trees (it cannot be both trained and tested).
 EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassifier>& classifiers, const EvaluationOptions& options);
+
+// One experiment: train on the rows `train`, test on the rows `test` (e.g. two dataset folders).
+// Reported as random_splits with one experiment; species of the test set that the training set
+// lacks can only be wrong (the report lists them).
+EvaluationReport evaluate_train_test(const LabelledSet& set, const std::vector<NamedClassifier>& classifiers,
+                                     const std::vector<std::size_t>& train, const std::vector<std::size_t>& test,
+                                     const EvaluationOptions& options);
+
+// Genus of a scientific name: its first word ("Quercus rubra L." -> "Quercus"); "" for "".
+std::string genus_of(const std::string& scientific_name);
 
 // Writes report/: summary.json (with the random-split accuracy per group, e.g. per scanner, when
 // the set has groups), per_species.csv, confusion_<name>.csv and .png (row-normalised percentages

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,9 @@ class FeatureSink {
 public:
     explicit FeatureSink(std::vector<double>& values);
     void add(const std::string& name, double value);
+    // A value that cannot be computed for this tree (too few points, no intensity, ...): NaN,
+    // which the classifiers treat as missing.
+    void missing(const std::string& name);
     std::size_t size() const { return values_.size(); }
 
 private:
@@ -81,7 +85,22 @@ void skip_skeleton(FeatureSink& out);  // zeros for every skeleton feature
 void describe_envelope(Catalogue& c);
 void compute_envelope(const TreeFrame& frame, FeatureSink& out);
 void describe_scan(Catalogue& c);
-void compute_scan(const TreeFrame& frame, FeatureSink& out);
+// input_points per m^2 of the crown disc of radius crown_radius.
+void compute_scan(std::size_t input_points, float crown_radius, FeatureSink& out);
+
+// The airborne group reads the crown with its attributes (intensity, returns, colours) and the
+// clip's ground returns: computed for every tree, however few points it has.
+struct AirborneInput {
+    const PointCloud* crown = nullptr;      // the crown, or `thinned` (see airborne_input in features.cpp)
+    std::shared_ptr<const PointCloud> thinned;
+    std::optional<float> ground_z;          // lowest ground return, when the clip has ground returns
+    std::size_t ground_returns = 0;
+    double ground_intensity = 0;            // median intensity of the ground returns (0: none)
+};
+void describe_airborne(Catalogue& c);
+void compute_airborne(const AirborneInput& in, FeatureSink& out);
+// The group's crown radius (als_crown_radius): the scan density of trees too small for the frame.
+float airborne_crown_radius(const AirborneInput& in);
 
 // Small statistics shared by the groups.
 float quantile(std::vector<float> values, double q);  // 0 for an empty vector

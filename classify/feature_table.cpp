@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <sstream>
 #include <unordered_map>
 
@@ -87,6 +88,13 @@ double parse_double(const std::string& text, const std::string& file, std::size_
     return v;
 }
 
+// A feature value: a finite number, or `nan` / an empty field for a missing value (a feature that
+// could not be computed for that tree). Infinities are errors.
+double parse_feature(const std::string& text, const std::string& file, std::size_t line, const std::string& column) {
+    if (text.empty() || text == "nan" || text == "NaN" || text == "NA") return std::numeric_limits<double>::quiet_NaN();
+    return parse_double(text, file, line, column);
+}
+
 std::vector<std::string> read_lines(const std::filesystem::path& path) {
     std::istringstream in(read_file(path));
     std::vector<std::string> lines;
@@ -131,7 +139,7 @@ FeatureTable read_feature_csv(const std::filesystem::path& path) {
         if (fields.size() != header.size())
             throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) +
                                          " fields, the header has " + std::to_string(header.size()));
-        for (std::size_t c = 0; c < table.cols(); ++c) row[c] = parse_double(fields[c + 1], file, l + 1, header[c + 1]);
+        for (std::size_t c = 0; c < table.cols(); ++c) row[c] = parse_feature(fields[c + 1], file, l + 1, header[c + 1]);
         table.add_row(fields[0], row);
     }
     if (table.rows() == 0) throw Error::input(file, "no rows after the header");
@@ -164,6 +172,7 @@ std::vector<TreeLabel> read_labels_csv(const std::filesystem::path& path) {
     const auto x_col = find_column(header, {"x", "base_x"});
     const auto y_col = find_column(header, {"y", "base_y"});
     const auto group_col = find_column(header, {"tile", "site", "group", "plot"});
+    const auto name_col = find_column(header, {"scientific_name", "genus"});
     std::vector<TreeLabel> labels;
     for (std::size_t l = 1; l < lines.size(); ++l) {
         const auto fields = split_csv_line(lines[l]);
@@ -180,6 +189,7 @@ std::vector<TreeLabel> read_labels_csv(const std::filesystem::path& path) {
             label.y = parse_double(fields[*y_col], file, l + 1, header[*y_col]);
         }
         if (group_col) label.group = fields[*group_col];
+        if (name_col) label.scientific_name = fields[*name_col];
         labels.push_back(std::move(label));
     }
     if (labels.empty()) throw Error::input(file, "no labels after the header");

@@ -47,6 +47,7 @@ struct TreeLabel {
     std::string species;
     std::optional<double> x, y;     // position, metres (spatial voting)
     std::string group;              // site or tile ("" when the file has none)
+    std::string scientific_name;    // optional column `scientific_name` (or `genus`): its first word is the genus
 };
 
 std::vector<TreeLabel> read_labels_csv(const std::filesystem::path& path);

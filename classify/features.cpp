@@ -2,6 +2,7 @@
 // axes) and runs the feature groups in catalogue order.
 #include "classify/features.hpp"
 
+#include "classify/crown.hpp"
 #include "classify/feature_groups.hpp"
 #include "core/error.hpp"
 #include "reconstruct/preprocess.hpp"
@@ -13,6 +14,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 namespace treelobes::classify {
@@ -30,6 +33,11 @@ void FeatureSink::add(const std::string& name, double value) {
                                             (index < catalogue.size() ? catalogue[index].name : std::string("nothing")) + "'");
     // A degenerate tree can make a ratio undefined; 0 keeps the vector usable and is rare.
     values_.push_back(std::isfinite(value) ? value : 0.0);
+}
+
+void FeatureSink::missing(const std::string& name) {
+    add(name, 0.0);
+    values_.back() = std::numeric_limits<double>::quiet_NaN();
 }
 
 float quantile(std::vector<float> values, double q) {
@@ -81,6 +89,7 @@ std::vector<FeatureInfo> build_catalogue() {
         {"structure", detail::describe_structure}, {"normals", detail::describe_normals},
         {"hull", detail::describe_hull},           {"skeleton", detail::describe_skeleton},
         {"envelope", detail::describe_envelope},   {"scan", detail::describe_scan},
+        {"airborne", detail::describe_airborne},
     };
     for (const auto& [group, describe] : groups) {
         detail::Catalogue catalogue(list, group);
@@ -165,9 +174,10 @@ Eigen::Vector2f principal_axis(const std::vector<Eigen::Vector3f>& points, const
     return major.cast<float>();
 }
 
-TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, const std::string& name) {
-    if (cloud.size() < 50)
-        throw Error::input(name, "too few points for shape features (" + std::to_string(cloud.size()) + ", need 50)");
+// The frame of the shape groups; `ground_z` (the lowest ground return of the clip) is the ground
+// level when known, else the ground plane found by the cleaning or the lowest points.
+TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, const std::string& name,
+                      std::optional<float> ground_z) {
     TreeFrame frame;
     frame.options = &options;
     frame.input_points = cloud.size();
@@ -199,11 +209,13 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
     PreprocessOptions clean;
     clean.voxel_size = frame.voxel;
     clean.table_width = std::max(options.normal_neighbours, skeleton_table_width(SkeletonOptions{}));
+    if (ground_z) clean.ground = GroundMode::Keep;  // the ground returns are gone already (classify/crown.hpp)
     const Preprocessed pre = preprocess_cloud(local, clean, name);
 
     // Ground: the plane's height under the stem when the scan has ground, else the lowest points.
     float ground = detail::quantile(coordinate(pre.points, 2), 0.001);
-    if (pre.ground_found) ground = -pre.ground_plane.w() / pre.ground_plane.z();  // n.p + d = 0 at x = y = 0
+    if (ground_z) ground = *ground_z - base;
+    else if (pre.ground_found) ground = -pre.ground_plane.w() / pre.ground_plane.z();  // n.p + d = 0 at x = y = 0
     const Eigen::Vector3f shift(0, 0, ground);
     for (const auto& p : pre.points) frame.points.push_back(p - shift);
     for (const auto& p : local.positions) frame.raw.push_back(p - shift);
@@ -226,6 +238,32 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
     return frame;
 }
 
+// The airborne group's input: the crown and the clip's ground returns (their level and median
+// intensity, the reference that normalises the crown's intensity per file).
+detail::AirborneInput airborne_input(const PointCloud& clip, const CrownExtraction& extraction) {
+    detail::AirborneInput in;
+    in.crown = &extraction.crown;
+    // Airborne crowns have hundreds to thousands of points; a dense terrestrial scan is thinned
+    // evenly for this group (its shares, quantiles and raster tops do not need more points).
+    constexpr std::size_t kAirbornePoints = 20000;
+    if (extraction.crown.size() > kAirbornePoints) {
+        std::vector<std::size_t> every;
+        const double step = static_cast<double>(extraction.crown.size()) / kAirbornePoints;
+        for (std::size_t i = 0; i < kAirbornePoints; ++i) every.push_back(static_cast<std::size_t>(i * step));
+        in.thinned = std::make_shared<const PointCloud>(extraction.crown.subset(every));
+        in.crown = in.thinned.get();
+    }
+    in.ground_z = extraction.ground_z;
+    in.ground_returns = extraction.counts.ground;
+    if (clip.intensity.size() == clip.size() && clip.classification.size() == clip.size()) {
+        std::vector<float> ground;
+        for (std::size_t i = 0; i < clip.size(); ++i)
+            if (clip.classification[i] == 2) ground.push_back(clip.intensity[i]);
+        if (!ground.empty()) in.ground_intensity = detail::quantile(ground, 0.5);
+    }
+    return in;
+}
+
 }  // namespace
 
 const std::vector<FeatureInfo>& feature_catalogue() {
@@ -240,16 +278,32 @@ std::vector<std::string> feature_names() {
 }
 
 std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptions& options, const std::string& name,
-                                     FeatureTimings* timings) {
+                                     FeatureTimings* timings, CrownCounts* crown) {
     FeatureTimings local;
     FeatureTimings& t = timings ? *timings : local;
     auto start = Clock::now();
-    TreeFrame frame = build_frame(cloud, options, name);
-    t.prepare = seconds_since(start);
-
+    if (cloud.empty()) throw Error::input(name, "no points");
+    CrownExtraction extraction = extract_crown(cloud, options.crown);
+    if (crown) *crown = extraction.counts;
+    const PointCloud& points = extraction.crown;
     std::vector<double> values;
     values.reserve(feature_catalogue().size());
     detail::FeatureSink out(values);
+    if (points.size() < options.min_shape_points) {
+        // Too few points for a frame, normals or a skeleton: those groups are missing, the
+        // airborne group (height, width, intensity, returns) and the scan density are not.
+        if (crown) crown->shape_features = false;
+        t.prepare = seconds_since(start);
+        for (const auto& info : feature_catalogue())
+            if (info.group != "scan" && info.group != "airborne") out.missing(info.name);
+        const detail::AirborneInput airborne = airborne_input(cloud, extraction);
+        detail::compute_scan(points.size(), detail::airborne_crown_radius(airborne), out);
+        detail::compute_airborne(airborne, out);
+        t.points = seconds_since(start) - t.prepare;
+        return values;
+    }
+    TreeFrame frame = build_frame(points, options, name, extraction.ground_z);
+    t.prepare = seconds_since(start);
     start = Clock::now();
     detail::compute_shape(frame, out);
     detail::compute_vertical(frame, out);
@@ -269,7 +323,8 @@ std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptio
     t.skeleton = seconds_since(start);
     start = Clock::now();
     detail::compute_envelope(frame, out);
-    detail::compute_scan(frame, out);
+    detail::compute_scan(frame.input_points, frame.crown_radius, out);
+    detail::compute_airborne(airborne_input(cloud, extraction), out);
     t.points += seconds_since(start);
     if (values.size() != feature_catalogue().size())
         throw Error(ExitCode::Internal, "feature extraction produced " + std::to_string(values.size()) + " of " +
@@ -284,7 +339,15 @@ std::string features_markdown() {
        << "Generated from `classify::feature_catalogue()` (classify/features.cpp and the group files); a unit test\n"
        << "fails when this file and the code disagree. Regenerate with `treelobes classify features --list > docs/features.md`.\n\n"
        << catalogue.size() << " features per tree, computed by `treelobes classify features` (seed 001 §6.1).\n\n"
-       << "## Frame and density\n\n"
+       << "## Crown, frame and density\n\n"
+       << "- The crown is extracted first (classify/crown.hpp): noise (classes 7, 18) and ground returns (class 2) are removed,\n"
+       << "  the lowest ground return is the ground level z = 0, points separated from the rest by a vertical gap of more than\n"
+       << "  5 m above the crown (high outliers: birds, clouds) go, and with a known ground level so do points below the first\n"
+       << "  vertical gap of max(1.5 m, 0.1 H) under the crown that lies below half the height (understorey).\n"
+       << "- Crowns of fewer than 50 points after that get only the airborne group and the scan density; every other\n"
+       << "  feature is missing (NaN, written `nan`). The airborne group marks what it cannot compute (no intensity, returns,\n"
+       << "  ground returns or colours; an empty layer) as missing too. JointBoost learns per stump whether missing values go\n"
+       << "  above or below the threshold; XGBoost treats NaN as missing natively (docs/classify.md).\n"
        << "- The points are cleaned and reduced to one point per voxel (reconstruct/preprocess: duplicates, voxel\n"
        << "  grid, statistical outliers, ground plane). Voxel size v = clamp(0.01 H, 0.03 m, 0.25 m) from a rough\n"
        << "  height H (0.1 % to 99.9 % height quantiles), so a thinned scan fills nearly the same voxels.\n"
@@ -295,7 +358,7 @@ std::string features_markdown() {
        << "  Every feature is therefore invariant to position and heading.\n"
        << "- H = height (99.9 % quantile of z), h = z / H (relative height), r = horizontal distance to the axis,\n"
        << "  R = crown radius (95 % quantile of r). \"Voxel points\" are the reduced points; \"raw points\" the input.\n"
-       << "- Undefined values (empty layer, no visible stem) are 0.\n\n";
+       << "- Undefined values of the shape groups (empty layer, no visible stem) are 0.\n\n";
     std::string group;
     for (const auto& f : catalogue) {
         if (f.group != group) {

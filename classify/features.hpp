@@ -12,6 +12,7 @@
 // group's point density is the one feature that follows the density on purpose (routing only).
 #pragma once
 
+#include "classify/crown.hpp"
 #include "core/point_cloud.hpp"
 
 #include <string>
@@ -27,12 +28,16 @@ struct FeatureOptions {
     int normal_neighbours = 12;      // k of the local PCA (normals, curvature, eigen-features)
     bool skeleton = true;            // false: the skeleton group is filled with zeros (faster)
     std::size_t max_raw_points = 400000;  // raw points read for the trunk and count features (evenly thinned above)
+    // Crowns with fewer points (after the crown extraction) get only the airborne group and the
+    // scan density; the shape groups need a frame, normals and a skeleton and are missing (NaN).
+    std::size_t min_shape_points = 50;
+    CrownOptions crown;                   // ground, understorey, noise and outliers removed first
 };
 
 struct FeatureInfo {
     std::string name;
-    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton, envelope, scan
-    std::string unit;         // "m", "deg", "1" (dimensionless), "count", "1/m", "1/m^2"
+    std::string group;        // shape, vertical, radial, horizontal, normals, structure, hull, skeleton, envelope, scan, airborne
+    std::string unit;         // "m", "m^2", "deg", "1" (dimensionless), "count", "1/m", "1/m^2"
     std::string description;  // how it is computed
 };
 
@@ -45,10 +50,13 @@ struct FeatureTimings {
     double prepare = 0, points = 0, normals = 0, hull = 0, skeleton = 0;
 };
 
-// The features of one tree's points (z up, metres). Throws Error::input naming `name` when the
-// cloud has too few points or is too flat to be a tree.
+// The features of one tree's points (z up, metres). The crown is extracted first (classify/crown.hpp;
+// `crown` receives what was removed). Every tree with at least one point gets a vector: features
+// that cannot be computed are NaN (missing). Throws Error::input naming `name` when the cloud is
+// empty, or has enough points for the shape groups but is too flat to be a tree.
 std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptions& options = {},
-                                     const std::string& name = {}, FeatureTimings* timings = nullptr);
+                                     const std::string& name = {}, FeatureTimings* timings = nullptr,
+                                     CrownCounts* crown = nullptr);
 
 // The scan group's feature: input points per m^2 of crown cover. It tells the scan kind (airborne
 // or terrestrial), changes with the point density by design, and is never a JointBoost stump

@@ -75,7 +75,7 @@ std::vector<double> JointBoostModel::scores(const double* features) const {
         for (std::size_t c = 0; c < h.size(); ++c) h[c] += m[c] / static_cast<double>(members.size());
     }
     for (const auto& s : stumps) {
-        const auto& values = features[s.feature] > s.threshold ? s.above : s.below;
+        const auto& values = s.goes_above(features[s.feature]) ? s.above : s.below;
         for (std::size_t c = 0; c < h.size(); ++c) h[c] += values[c];
     }
     return h;
@@ -135,8 +135,8 @@ void validate_training_input(const FeatureTable& table, const std::vector<int>& 
         if (count[c] == 0) throw Error::input("", "JointBoost: class '" + classes[c] + "' has no training trees");
     for (std::size_t r = 0; r < table.rows(); ++r)
         for (std::size_t f = 0; f < table.cols(); ++f)
-            if (!std::isfinite(table.at(r, f)))
-                throw Error::input("", "tree '" + table.ids[r] + "': feature '" + table.feature_names[f] + "' is not finite");
+            if (std::isinf(table.at(r, f)))  // NaN is a missing value; infinity is a bug upstream
+                throw Error::input("", "tree '" + table.ids[r] + "': feature '" + table.feature_names[f] + "' is infinite");
 }
 
 // The best stump of one feature: its gain (error reduction relative to sum(w)), threshold
@@ -151,10 +151,15 @@ struct Candidate {
 // One boosting run over a fixed training set.
 class RoundFitter {
 public:
-    RoundFitter(const FeatureTable& table, const std::vector<int>& labels, int classes)
-        : table_(table), labels_(labels), n_(table.rows()), f_(table.cols()), c_(classes),
-          weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0), order_(table.cols()), splits_(table.cols()),
-          priority_(table.cols(), 0.0) {
+    // `initial_weights` (one per tree, empty = all 1) start every class's weight of that tree.
+    RoundFitter(const FeatureTable& table, const std::vector<int>& labels, int classes, const std::vector<double>& initial_weights = {})
+        : table_(table), labels_(labels), n_(table.rows()), c_(classes), weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0) {
+        if (!initial_weights.empty())
+            for (std::size_t i = 0; i < n_; ++i)
+                for (int c = 0; c < c_; ++c) weight(i, c) = initial_weights[i];
+        make_candidates();
+        f_ = source_.size();
+        order_.resize(f_), splits_.resize(f_), priority_.assign(f_, 0.0);
         presort();
     }
 
@@ -191,7 +196,7 @@ public:
     // exp(-z H) over trees and classes (the weights before renormalisation tell it).
     double update(const Stump& stump) {
         for (std::size_t i = 0; i < n_; ++i) {
-            const auto& h = table_.at(i, stump.feature) > stump.threshold ? stump.above : stump.below;
+            const auto& h = stump.goes_above(table_.at(i, stump.feature)) ? stump.above : stump.below;
             for (int c = 0; c < c_; ++c) weight(i, c) *= std::exp(-(labels_[i] == c ? 1.0 : -1.0) * h[c]);
         }
         const double mean = std::accumulate(weights_.begin(), weights_.end(), 0.0) / static_cast<double>(weights_.size());
@@ -205,13 +210,30 @@ public:
 private:
     double& weight(std::size_t i, int c) { return weights_[i * static_cast<std::size_t>(c_) + c]; }
     double weight(std::size_t i, int c) const { return weights_[i * static_cast<std::size_t>(c_) + c]; }
-    double value(std::size_t i, std::size_t f) const { return table_.at(i, f); }
+    // Value of tree i for candidate feature f: a missing value sorts below every value of its
+    // column (the stump sends it below the threshold) or above (it goes above).
+    double value(std::size_t i, std::size_t f) const {
+        const double v = table_.at(i, source_[f]);
+        return std::isnan(v) ? (missing_above_[f] ? kInf : -kInf) : v;
+    }
 
-    // Sample indices sorted by each feature (stable: equal values keep row order). Constant
-    // features and the scan descriptor get an empty order and are never split.
+    // Candidate features: each column once; a column with missing values (NaN) twice, once with
+    // them sent below every threshold and once above, so that every round learns the better
+    // direction for them (the default direction of XGBoost's sparsity-aware split finding).
+    void make_candidates() {
+        for (std::size_t f = 0; f < table_.cols(); ++f) {
+            bool missing = false, present = false;
+            for (std::size_t i = 0; i < n_; ++i) (std::isnan(table_.at(i, f)) ? missing : present) = true;
+            source_.push_back(f), missing_above_.push_back(0);
+            if (missing && present) source_.push_back(f), missing_above_.push_back(1);
+        }
+    }
+
+    // Sample indices sorted by each candidate feature (stable: equal values keep row order).
+    // Constant features and the scan descriptor get an empty order and are never split.
     void presort() {
         tbb::parallel_for(std::size_t(0), f_, [&](std::size_t f) {
-            if (is_scan_descriptor(table_.feature_names[f])) return;
+            if (is_scan_descriptor(table_.feature_names[source_[f]])) return;
             std::vector<int> order(n_);
             std::iota(order.begin(), order.end(), 0);
             std::stable_sort(order.begin(), order.end(), [&](int i, int j) { return value(i, f) < value(j, f); });
@@ -375,18 +397,23 @@ private:
     // The stump of a candidate: midpoint threshold and the weighted means a_S, b_S, k_c.
     Stump make_stump(const Candidate& candidate) const {
         Stump s;
-        s.feature = candidate.feature;
+        s.feature = static_cast<int>(source_[candidate.feature]);
+        s.missing_above = missing_above_[candidate.feature] != 0;
         const auto& order = order_[candidate.feature];
         const double lo = value(order[candidate.position], candidate.feature);
         const double hi = value(order[candidate.position + 1], candidate.feature);
         s.threshold = lo + (hi - lo) / 2;
         if (!(s.threshold < hi)) s.threshold = lo;  // adjacent doubles: "v > lo" is the same split
+        // A split between the missing values and the lowest (highest) present value: present
+        // values on one side, missing ones on the other; the threshold stays a finite number.
+        if (lo == -kInf) s.threshold = hi - std::max(1.0, std::abs(hi));
+        if (hi == kInf) s.threshold = lo;
         s.sharing = candidate.sharing;
         double wa = 0, za = 0, wb = 0, zb = 0;
         for (int c : s.sharing)
             for (std::size_t i = 0; i < n_; ++i) {
                 const double w = weight(i, c), signed_w = labels_[i] == c ? w : -w;
-                if (value(i, s.feature) > s.threshold) wa += w, za += signed_w;
+                if (s.goes_above(table_.at(i, s.feature))) wa += w, za += signed_w;
                 else wb += w, zb += signed_w;
             }
         s.a = wa > 0 ? za / wa : 0.0;
@@ -399,8 +426,10 @@ private:
 
     const FeatureTable& table_;
     const std::vector<int>& labels_;
-    std::size_t n_, f_;
+    std::size_t n_, f_ = 0;                  // f_: candidate features (source_.size())
     int c_;
+    std::vector<std::size_t> source_;        // per candidate feature: its column
+    std::vector<char> missing_above_;        // per candidate feature: missing values go above
     std::vector<double> weights_;            // sample-major: weights_[i * classes + c]
     std::vector<double> signed_weights_;     // z_i^c w_i^c, same layout
     std::vector<std::vector<int>> order_;
@@ -411,7 +440,8 @@ private:
     double loss_ = 1.0;  // mean exp(-z H), H = 0 at the start
 };
 
-// Scores of held-out trees, one stump at a time; score() = (errors, mean log-loss at T = 1).
+// Scores of held-out trees, one stump at a time; score() = (errors, mean log-loss at T = 1),
+// each tree's error counted with its class weight (1 unless the classes are balanced).
 struct ValidationTracker {
     const FeatureTable& table;
     const std::vector<int>& labels;
@@ -422,22 +452,36 @@ struct ValidationTracker {
 
     void add(const Stump& s) {
         for (std::size_t i = 0; i < table.rows(); ++i) {
-            const auto& values = table.at(i, s.feature) > s.threshold ? s.above : s.below;
+            const auto& values = s.goes_above(table.at(i, s.feature)) ? s.above : s.below;
             for (std::size_t c = 0; c < values.size(); ++c) scores[i][c] += values[c];
         }
     }
-    std::pair<int, double> score() const {
-        int errors = 0;
+    std::vector<double> error_weights;  // per row, empty = 1
+    std::pair<double, double> score() const {
+        double errors = 0;
         double logloss = 0;
         for (std::size_t i = 0; i < table.rows(); ++i) {
             const auto p = probabilities_from_scores(scores[i]);
             const auto top = std::max_element(p.begin(), p.end()) - p.begin();
-            errors += top != labels[i];
+            if (top != labels[i]) errors += error_weights.empty() ? 1.0 : error_weights[i];
             logloss -= std::log(std::max(p[labels[i]], 1e-15));
         }
         return {errors, table.rows() > 0 ? logloss / static_cast<double>(table.rows()) : 0.0};
     }
 };
+
+// Per tree: 1, or with balanced classes N / (K n_y) (every class weighs the same in total; the
+// mean stays 1, so a balanced set gets exactly 1 everywhere).
+std::vector<double> tree_weights(const std::vector<int>& labels, int classes, bool balance) {
+    if (!balance) return {};
+    std::vector<double> count(classes, 0.0);
+    for (int y : labels) ++count[y];
+    int present = 0;
+    for (double n : count) present += n > 0;
+    std::vector<double> w;
+    for (int y : labels) w.push_back(static_cast<double>(labels.size()) / (present * count[y]));
+    return w;
+}
 
 std::vector<int> subset_labels(const std::vector<int>& labels, const std::vector<std::size_t>& rows) {
     std::vector<int> out;
@@ -450,12 +494,13 @@ std::vector<int> subset_labels(const std::vector<int>& labels, const std::vector
 
 JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels,
                                       const std::vector<std::string>& classes, int rounds,
-                                      std::vector<double>* training_loss) {
+                                      std::vector<double>* training_loss, bool balance_classes) {
     validate_training_input(table, labels, classes);
     JointBoostModel model;
     model.classes = classes;
     model.feature_names = table.feature_names;
-    RoundFitter fitter(table, labels, static_cast<int>(classes.size()));
+    RoundFitter fitter(table, labels, static_cast<int>(classes.size()),
+                       tree_weights(labels, static_cast<int>(classes.size()), balance_classes));
     for (int m = 0; m < rounds; ++m) {
         Stump stump;
         if (!fitter.fit(stump)) break;
@@ -483,7 +528,7 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
     const std::vector<int> fold = options.folds >= 2 ? stratified_folds(labels, class_count, options.folds, options.seed)
                                                      : std::vector<int>{};
     if (fold.empty() || *std::max_element(fold.begin(), fold.end()) < 1) {  // nothing to stop on: max_rounds
-        auto model = fit_jointboost_rounds(table, labels, classes, options.max_rounds, &r.training_loss);
+        auto model = fit_jointboost_rounds(table, labels, classes, options.max_rounds, &r.training_loss, options.balance_classes);
         r.rounds = r.rounds_tried = static_cast<int>(model.stumps.size());
         return model;
     }
@@ -508,14 +553,19 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
         runs[k].fit_labels = subset_labels(labels, fit_rows);
         runs[k].held_table = table.select_rows(runs[k].held_out);
         runs[k].held_labels = subset_labels(labels, runs[k].held_out);
-        runs[k].fitter = std::make_unique<RoundFitter>(runs[k].fit_table, runs[k].fit_labels, class_count);
+        runs[k].fitter = std::make_unique<RoundFitter>(runs[k].fit_table, runs[k].fit_labels, class_count,
+                                                       tree_weights(runs[k].fit_labels, class_count, options.balance_classes));
         runs[k].tracker = std::make_unique<ValidationTracker>(runs[k].held_table, runs[k].held_labels, class_count);
+        if (options.balance_classes) {
+            const auto w = tree_weights(labels, class_count, true);
+            for (auto i : runs[k].held_out) runs[k].tracker->error_weights.push_back(w[i]);
+        }
     }
     std::vector<std::vector<Stump>> fold_stumps(folds);
-    std::pair<int, double> best{std::numeric_limits<int>::max(), kInf};
+    std::pair<double, double> best{kInf, kInf};
     int best_rounds = 0;
     for (int m = 0; m < options.max_rounds; ++m) {
-        int errors = 0;
+        double errors = 0;
         double logloss = 0, loss = 0;
         bool advanced = false;
         for (int k = 0; k < folds; ++k) {
@@ -533,9 +583,9 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
             loss += run.fitter->loss() / folds;
         }
         if (!advanced) break;
-        const std::pair<int, double> score{errors, logloss / static_cast<double>(labels.size())};
+        const std::pair<double, double> score{errors, logloss / static_cast<double>(labels.size())};
         r.training_loss.push_back(loss);
-        r.validation_error.push_back(static_cast<double>(errors) / static_cast<double>(labels.size()));
+        r.validation_error.push_back(errors / static_cast<double>(labels.size()));
         r.validation_logloss.push_back(score.second);
         if (score.first <= best.first) best = score, best_rounds = m + 1;
         if (score.first == 0 && score.second < options.settled_logloss) break;
@@ -578,7 +628,7 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
                 (options.average_probabilities ? model.members[k].stumps : model.stumps).push_back(std::move(s));
             }
     } else {
-        model = fit_jointboost_rounds(table, labels, classes, best_rounds);
+        model = fit_jointboost_rounds(table, labels, classes, best_rounds, nullptr, options.balance_classes);
     }
     model.temperature = r.temperature = temperature;
     r.rounds = options.fold_ensemble ? best_rounds : static_cast<int>(model.stumps.size());
@@ -654,9 +704,11 @@ constexpr const char* kProbabilityMapping = "p_c = sigma(2 H_c / T) / sum_c' sig
 
 nlohmann::json stumps_json(const JointBoostModel& model) {
     nlohmann::json stumps = nlohmann::json::array();
-    for (const auto& s : model.stumps)
+    for (const auto& s : model.stumps) {
         stumps.push_back({{"feature", s.feature}, {"threshold", s.threshold}, {"a", s.a}, {"b", s.b},
                           {"sharing", s.sharing}, {"k", s.k}});
+        if (s.missing_above) stumps.back()["missing_above"] = true;  // absent: missing values go below
+    }
     return stumps;
 }
 
@@ -702,6 +754,7 @@ Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const s
     Stump s;
     s.feature = j.at("feature").get<int>();
     s.threshold = j.at("threshold").get<double>();
+    s.missing_above = j.contains("missing_above") && j.at("missing_above").get<bool>();
     s.a = j.at("a").get<double>();
     s.b = j.at("b").get<double>();
     s.sharing = j.at("sharing").get<std::vector<int>>();

@@ -28,6 +28,7 @@
 
 #include "classify/feature_table.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -74,12 +75,20 @@ struct JointBoostOptions {
     bool route_by_scan = true;
     double route_min_ratio = 3.0;
     int route_min_trees = 20;
+    // Class imbalance: every tree starts with weight N / (K n_y) (K classes, n_y trees of its
+    // class), so that each class weighs the same in total, and out-of-fold errors are counted
+    // with the same weights. A balanced training set is unchanged (all weights 1).
+    bool balance_classes = true;
     std::uint64_t seed = 1;            // fold assignment
 };
 
 struct Stump {
     int feature = 0;
     double threshold = 0;
+    // Where a missing value (NaN) goes: chosen in training (each column with missing values is
+    // tried with them below and above every threshold), false = below.
+    bool missing_above = false;
+    bool goes_above(double v) const { return std::isnan(v) ? missing_above : v > threshold; }
     double a = 0;                      // value for classes in the set when v_f > threshold
     double b = 0;                      // value for classes in the set when v_f <= threshold
     std::vector<int> sharing;          // classes of S, ascending
@@ -149,7 +158,7 @@ JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<in
 // The boosting rounds themselves, without early stopping (exposed for tests): `rounds` stumps.
 JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels,
                                       const std::vector<std::string>& classes, int rounds,
-                                      std::vector<double>* training_loss = nullptr);
+                                      std::vector<double>* training_loss = nullptr, bool balance_classes = false);
 
 // The scan routing train_jointboost would choose for these training trees: the column of the scan
 // descriptor and the density threshold, or route_feature = -1 (one model).

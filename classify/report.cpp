@@ -141,7 +141,15 @@ json scores_json(const Scores& s, const std::vector<std::string>& classes) {
               {"train_seconds_mean", s.experiments ? s.train_seconds / s.experiments : 0.0},
               {"cpu_seconds_mean", s.experiments ? s.cpu_seconds / s.experiments : 0.0},
               {"predict_seconds_total", s.predict_seconds},
-              {"mean_rounds", s.mean_rounds}};
+              {"mean_rounds", s.mean_rounds},
+              {"macro_f1", s.macro_f1},
+              {"kappa", s.kappa}};
+    if (s.genus_level)
+        j["genus"] = {{"genera", s.genera},
+                      {"tree_accuracy", s.genus_tree_accuracy},
+                      {"average_recognition_rate", s.genus_average_rate},
+                      {"macro_f1", s.genus_macro_f1},
+                      {"kappa", s.genus_kappa}};
     if (s.voted) {
         j["voted_average_recognition_rate"] = s.voted_average_rate;
         j["voted_tree_accuracy"] = s.voted_tree_accuracy;
@@ -211,6 +219,8 @@ void write_report(const EvaluationReport& report, const EvaluationOptions& optio
                           {"confidence_factor", options.voting.confidence_factor},
                           {"voting_radius_m", options.voting.radius_m}};
     summary["site_groups"] = report.site_groups;
+    summary["mode"] = report.mode;
+    if (!report.site_split_note.empty()) summary["site_split_note"] = report.site_split_note;
     summary["seconds"] = report.seconds;
     for (const auto& c : report.classifiers) {
         json entry = {{"random_splits", scores_json(c.random_splits, report.classes)}};
@@ -252,19 +262,23 @@ void write_report(const EvaluationReport& report, const EvaluationOptions& optio
 
 std::string report_summary(const EvaluationReport& report) {
     std::ostringstream out;
-    out << "Species classification: " << report.classes.size() << " species, "
-        << (report.classifiers.empty() ? 0 : report.classifiers.front().random_splits.experiments) << " random 50/50 splits";
+    out << "Species classification: " << report.classes.size() << " species, ";
+    if (report.mode == "train_test") out << "trained on one set, tested on another";
+    else out << (report.classifiers.empty() ? 0 : report.classifiers.front().random_splits.experiments) << " random 50/50 splits";
     if (!report.site_groups.empty()) out << ", site split over " << report.site_groups.size() << " groups";
     char line[256];
-    std::snprintf(line, sizeof line, " (%.1f s)\n\n", report.seconds);
+    std::snprintf(line, sizeof line, " (%.1f s)\n", report.seconds);
     out << line;
-    out << "| classifier | average recognition rate | tree accuracy | confident: share / accuracy | unconfident accuracy | with voting | site split | train s/split | CPU s/split |\n"
-        << "|---|---|---|---|---|---|---|---|---|\n";
+    if (!report.site_split_note.empty()) out << "Site split " << report.site_split_note << "\n";
+    out << "\n| classifier | average recognition rate | tree accuracy | macro-F1 | kappa | genus: tree accuracy / rate | confident: share / accuracy | unconfident accuracy | with voting: rate / trees | site split | train s/split | CPU s/split |\n"
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& c : report.classifiers) {
         const Scores& s = c.random_splits;
-        out << "| " << c.name << " | " << percent(s.average_rate) << " % | " << percent(s.tree_accuracy) << " % | "
+        std::snprintf(line, sizeof line, "%.3f | %.3f", s.macro_f1, s.kappa);
+        out << "| " << c.name << " | " << percent(s.average_rate) << " % | " << percent(s.tree_accuracy) << " % | " << line << " | "
+            << (s.genus_level ? percent(s.genus_tree_accuracy) + " % / " + percent(s.genus_average_rate) + " %" : std::string("-")) << " | "
             << percent(s.confident_fraction) << " % / " << percent(s.confident_accuracy) << " % | " << percent(s.unconfident_accuracy)
-            << " % | " << (s.voted ? percent(s.voted_average_rate) + " %" : std::string("-")) << " | "
+            << " % | " << (s.voted ? percent(s.voted_average_rate) + " % / " + percent(s.voted_tree_accuracy) + " %" : std::string("-")) << " | "
             << (c.site_split.experiments > 0 ? percent(c.site_split.average_rate) + " %" : std::string("-")) << " | ";
         std::snprintf(line, sizeof line, "%.3f | %.3f", s.experiments ? s.train_seconds / s.experiments : 0.0,
                       s.experiments ? s.cpu_seconds / s.experiments : 0.0);

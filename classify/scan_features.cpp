@@ -5,6 +5,7 @@
 // never splits on it (is_scan_descriptor()); the XGBoost baseline gets the same table and may.
 #include "classify/feature_groups.hpp"
 
+#include <algorithm>
 #include <numbers>
 
 namespace treelobes::classify {
@@ -23,9 +24,10 @@ void describe_scan(Catalogue& c) {
 // sparse voxel points, which overstated its density up to terrestrial values (1,190 points/m^2
 // for a 3 m lagerstroemia against 36-205 for other airborne trees; per disc: 36-158 against 850
 // and more for every terrestrial tree of the 480-tree set).
-void compute_scan(const TreeFrame& f, FeatureSink& out) {
-    const double disc = std::numbers::pi * f.crown_radius * f.crown_radius;
-    out.add(kScanDensityFeature, static_cast<double>(f.input_points) / disc);
+void compute_scan(std::size_t input_points, float crown_radius, FeatureSink& out) {
+    // A crown of one point or one column has no width: a disc of 0.5 m keeps the density finite.
+    const double r = std::max(crown_radius, 0.5f);
+    out.add(kScanDensityFeature, static_cast<double>(input_points) / (std::numbers::pi * r * r));
 }
 
 }  // namespace detail

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 
 namespace treelobes::classify {
@@ -22,7 +23,9 @@ void check(int status, const char* what) {
 
 struct Matrix {
     DMatrixHandle handle = nullptr;
-    Matrix(const FeatureTable& t, const std::vector<std::size_t>& rows, const std::vector<int>* labels) {
+    // Missing features (NaN) are XGBoost's missing values: each split learns their default
+    // direction. With `balance`, each tree weighs N / (K n_y), as in JointBoost.
+    Matrix(const FeatureTable& t, const std::vector<std::size_t>& rows, const std::vector<int>* labels, bool balance = false) {
         std::vector<float> data;
         data.reserve(rows.size() * t.cols());
         for (auto r : rows)
@@ -33,6 +36,14 @@ struct Matrix {
             std::vector<float> y;
             for (auto r : rows) y.push_back(static_cast<float>((*labels)[r]));
             check(XGDMatrixSetFloatInfo(handle, "label", y.data(), y.size()), "labels");
+            if (balance) {
+                std::map<int, double> count;
+                for (auto r : rows) ++count[(*labels)[r]];
+                std::vector<float> w;
+                for (auto r : rows)
+                    w.push_back(static_cast<float>(static_cast<double>(rows.size()) / (count.size() * count[(*labels)[r]])));
+                check(XGDMatrixSetFloatInfo(handle, "weight", w.data(), w.size()), "weights");
+            }
         }
     }
     ~Matrix() { XGDMatrixFree(handle); }
@@ -83,7 +94,7 @@ int choose_rounds(const FeatureTable& train, const std::vector<int>& labels, int
     std::vector<std::size_t> validation, fit;
     stratified_split(labels, classes, o.validation_fraction, o.seed, false, validation, fit);
     if (validation.empty() || o.validation_fraction <= 0) return o.max_rounds;
-    const Matrix fit_matrix(train, fit, &labels);
+    const Matrix fit_matrix(train, fit, &labels, o.balance_classes);
     const Matrix validation_matrix(train, validation, nullptr);
     Booster booster(fit_matrix, classes, o);
     std::pair<int, double> best{std::numeric_limits<int>::max(), std::numeric_limits<double>::infinity()};
@@ -113,7 +124,7 @@ XGBoostRun xgboost_train_predict(const FeatureTable& train, const std::vector<in
     XGBoostRun run;
     const auto start = std::chrono::steady_clock::now();
     run.rounds = choose_rounds(train, labels, classes, options);
-    const Matrix train_matrix(train, all_rows(train.rows()), &labels);
+    const Matrix train_matrix(train, all_rows(train.rows()), &labels, options.balance_classes);
     Booster booster(train_matrix, classes, options);
     for (int m = 0; m < run.rounds; ++m) booster.boost(train_matrix, m);
     const auto trained = std::chrono::steady_clock::now();

@@ -20,6 +20,7 @@ struct XGBoostOptions {
     int patience = 30;
     std::uint64_t seed = 1;
     int threads = 0;                   // 0 = as many as TBB may use
+    bool balance_classes = true;       // tree weights N / (K n_y), as JointBoostOptions
 };
 
 struct XGBoostRun {

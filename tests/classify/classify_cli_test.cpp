@@ -168,6 +168,25 @@ TEST_F(ClassifyCli, EvaluateWritesTheReport) {
     EXPECT_EQ(tested_total, 5 * test_trees);
 }
 
+// --train A --test B: one experiment on two folders (here the same trees twice), the crown
+// extraction reported per tree, and the usage errors of the mode.
+TEST_F(ClassifyCli, EvaluateTrainsOnOneFolderAndTestsOnAnother) {
+    TempDir dir;
+    const auto r = run_cli("classify evaluate --train " + quoted(dataset()) + " --test " + quoted(dataset()) +
+                           " --groups airborne,shape --no-xgboost --max-rounds 40 --out " + quoted(dir / "report") + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["mode"], "train_test");
+    EXPECT_EQ(summary["classifiers"]["JointBoost"]["random_splits"]["experiments"], 1);
+    EXPECT_TRUE(summary["test_species_not_trained"].empty());
+    EXPECT_GE(summary["classifiers"]["JointBoost"]["random_splits"]["tree_accuracy"].get<double>(), 0.5);
+    EXPECT_GT(summary["removed"]["ground"].get<long>(), 0) << "the synth scans hold their ground patch";
+    EXPECT_EQ(lines_of(read_file(dir / "report" / "crowns.csv")).size(), 1u + 2 * 12u);
+    EXPECT_EQ(run_cli("classify evaluate --train " + quoted(dataset()) + " --out " + quoted(dir / "r2")).exit_code, 1);
+    EXPECT_EQ(run_cli("classify evaluate " + quoted(dataset()) + " --features " + quoted(features()) + " --groups nosuch --out " +
+                      quoted(dir / "r3")).exit_code, 1);
+}
+
 TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
     ASSERT_EQ(features_run_->exit_code, 0);
     TempDir dir;

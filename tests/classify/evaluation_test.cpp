@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 
 using namespace treelobes;
@@ -303,9 +304,17 @@ TEST(ClassifyTables, FeatureCsvRoundTripsExactlyAndRejectsBadFiles) {
     EXPECT_EQ(back.ids, t.ids);
     EXPECT_EQ(back.values, t.values);
     EXPECT_EQ(back.feature_names, t.feature_names);
-    test::write_text(dir / "nan.csv", "id,a,b\nx,1,nan\n");
+    // A missing value (a feature that could not be computed) reads back as NaN; infinity is an error.
+    t.add_row("z", std::vector<double>{std::numeric_limits<double>::quiet_NaN(), 2.0});
+    write_feature_csv(t, dir / "missing.csv");
+    const auto missing = read_feature_csv(dir / "missing.csv");
+    EXPECT_TRUE(std::isnan(missing.at(2, 0)));
+    EXPECT_EQ(missing.at(2, 1), 2.0);
+    test::write_text(dir / "empty_field.csv", "id,a,b\nx,1,\n");
+    EXPECT_TRUE(std::isnan(read_feature_csv(dir / "empty_field.csv").at(0, 1)));
+    test::write_text(dir / "inf.csv", "id,a,b\nx,1,inf\n");
     try {
-        read_feature_csv(dir / "nan.csv");
+        read_feature_csv(dir / "inf.csv");
         FAIL();
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), ExitCode::InvalidInput);
@@ -375,4 +384,66 @@ TEST(ClassifyVoting, PlantingLayouts) {
         EXPECT_LE(p.y(), 16.0);
     }
     EXPECT_EQ(cells.size(), labels.size());
+}
+
+// Macro-F1, Cohen's kappa and the genus level from the confusion matrix, checked on a classifier
+// whose answer is known: always the first species. 3 species x 10 trees, 5 tested per split.
+TEST(ClassifyEvaluation, MacroF1KappaAndGenusLevel) {
+    LabelledSet set = clustered_set(3, 10, 0.1, false, 7);
+    set.class_genus = {"Quercus", "Quercus", "Acer"};
+    EvaluationOptions options;
+    options.splits = 4;
+    const auto report = evaluate(set, {always_first()}, options);
+    const Scores& s = report.classifiers[0].random_splits;
+    EXPECT_NEAR(s.tree_accuracy, 1.0 / 3, 1e-12);
+    // Species 0: precision 1/3, recall 1 -> F1 0.5; the others 0. Kappa of a constant answer: 0.
+    EXPECT_NEAR(s.macro_f1, 0.5 / 3, 1e-12);
+    EXPECT_NEAR(s.kappa, 0.0, 1e-12);
+    ASSERT_TRUE(s.genus_level);
+    EXPECT_EQ(s.genera, (std::vector<std::string>{"Acer", "Quercus"}));
+    EXPECT_NEAR(s.genus_tree_accuracy, 2.0 / 3, 1e-12);      // both oaks count as right at genus level
+    EXPECT_NEAR(s.genus_average_rate, 0.5, 1e-12);           // Quercus 100 %, Acer 0 %
+    // A perfect classifier: kappa 1, macro-F1 1.
+    const auto perfect = evaluate(set, {nearest_mean()}, options).classifiers[0].random_splits;
+    EXPECT_NEAR(perfect.kappa, 1.0, 1e-12);
+    EXPECT_NEAR(perfect.macro_f1, 1.0, 1e-12);
+    EXPECT_EQ(genus_of("Quercus rubra L."), "Quercus");
+    EXPECT_EQ(genus_of("Magnolia sp."), "Magnolia");
+    EXPECT_EQ(genus_of(""), "");
+}
+
+// Sites that share no species: the site split would test species never trained, so it does not
+// run and the report says why; sites that share species get it.
+TEST(ClassifyEvaluation, SiteSplitOnlyWhenGroupsShareSpecies) {
+    LabelledSet set = clustered_set(4, 6, 0.1, false, 3);
+    for (int y : set.labels) set.groups.push_back(y < 2 ? "north" : "south");
+    EvaluationOptions options;
+    options.splits = 2;
+    const auto apart = evaluate(set, {nearest_mean()}, options);
+    EXPECT_EQ(apart.classifiers[0].site_split.experiments, 0);
+    EXPECT_NE(apart.site_split_note.find("never trained"), std::string::npos) << apart.site_split_note;
+    set.groups.clear();
+    for (std::size_t r = 0; r < set.labels.size(); ++r) set.groups.push_back((r / 4) % 2 ? "north" : "south");  // every species in both
+    const auto shared = evaluate(set, {nearest_mean()}, options);
+    EXPECT_EQ(shared.classifiers[0].site_split.experiments, 2);
+    EXPECT_TRUE(shared.site_split_note.empty());
+}
+
+// --train A --test B: one experiment on exactly the rows given.
+TEST(ClassifyEvaluation, TrainOnOneSetTestOnAnother) {
+    const LabelledSet set = clustered_set(3, 8, 0.1, false, 5);
+    std::vector<std::size_t> train, test;
+    for (std::size_t r = 0; r < set.labels.size(); ++r) (r < 12 ? train : test).push_back(r);
+    const auto report = evaluate_train_test(set, {nearest_mean()}, train, test, {});
+    EXPECT_EQ(report.mode, "train_test");
+    const Scores& s = report.classifiers[0].random_splits;
+    EXPECT_EQ(s.experiments, 1);
+    EXPECT_NEAR(s.tree_accuracy, 1.0, 1e-12);
+    int tested = 0;
+    for (std::size_t r = 0; r < set.labels.size(); ++r)
+        for (int n : s.row_predictions[r]) {
+            tested += n;
+            EXPECT_TRUE(n == 0 || r >= 12) << "training row " << r << " was tested";
+        }
+    EXPECT_EQ(tested, 12);
 }

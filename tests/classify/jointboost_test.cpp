@@ -395,7 +395,7 @@ TEST(JointBoost, ModelFileRoundTripsAndRejectsBadFiles) {
 
 TEST(JointBoost, RejectsBadTrainingInput) {
     FeatureTable t = empty_table(2);
-    const double a[2] = {1, 2}, b[2] = {std::nan(""), 3};
+    const double a[2] = {1, 2}, b[2] = {std::numeric_limits<double>::infinity(), 3};  // NaN is a missing value, infinity an error
     t.add_row("x", a);
     t.add_row("y", a);
     EXPECT_THROW(train_jointboost(t, {0, 0}, class_names(1), {}), Error);
@@ -577,4 +577,76 @@ TEST(JointBoost, ProbabilityAveragingEnsembleKeepsItsMembersThroughTheFile) {
     ASSERT_NE(at, std::string::npos);
     test::write_text(dir / "bad.jb", std::string(text).replace(at, 13, "\"members\": 7, \"x\": ["));
     EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad.jb"); }), ExitCode::InvalidInput);
+}
+
+// Missing values (NaN: a feature that could not be computed) go to the side of the threshold that
+// fits best, learnt per stump. Class 0 trees have feature 0 missing or high, class 1 trees low:
+// one stump separates them only if the missing values go above, with the high ones.
+TEST(JointBoost, LearnsWhichSideMissingValuesGo) {
+    FeatureTable t = empty_table(2);
+    std::vector<int> y;
+    synth::Rng rng(3);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    for (int i = 0; i < 30; ++i) {
+        const double missing_or_high[2] = {i % 2 ? nan : rng.uniform(3, 4), rng.normal()};
+        const double low[2] = {rng.uniform(0, 1), rng.normal()};
+        t.add_row(test::numbered("a", static_cast<std::size_t>(i)), missing_or_high), y.push_back(0);
+        t.add_row(test::numbered("b", static_cast<std::size_t>(i)), low), y.push_back(1);
+    }
+    const JointBoostModel one = fit_jointboost_rounds(t, y, class_names(2), 1);
+    ASSERT_EQ(one.stumps.size(), 1u);
+    EXPECT_EQ(one.stumps[0].feature, 0);
+    EXPECT_TRUE(one.stumps[0].missing_above);
+    for (std::size_t r = 0; r < t.rows(); ++r) {
+        const auto p = one.probabilities(t.row(r));
+        EXPECT_EQ(p[0] > p[1] ? 0 : 1, y[r]) << t.ids[r];
+    }
+    // A new tree without feature 0 is taken for class 0; the direction survives the model file.
+    const double unseen[2] = {nan, 0.0};
+    TempDir dir;
+    save_jointboost(one, dir / "m.jb");
+    const JointBoostModel back = load_jointboost(dir / "m.jb");
+    EXPECT_TRUE(back.stumps[0].missing_above);
+    EXPECT_GT(back.probabilities(unseen)[0], 0.5);
+    EXPECT_EQ(back.probabilities(unseen), one.probabilities(unseen));
+    // The full training (cross-validated ensemble) takes the table with missing values too.
+    const JointBoostModel model = train_jointboost(t, y, class_names(2), {});
+    EXPECT_GT(model.probabilities(unseen)[0], 0.5);
+}
+
+// Class weights: with 40 trees of class 0 and 4 of class 1 whose feature overlaps, the balanced
+// model recognises the rare class better than the unweighted one, and a balanced set is unchanged.
+TEST(JointBoost, BalancedClassWeightsFavourTheRareClass) {
+    FeatureTable t = empty_table(1);
+    std::vector<int> y;
+    synth::Rng rng(8);
+    for (int i = 0; i < 40; ++i) {
+        const double v[1] = {rng.normal(0, 1)};
+        t.add_row(test::numbered("a", static_cast<std::size_t>(i)), v), y.push_back(0);
+    }
+    for (int i = 0; i < 4; ++i) {
+        const double v[1] = {rng.normal(1.5, 1)};
+        t.add_row(test::numbered("b", static_cast<std::size_t>(i)), v), y.push_back(1);
+    }
+    JointBoostOptions plain, balanced;
+    plain.folds = balanced.folds = 0;
+    plain.max_rounds = balanced.max_rounds = 3;
+    plain.balance_classes = false;
+    const auto rare_votes = [&](const JointBoostModel& m) {
+        int n = 0;
+        for (std::size_t r = 0; r < t.rows(); ++r) {
+            const auto p = m.probabilities(t.row(r));
+            n += p[1] > p[0];
+        }
+        return n;
+    };
+    EXPECT_GT(rare_votes(train_jointboost(t, y, class_names(2), balanced)), rare_votes(train_jointboost(t, y, class_names(2), plain)));
+    FeatureTable even;
+    std::vector<int> even_y;
+    gaussian_clusters(3, 2, 10, 4, even, even_y);
+    JointBoostOptions even_plain = plain, even_balanced = balanced;
+    even_plain.max_rounds = even_balanced.max_rounds = 20;
+    const auto a = train_jointboost(even, even_y, class_names(3), even_plain), b = train_jointboost(even, even_y, class_names(3), even_balanced);
+    ASSERT_EQ(a.stumps.size(), b.stumps.size());
+    for (std::size_t k = 0; k < a.stumps.size(); ++k) EXPECT_EQ(a.stumps[k].threshold, b.stumps[k].threshold);
 }
