@@ -45,5 +45,6 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job);
 
 }  // namespace treelobes::cli

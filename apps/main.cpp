@@ -42,6 +42,7 @@ int run(int argc, char** argv) {
     cli::add_synth_command(app, global, job);
     cli::add_classify_command(app, global, job);
     cli::add_lobes_commands(app, global, job);
+    cli::add_tile_command(app, global, job);
 
     try {
         app.parse(argc, argv);
