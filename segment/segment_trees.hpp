@@ -46,6 +46,7 @@ struct SegmentOptions {
     // Airborne (canopy height model and crowns).
     float chm_cell = 0.5f;               // CHM cell edge (metres)
     float point_radius = 0.15f;          // each point drawn as a disc of this radius (pit-free CHM)
+    float pit_depth = 1.0f;              // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
     float window_base = 2.0f;            // treetop window diameter at 0 m height (metres) ...
     float window_per_metre = 0.1f;       // ... plus this much per metre of height (Popescu & Wynne 2004)
     float max_window = 8.0f;             // cap of the treetop window diameter (metres)

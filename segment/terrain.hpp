@@ -3,14 +3,15 @@
 //
 // Three cases, detected in this order:
 //  - "normalised": the tile was height-normalised already (lidR's normalize_height: ground near
-//    z = 0 in the file's coordinates). The DTM is flat at global z = 0 and the height above
+//    z = 0 in the file's coordinates, and flat). The DTM is flat at global z = 0 and the height above
 //    ground is the point's global z.
 //  - "classified": the tile carries ASPRS class 2 (ground). Those points are the ground as given.
 //  - "filtered": neither; ground is found by the progressive morphological filter (Zhang et al.
 //    2003, §2) run on the lowest point of each DTM cell, then every point within
 //    `ground_tolerance` of the resulting surface counts as ground.
 // The DTM is the mean height of the ground points of each cell; cells without ground are filled
-// by inverse-distance weighting of the nearest ground cells (no holes inside the tile).
+// from the 12 nearest ground cells by a plane fitted with inverse-squared-distance weights (no
+// holes inside the tile; slopes stay slopes across holes under crowns).
 #pragma once
 
 #include "core/point_cloud.hpp"
@@ -32,8 +33,8 @@ struct TerrainOptions {
     float initial_distance = 0.3f;      // height tolerance of the smallest window (metres)
     float max_distance = 3.0f;          // height tolerance cap of the largest windows (metres)
     float ground_tolerance = 0.25f;     // points this close above (or below) the DTM surface are ground (metres)
-    // Detection of an already normalised tile: the lowest points of the occupied cells must lie
-    // within this distance of global z = 0 (metres).
+    // Detection of an already normalised tile: the lowest points of at least half of the
+    // occupied 5 m cells must lie within this distance of global z = 0 (metres), without a slope.
     float normalised_tolerance = 0.5f;
     bool use_classification = true;     // false: ignore an input class 2 and filter afresh
 };
