@@ -41,16 +41,19 @@ for s in 1 2 3; do tile "tls_$s" "$s" --trees 12 --size 30 --scanner tls --stati
 
 # row LABEL ARGS...: one table row from one segment_eval run.
 row() {
-  local label=$1
+  local label=$1 result
   shift
-  "$EVAL" "$@" | python3 -c '
+  result=$("$EVAL" "$@")
+  python3 - "$label" "$result" <<'PY'
 import json, sys
-d = json.load(sys.stdin)
+d = json.loads(sys.argv[2])
 s = d.get("score")
-score = (f"{s[\"reference_trees\"]:5d} {s[\"found_trees\"]:5d} {s[\"matched\"]:5d} {s[\"f1\"]:6.3f} {100 * s[\"points_right\"]:6.1f}"
-         if s else "    -     -     -      -      -")
-print(f"{sys.argv[1]:<34} {d[\"ground_source\"]:<10} {d[\"mode\"]:<4} {score} {d[\"seconds\"][\"total\"]:7.2f} {d[\"peak_memory_mb\"]:7.0f}")
-' "$label"
+if s:
+    score = f"{s['reference_trees']:5d} {s['found_trees']:5d} {s['matched']:5d} {s['f1']:6.3f} {100 * s['points_right']:6.1f}"
+else:
+    score = "    -     -     -      -      -"
+print(f"{sys.argv[1]:<34} {d['ground_source']:<10} {d['mode']:<4} {score} {d['seconds']['total']:7.2f} {d['peak_memory_mb']:7.0f}")
+PY
 }
 header() { printf '%-34s %-10s %-4s %5s %5s %5s %6s %6s %7s %7s\n' "$1" ground mode true found match F1 right% seconds peak_MB; }
 
@@ -65,40 +68,44 @@ for s in 1 2 3; do row "TLS, seed $s, ground filtered" "$WORK/tls_$s/tile.las" -
 echo
 echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
 header "setting"
+CONIFER=(--set min_top_prominence=0 --set chm_smoothing=0)
 row "defaults" "$DATA/lidr/MixedConifer.las" --reference treeID
-row "conifer (no crown merging/smoothing)" "$DATA/lidr/MixedConifer.las" --reference treeID --set min_top_prominence=0 --set chm_smoothing=0
+row "conifer (no crown merging/smoothing)" "$DATA/lidr/MixedConifer.las" --reference treeID "${CONIFER[@]}"
 echo "matching table (conifer setting):"
-"$EVAL" "$DATA/lidr/MixedConifer.las" --reference treeID --set min_top_prominence=0 --set chm_smoothing=0 | python3 -c '
+python3 - "$("$EVAL" "$DATA/lidr/MixedConifer.las" --reference treeID "${CONIFER[@]}")" <<'PY'
 import json, sys
-d = json.load(sys.stdin)
+d = json.loads(sys.argv[1])
 print("| height (lidR tree) | lidR trees | found | matched |")
 print("|---|---|---|---|")
 for r in d["score"]["by_height"]:
-    print(f"| {r[\"height\"]} | {r[\"reference\"]} | {r[\"found\"]} | {r[\"matched\"]} |")'
+    print(f"| {r['height']} | {r['reference']} | {r['found']} | {r['matched']} |")
+PY
 
 echo
 echo "== TreeLS pine_plot.las: stems"
-"$EVAL" "$DATA/treels/pine_plot.las" --trees | python3 -c '
+python3 - "$("$EVAL" "$DATA/treels/pine_plot.las" --trees)" <<'PY'
 import json, sys
-d = json.load(sys.stdin)
-print(f"{d[\"trees\"]} trees ({d[\"mode_reason\"]}; ground {d[\"ground_source\"]}), {d[\"seconds\"][\"total\"]:.2f} s")
+d = json.loads(sys.argv[1])
+print(f"{d['trees']} trees ({d['mode_reason']}; ground {d['ground_source']}), {d['seconds']['total']:.2f} s")
 print("| id | x | y | height m | stem diameter at 1-2 m, cm | points |")
 print("|---|---|---|---|---|---|")
 for t in d["tree_list"]:
-    print(f"| {t[\"id\"]} | {t[\"x\"]:.2f} | {t[\"y\"]:.2f} | {t[\"height\"]:.1f} | {200 * t[\"stem_radius\"]:.1f} | {t[\"points\"]} |")'
+    print(f"| {t['id']} | {t['x']:.2f} | {t['y']:.2f} | {t['height']:.1f} | {200 * t['stem_radius']:.1f} | {t['points']} |")
+PY
 
 echo
 echo "== scaling (ALS open seed 11 and its 2 x 2 and 4 x 4 copies; TLS tiles as generated)"
 printf '%-34s %9s %9s %9s %9s %8s\n' input points terrain_s segment_s total_s peak_MB
 scale() {
-  local label=$1
+  local label=$1 result
   shift
-  "$EVAL" "$@" | python3 -c '
+  result=$("$EVAL" "$@")
+  python3 - "$label" "$result" <<'PY'
 import json, sys
-d = json.load(sys.stdin)
+d = json.loads(sys.argv[2])
 t = d["seconds"]
-print(f"{sys.argv[1]:<34} {d[\"points\"]:9d} {t[\"terrain\"]:9.2f} {t[\"segment\"]:9.2f} {t[\"total\"]:9.2f} {d[\"peak_memory_mb\"]:8.0f}")
-' "$label"
+print(f"{sys.argv[1]:<34} {d['points']:9d} {t['terrain']:9.2f} {t['segment']:9.2f} {t['total']:9.2f} {d['peak_memory_mb']:8.0f}")
+PY
 }
 scale "ALS x1" "$WORK/als_open_11/tile.las"
 scale "ALS x4 (2 x 2 copies)" "$WORK/als_open_11/tile.las" --replicate 2
