@@ -1,9 +1,9 @@
 #include "forestry/measures.hpp"
 
 #include "core/error.hpp"
-#include "core/grid_thinning.hpp"
+#include "geometry/grid_thinning.hpp"
+#include "geometry/ransac_fit.hpp"
 #include "lobes/alpha_shape.hpp"
-#include "reconstruct/ransac_fit.hpp"
 
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_point.hpp>
