@@ -45,6 +45,7 @@ int run(int argc, char** argv) {
     cli::add_lobes_commands(app, global, job);
     cli::add_export_command(app, global, job);
     cli::add_rebuild_command(app, global, job);
+    cli::add_tile_command(app, global, job);
 
     try {
         app.parse(argc, argv);

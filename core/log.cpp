@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <unistd.h>
@@ -37,7 +38,7 @@ void log_debug(const std::string& message) { emit(LogLevel::Debug, "debug: ", me
 
 Progress::Progress(std::string label, std::size_t total)
     : label_(std::move(label)), total_(total), terminal_(::isatty(STDERR_FILENO) != 0),
-      last_draw_(std::chrono::steady_clock::now()) {}
+      start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
 
 Progress::~Progress() {
     if (!finished_ && done_ > 0) finish();
@@ -62,13 +63,22 @@ void Progress::finish() {
 void Progress::draw(bool final_line) {
     if (static_cast<int>(log_level()) < static_cast<int>(LogLevel::Info)) return;
     const double fraction = total_ ? static_cast<double>(done_) / static_cast<double>(total_) : 1.0;
+    // Remaining time at the mean pace so far; none before the first step or after the last.
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    std::string eta;
+    if (done_ > 0 && done_ < total_) {
+        const long remaining = std::lround(elapsed / static_cast<double>(done_) * static_cast<double>(total_ - done_));
+        char text[40];
+        std::snprintf(text, sizeof text, ", ETA %ld:%02ld", remaining / 60, remaining % 60);
+        eta = text;
+    }
     if (terminal_) {
         const int width = 30, filled = static_cast<int>(fraction * width);
-        std::fprintf(stderr, "\r%s [%s%s] %zu/%zu", label_.c_str(), std::string(filled, '#').c_str(),
-                     std::string(width - filled, ' ').c_str(), done_, total_);
+        std::fprintf(stderr, "\r%s [%s%s] %zu/%zu%s   ", label_.c_str(), std::string(filled, '#').c_str(),
+                     std::string(width - filled, ' ').c_str(), done_, total_, eta.c_str());
         if (final_line) std::fputc('\n', stderr);
     } else if (final_line || done_ < total_) {
-        std::fprintf(stderr, "treelobes: %s %zu/%zu (%.0f%%)\n", label_.c_str(), done_, total_, 100.0 * fraction);
+        std::fprintf(stderr, "treelobes: %s %zu/%zu (%.0f%%%s)\n", label_.c_str(), done_, total_, 100.0 * fraction, eta.c_str());
     }
     std::fflush(stderr);
 }

@@ -19,7 +19,8 @@ void log_warn(const std::string& message);
 void log_info(const std::string& message);
 void log_debug(const std::string& message);
 
-// Progress of a long loop: a redrawn bar on a terminal, a line every few seconds otherwise.
+// Progress of a long loop: a redrawn bar on a terminal, a line every few seconds otherwise;
+// both show the estimated time left at the pace so far.
 // Silent below LogLevel::Info. Not thread-safe: call advance() from one thread.
 class Progress {
 public:
@@ -36,6 +37,7 @@ private:
     std::size_t done_ = 0;
     bool terminal_;
     bool finished_ = false;
+    std::chrono::steady_clock::time_point start_;
     std::chrono::steady_clock::time_point last_draw_;
 };
 

@@ -28,48 +28,48 @@ View View::side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azi
 
 namespace {
 
-// Image axes of a view: right = forward x up, up = the view's up made orthogonal to forward
-// (Gram-Schmidt; +y when looking straight along the vertical).
-void image_axes(const View& view, Eigen::Vector3d& forward, Eigen::Vector3d& right, Eigen::Vector3d& up) {
-    if (!view.forward.allFinite() || view.forward.norm() == 0) throw Error::usage("render: view direction is zero");
-    forward = view.forward.normalized();
-    up = view.up - view.up.dot(forward) * forward;
-    if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY().dot(forward) * forward;
-    up.normalize();
-    right = forward.cross(up).normalized();
-}
+struct ImageAxes {
+    Eigen::Vector3d forward, right, up;
+    double half_width = 1e-9, half_height = 1e-9;  // of the view's box on the image axes
+};
 
-// Half extents of the box's corners along the image axes, around the box centre.
-Eigen::Vector2d half_extents(const View& view, const Eigen::Vector3d& right, const Eigen::Vector3d& up) {
+ImageAxes image_axes(const View& view) {
+    if (!view.forward.allFinite() || view.forward.norm() == 0) throw Error::usage("render: view direction is zero");
+    ImageAxes axes;
+    axes.forward = view.forward.normalized();
+    // Image axes: right = forward x up, up = right x forward (Gram-Schmidt against forward).
+    Eigen::Vector3d up = view.up - view.up.dot(axes.forward) * axes.forward;
+    if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY().dot(axes.forward) * axes.forward;
+    axes.up = up.normalized();
+    axes.right = axes.forward.cross(axes.up).normalized();
     const Eigen::Vector3d centre = 0.5 * (view.lo + view.hi);
-    Eigen::Vector2d half(1e-9, 1e-9);
     for (int corner = 0; corner < 8; ++corner) {
         const Eigen::Vector3d p((corner & 1) ? view.hi.x() : view.lo.x(), (corner & 2) ? view.hi.y() : view.lo.y(),
                                 (corner & 4) ? view.hi.z() : view.lo.z());
-        half.x() = std::max(half.x(), std::abs((p - centre).dot(right)));
-        half.y() = std::max(half.y(), std::abs((p - centre).dot(up)));
+        axes.half_width = std::max(axes.half_width, std::abs((p - centre).dot(axes.right)));
+        axes.half_height = std::max(axes.half_height, std::abs((p - centre).dot(axes.up)));
     }
-    return half;
+    return axes;
 }
 
 }  // namespace
 
 double View::aspect() const {
-    Eigen::Vector3d forward, right, image_up;
-    image_axes(*this, forward, right, image_up);
-    const Eigen::Vector2d half = half_extents(*this, right, image_up);
-    return half.x() / half.y();
+    const ImageAxes axes = image_axes(*this);
+    return axes.half_width / axes.half_height;
 }
 
 Rasterizer::Rasterizer(int width, int height, const View& view, Rgba background)
     : image_(width, height, background),
       depth_(static_cast<std::size_t>(width) * height, std::numeric_limits<double>::infinity()) {
-    image_axes(view, forward_, right_, up_);
+    const ImageAxes axes = image_axes(view);
+    forward_ = axes.forward;
+    up_ = axes.up;
+    right_ = axes.right;
     centre_ = 0.5 * (view.lo + view.hi);
     // Extent of the box's corners on the image axes decides the scale.
-    const Eigen::Vector2d half = half_extents(view, right_, up_);
     const double usable = 1.0 - 2.0 * view.margin;
-    scale_ = std::min(width * usable / (2 * half.x()), height * usable / (2 * half.y()));
+    scale_ = std::min(width * usable / (2 * axes.half_width), height * usable / (2 * axes.half_height));
 }
 
 Eigen::Vector3d Rasterizer::project(const Eigen::Vector3d& world) const {

@@ -1,0 +1,414 @@
+// `treelobes tile INPUT --out DIR`: a LiDAR tile in, every tree out. Terrain (ground, DTM,
+// height above ground) and tree segmentation (segment/), then every tree through the per-tree
+// pipeline (forestry/tree_pipeline.hpp: skeleton, lobes, DBF6, measures, species) in its own
+// error boundary, then the tile's tables, points, forest file and pictures (docs/tile.md).
+// Finished outputs are kept on a re-run unless --overwrite (trees whose record and files exist
+// are read back instead of made again).
+#include "apps/command.hpp"
+#include "apps/summary_values.hpp"
+#include "classify/jointboost.hpp"
+#include "core/atomic_file.hpp"
+#include "core/cloud_io.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/mesh_io.hpp"
+#include "core/skeleton_io.hpp"
+#include "core/version.hpp"
+#include "encode/forest_file.hpp"
+#include "forestry/tile_trees.hpp"
+#include "forestry/tree_pipeline.hpp"
+#include "render/tile_map.hpp"
+#include "segment/segment_trees.hpp"
+#include "segment/terrain.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <optional>
+
+namespace fs = std::filesystem;
+
+namespace treelobes::cli {
+
+namespace {
+
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+struct TileCliOptions {
+    std::string input;
+    std::string out;
+    std::string mode = "auto";
+    bool use_input_segmentation = false;
+    bool overwrite = false;
+    std::string model;
+    classify::VotingOptions voting;
+    TerrainOptions terrain;
+    SegmentOptions segment;
+    forestry::TreePipelineOptions trees;
+    std::string outlier_test = "auto";
+    int map_px = 1600;
+};
+
+// Names of the outputs in DIR (docs/tile.md).
+struct TileOutputs {
+    fs::path dir, points, csv, geojson, forest, dtm, hillshade, map, summary, failures, trees;
+    explicit TileOutputs(const fs::path& out)
+        : dir(out), points(out / "points.las"), csv(out / "trees.csv"), geojson(out / "trees.geojson"), forest(out / "tile.forest"),
+          dtm(out / "dtm.asc"), hillshade(out / "hillshade.png"), map(out / "top_view.png"), summary(out / "summary.json"),
+          failures(out / "failures.jsonl"), trees(out / "trees") {}
+    fs::path tree_file(int id, const std::string& suffix) const {
+        char name[32];
+        std::snprintf(name, sizeof name, "tree_%04d", id);
+        return trees / (name + suffix);
+    }
+};
+
+const char* kSkeletonSuffix = "_skeleton.ply";
+const char* kBranchesSuffix = "_branches.ply";
+const char* kTlobeSuffix = ".tlobe";
+const char* kDbf6Suffix = ".dbf6";
+const char* kRecordSuffix = ".json";
+
+double seconds_since(Clock::time_point& mark) {
+    const auto now = Clock::now();
+    const double s = std::chrono::duration<double>(now - mark).count();
+    mark = now;
+    return s;
+}
+
+// The resolved options that shape the outputs (summary.json records them; the per-tree part is
+// the key that lets a re-run reuse a finished tree).
+json tree_options_json(const TileCliOptions& o) {
+    const auto& t = o.trees;
+    return {{"min_tree_points", t.min_points},
+            {"outlier_test", o.outlier_test},
+            {"beta", t.reconstruct.skeleton.beta},
+            {"gamma", t.reconstruct.allometry.gamma},
+            {"fs", t.reconstruct.allometry.fs},
+            {"alpha_factor", t.lobes.alpha.alpha_factor},
+            {"lobe_shape_points", t.lobes.max_shape_points},
+            {"dbf6_resolution", t.dbf6.encode.resolution},
+            {"dbf6_lods", t.dbf6.lods},
+            {"breast_height", t.dbh.breast_height},
+            {"crown_alpha_factor", t.crown.alpha_factor},
+            {"model", o.model}};
+}
+
+json options_json(const TileCliOptions& o, const TreeSegmentation& segmentation) {
+    return {{"mode", o.mode},
+            {"mode_used", o.use_input_segmentation ? "input" : scan_mode_name(segmentation.mode_used)},
+            {"mode_reason", o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason},
+            {"use_input_segmentation", o.use_input_segmentation},
+            {"dtm_cell", o.terrain.cell_size},
+            {"min_tree_height", o.segment.min_tree_height},
+            {"vote_radius", o.voting.radius_m},
+            {"vote_confidence", o.voting.confidence_factor},
+            {"trees", tree_options_json(o)}};
+}
+
+// Per-point tree ids: the input's treeID (--use-input-segmentation) or a fresh segmentation, in
+// which case an input treeID is kept as `treeID_input`.
+std::vector<std::int32_t> input_tree_ids(const PointCloud& cloud, const std::string& input) {
+    const ExtraAttribute* attribute = cloud.extra("treeID");
+    if (!attribute)
+        throw Error::input(input, "--use-input-segmentation: the input has no treeID attribute (LAS extra bytes or PLY scalar_treeID)");
+    std::vector<std::int32_t> ids;
+    ids.reserve(cloud.size());
+    for (double v : attribute->values) ids.push_back(std::isfinite(v) && v > 0 && v < 2147483647.0 ? static_cast<std::int32_t>(v) : 0);
+    return ids;
+}
+
+// The input points with treeID, classification (2 = ground) and HeightAboveGround.
+PointCloud labelled_points(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::int32_t>& tree_id, bool fresh_segmentation) {
+    PointCloud out = cloud;
+    if (fresh_segmentation)
+        if (ExtraAttribute* old = out.extra("treeID")) {
+            old->name = "treeID_input";
+            old->description = "treeID of the input";
+        }
+    ExtraAttribute& ids = out.add_extra("treeID", AttributeType::Int32);
+    ids.description = "tree id, 0 = no tree";
+    ids.values.assign(tree_id.begin(), tree_id.end());
+    ExtraAttribute& hag = out.add_extra("HeightAboveGround", AttributeType::Float32);
+    hag.description = "height above the DTM (m)";
+    hag.values.assign(terrain.height_above_ground.begin(), terrain.height_above_ground.end());
+    if (out.classification.empty()) out.classification.assign(out.size(), 1);  // ASPRS 1: unclassified
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        if (terrain.is_ground[i]) out.classification[i] = 2;
+        else if (out.classification[i] == 2) out.classification[i] = 1;  // no longer ground by the DTM
+    }
+    return out;
+}
+
+void write_tree_products(const TileOutputs& out, const forestry::TreeOutcome& outcome, const forestry::TreeProducts& products) {
+    write_skeleton_ply(products.skeleton, out.tree_file(outcome.id, kSkeletonSuffix));
+    write_mesh(products.branches, out.tree_file(outcome.id, kBranchesSuffix));
+    write_file_atomically(out.tree_file(outcome.id, kTlobeSuffix), products.tlobe);
+    write_file_atomically(out.tree_file(outcome.id, kDbf6Suffix),
+                          std::string(products.dbf6.begin(), products.dbf6.end()));
+}
+
+bool tree_files_exist(const TileOutputs& out, int id) {
+    for (const char* suffix : {kSkeletonSuffix, kBranchesSuffix, kTlobeSuffix, kDbf6Suffix, kRecordSuffix})
+        if (!fs::exists(out.tree_file(id, suffix))) return false;
+    return true;
+}
+
+// A finished tree of an earlier run with the same options and points, read back.
+std::optional<forestry::TreeOutcome> finished_tree(const TileOutputs& out, const forestry::TreeInput& tree, const std::string& key,
+                                                   std::size_t& lobes) {
+    if (!tree_files_exist(out, tree.id)) return std::nullopt;
+    const auto row = forestry::read_tree_record(read_file(out.tree_file(tree.id, kRecordSuffix)), key);
+    if (!row || row->measures.points != tree.points.size()) return std::nullopt;
+    forestry::TreeOutcome outcome;
+    outcome.id = tree.id;
+    outcome.ok = true;
+    outcome.measures = row->measures;
+    outcome.skeleton = read_skeleton_ply(out.tree_file(tree.id, kSkeletonSuffix));
+    lobes = row->lobes;
+    return outcome;
+}
+
+// Species names and confidences after spatial voting over the tile.
+void assign_species(std::vector<forestry::TreeRow>& rows, const std::vector<forestry::TreeOutcome>& outcomes,
+                    const std::vector<std::size_t>& row_of, const classify::JointBoostModel& model, const classify::VotingOptions& voting) {
+    const std::vector<int> voted = forestry::vote_species(outcomes, voting);
+    for (std::size_t i = 0; i < outcomes.size(); ++i) {
+        if (voted[i] < 0 || row_of[i] == SIZE_MAX) continue;
+        forestry::TreeRow& row = rows[row_of[i]];
+        row.species = model.classes.at(static_cast<std::size_t>(voted[i]));
+        row.species_confidence = outcomes[i].measures.species_probabilities.at(static_cast<std::size_t>(voted[i]));
+    }
+}
+
+// Writes `path` with `write` unless it exists and --overwrite is off; says which.
+template <typename Write>
+bool write_output(const fs::path& path, bool overwrite, Write&& write) {
+    if (!overwrite && fs::exists(path)) {
+        log_info(path.string() + " exists, kept (use --overwrite to redo)");
+        return false;
+    }
+    write();
+    return true;
+}
+
+std::string dbh_counts(const std::vector<forestry::TreeRow>& rows, json& counts) {
+    std::map<std::string, int> by_quality{{"ok", 0}, {"partial_arc", 0}, {"not_visible", 0}};
+    for (const auto& row : rows) ++by_quality[forestry::dbh_quality_name(row.measures.dbh.quality)];
+    counts = by_quality;
+    return std::to_string(by_quality["ok"]) + " ok, " + std::to_string(by_quality["partial_arc"]) + " partial arc, " +
+           std::to_string(by_quality["not_visible"]) + " not visible";
+}
+
+int run_tile(TileCliOptions& o, const GlobalOptions& global) {
+    const auto start = Clock::now();
+    auto mark = start;
+    json seconds = json::object();
+    o.segment.mode = parse_scan_mode(o.mode);
+    o.trees.reconstruct.preprocess.outlier_test = parse_outlier_test(o.outlier_test);
+    o.trees.reconstruct.preprocess.ground = GroundMode::Keep;  // the terrain stage removed the ground already
+    std::optional<classify::JointBoostModel> model;
+    if (!o.model.empty()) {
+        model = classify::load_jointboost(o.model);
+        o.trees.model = &*model;
+    }
+    const TileOutputs out(o.out);
+    std::error_code ec;
+    fs::create_directories(out.trees, ec);
+    if (!fs::is_directory(out.trees)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
+
+    const PointCloud cloud = read_point_cloud(o.input);
+    if (cloud.empty()) throw Error::input(o.input, "the tile holds no points");
+    if (cloud.georef.empty()) log_warn(o.input + ": no CRS in the input; outputs keep its coordinates without one");
+    seconds["read"] = rounded(seconds_since(mark));
+
+    const Terrain terrain = analyse_terrain(cloud, o.terrain);
+    seconds["terrain"] = rounded(seconds_since(mark));
+    TreeSegmentation segmentation;
+    std::map<int, Eigen::Vector3d> bases;
+    if (o.use_input_segmentation) {
+        segmentation.tree_id = input_tree_ids(cloud, o.input);
+    } else {
+        segmentation = segment_trees(cloud, terrain, o.segment);
+        for (const auto& tree : segmentation.trees) bases[tree.id] = tree.base.cast<double>();
+    }
+    std::vector<forestry::TreeInput> trees = forestry::split_trees(cloud, segmentation.tree_id, terrain.height_above_ground, bases);
+    seconds["segmentation"] = rounded(seconds_since(mark));
+    if (trees.empty()) log_warn(o.input + ": no trees found (" + std::to_string(terrain.ground_points) + " of " + std::to_string(cloud.size()) +
+                                " points are ground); the outputs list none");
+
+    // Trees finished by an earlier run are read back; the others go through the pipeline.
+    const json options = options_json(o, segmentation);
+    const std::string key = tree_options_json(o).dump();
+    std::vector<forestry::TreeOutcome> outcomes(trees.size());
+    std::vector<std::size_t> lobe_counts(trees.size(), 0);
+    std::vector<forestry::TreeInput> todo;
+    std::vector<std::size_t> todo_index;
+    for (std::size_t i = 0; i < trees.size(); ++i) {
+        std::optional<forestry::TreeOutcome> done = o.overwrite ? std::nullopt : finished_tree(out, trees[i], key, lobe_counts[i]);
+        if (done) {
+            outcomes[i] = std::move(*done);
+        } else {
+            todo.push_back(std::move(trees[i]));
+            todo_index.push_back(i);
+        }
+    }
+    const std::size_t reused = trees.size() - todo.size();
+    if (reused > 0) log_info(std::to_string(reused) + " trees finished by an earlier run are kept (use --overwrite to redo them)");
+    std::map<int, std::size_t> position_of;
+    for (std::size_t k = 0; k < todo.size(); ++k) position_of[todo[k].id] = todo_index[k];
+    json stage_seconds = json::object();
+    {
+        Progress progress("trees", todo.size());
+        const auto made = forestry::process_trees(todo, o.trees, [&](const forestry::TreeOutcome& outcome, const forestry::TreeProducts* products) {
+            if (products) {
+                write_tree_products(out, outcome, *products);
+                lobe_counts[position_of.at(outcome.id)] = products->lobes;
+            }
+            for (const auto& [stage, s] : outcome.seconds) stage_seconds[stage] = stage_seconds.value(stage, 0.0) + s;
+            progress.advance();
+        });
+        progress.finish();
+        for (std::size_t k = 0; k < made.size(); ++k) outcomes[todo_index[k]] = made[k];
+    }
+    todo.clear();
+    seconds["trees"] = rounded(seconds_since(mark));
+    for (auto& [stage, s] : stage_seconds.items()) s = rounded(s.get<double>());
+    seconds["tree_stages_summed"] = stage_seconds;
+
+    // Rows of the finished trees (ids ascending), species by spatial voting, failures.
+    std::vector<forestry::TreeRow> rows;
+    std::vector<std::size_t> row_of(outcomes.size(), SIZE_MAX);
+    json failures = json::array();
+    std::vector<encode::ForestTree> forest;
+    std::vector<render::TileMapStem> stems;
+    for (std::size_t i = 0; i < outcomes.size(); ++i) {
+        const auto& outcome = outcomes[i];
+        if (!outcome.ok) {
+            failures.push_back({{"tree_id", outcome.id}, {"reason", outcome.failure}, {"exit_code", static_cast<int>(outcome.failure_code)}});
+            continue;
+        }
+        row_of[i] = rows.size();
+        rows.push_back({outcome.measures, {}, std::nullopt, lobe_counts[i]});
+        stems.push_back({outcome.id, outcome.measures.position});
+        encode::ForestTree placed;
+        placed.skeleton = outcome.skeleton;
+        const Eigen::Vector3d root = placed.skeleton.origin + placed.skeleton.nodes[0].position.cast<double>();
+        placed.skeleton.origin = -placed.skeleton.nodes[0].position.cast<double>();
+        placed.position = root;
+        placed.name = "tree_" + std::to_string(outcome.id);
+        forest.push_back(std::move(placed));
+    }
+    if (model) assign_species(rows, outcomes, row_of, *model, o.voting);
+    for (std::size_t i : todo_index)  // after the tree's files: a record marks a finished tree
+        if (row_of[i] != SIZE_MAX)
+            write_file_atomically(out.tree_file(outcomes[i].id, kRecordSuffix), forestry::tree_record(rows[row_of[i]], cloud.origin, key));
+    seconds["species"] = rounded(seconds_since(mark));
+
+    // Tile outputs.
+    write_output(out.points, o.overwrite, [&] {
+        write_las(labelled_points(cloud, terrain, segmentation.tree_id, !o.use_input_segmentation), out.points);
+    });
+    write_file_atomically(out.csv, forestry::trees_csv(rows, cloud.origin));
+    write_file_atomically(out.geojson, forestry::trees_geojson(rows, cloud.origin, cloud.georef.crs_wkt));
+    encode::write_forest_file(forest, o.trees.dbf6, out.forest);
+    write_output(out.dtm, o.overwrite, [&] { write_ascii_grid(terrain.dtm, cloud.origin, out.dtm); });
+    write_output(out.hillshade, o.overwrite, [&] { write_hillshade_png(terrain.dtm, out.hillshade); });
+    write_output(out.map, o.overwrite, [&] {
+        render::TileMapOptions map;
+        map.max_side_px = o.map_px;
+        render::write_png(render::draw_tile_map(cloud, segmentation.tree_id, terrain.height_above_ground, stems, map), out.map);
+    });
+    if (!failures.empty()) {
+        std::string lines;
+        for (const auto& f : failures) lines += f.dump() + "\n";
+        write_file_atomically(out.failures, lines);
+    } else {
+        fs::remove(out.failures, ec);  // a failure list of an earlier run no longer holds
+    }
+    seconds["outputs"] = rounded(seconds_since(mark));
+    seconds["total"] = rounded(std::chrono::duration<double>(Clock::now() - start).count());
+
+    json dbh = json::object();
+    const std::string dbh_text = dbh_counts(rows, dbh);
+    std::size_t tree_points = 0;
+    for (const auto& row : rows) tree_points += row.measures.points;
+    const json summary = {
+        {"treelobes", kVersion},
+        {"command", "tile"},
+        {"input", o.input},
+        {"out", o.out},
+        {"options", options},
+        {"counts", {{"points", cloud.size()}, {"non_finite_dropped", cloud.source.dropped_non_finite},
+                    {"ground_points", terrain.ground_points}, {"ground_source", terrain.ground_source},
+                    {"tree_points", tree_points}, {"trees_found", outcomes.size()}, {"trees", rows.size()},
+                    {"trees_reused", reused}, {"trees_failed", failures.size()}, {"dbh", dbh}}},
+        {"crs", cloud.georef.empty() ? json(nullptr) : json(cloud.georef.crs_wkt)},
+        {"outputs", {{"points", out.points.string()}, {"trees_csv", out.csv.string()}, {"trees_geojson", out.geojson.string()},
+                     {"forest", out.forest.string()}, {"dtm", out.dtm.string()}, {"hillshade", out.hillshade.string()},
+                     {"top_view", out.map.string()}, {"trees", out.trees.string()},
+                     {"failures", failures.empty() ? json(nullptr) : json(out.failures.string())}}},
+        {"seconds", seconds},
+        {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
+    write_file_atomically(out.summary, summary.dump(2) + "\n");
+    if (global.json) {
+        std::cout << summary.dump(2) << "\n";
+    } else {
+        const std::string failure_note = failures.empty() ? "" : " (" + out.failures.string() + ")";
+        std::printf("%s: %zu points, %zu ground (%s); %s segmentation: %zu trees found, %zu modelled, %zu failed%s\n", o.input.c_str(),
+                    cloud.size(), terrain.ground_points, terrain.ground_source.c_str(), options["mode_used"].get<std::string>().c_str(),
+                    outcomes.size(), rows.size(), failures.size(), failure_note.c_str());
+        std::printf("DBH: %s; %.1f s, peak memory %.0f MB\n", dbh_text.c_str(), seconds["total"].get<double>(), peak_memory_mb());
+        std::printf("trees: %s and %s; picture: %s\n", out.csv.string().c_str(), out.geojson.string().c_str(), out.map.string().c_str());
+    }
+    return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
+}
+
+}  // namespace
+
+void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
+    auto o = std::make_shared<TileCliOptions>();
+    // A tile has hundreds of trees: lobes from at most 2,000 grid-thinned points each (the single-tree
+    // `lobes` command takes 6,000), which keeps the alpha shapes, the slowest per-tree stage, affordable.
+    o->trees.lobes.max_shape_points = 2000;
+    CLI::App* sub = app.add_subcommand(
+        "tile", "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
+                "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
+    sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, PLY, PCD or XYZ/CSV (decompress LAZ first)")->required();
+    sub->add_option("--out", o->out, "Output folder")->required();
+    sub->add_option("--mode", o->mode, "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
+                                       "paths) or auto (from the point density)")
+        ->check(CLI::IsMember({"auto", "als", "tls"}))->capture_default_str();
+    sub->add_flag("--use-input-segmentation", o->use_input_segmentation,
+                  "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
+    sub->add_option("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");
+    sub->add_option("--vote-radius", o->voting.radius_m, "Spatial voting neighbourhood, metres")->check(NonNegativeNumber)->capture_default_str();
+    sub->add_option("--vote-confidence", o->voting.confidence_factor, "A tree is confident when h1 > factor * h2")
+        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
+    sub->add_option("--dtm-cell", o->terrain.cell_size, "DTM cell size, metres")->check(PositiveNumber)->capture_default_str();
+    sub->add_option("--min-tree-height", o->segment.min_tree_height, "Lower tops are not trees, metres above ground")
+        ->check(PositiveNumber)->capture_default_str();
+    sub->add_option("--min-tree-points", o->trees.min_points, "Trees with fewer points fail (listed in failures.jsonl)")
+        ->check(CLI::Range(10, 100000000))->capture_default_str();
+    sub->add_option("--outlier-test", o->outlier_test, "Outlier test of the per-tree reconstruction: auto, global, local")
+        ->check(CLI::IsMember({"auto", "global", "local"}))->capture_default_str();
+    sub->add_option("--lobe-shape-points", o->trees.lobes.max_shape_points, "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
+        ->check(CLI::Range(100, 10000000))->capture_default_str();
+    sub->add_option("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")
+        ->check(CLI::Range(1.0, 64.0))->capture_default_str();
+    sub->add_option("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16))->capture_default_str();
+    sub->add_option("--map-size", o->map_px, "Longer side of top_view.png, pixels")->check(CLI::Range(200, 20000))->capture_default_str();
+    sub->add_flag("--overwrite", o->overwrite, "Redo outputs and trees that exist from an earlier run");
+    sub->callback([o, &global, &job] { job = [o, &global] { return run_tile(*o, global); }; });
+}
+
+}  // namespace treelobes::cli

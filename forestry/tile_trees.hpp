@@ -1,0 +1,53 @@
+// From a labelled tile to per-tree inputs, and the per-tree table that `treelobes tile` writes
+// (trees.csv, trees.geojson, and one JSON record per tree that lets a re-run skip it).
+#pragma once
+
+#include "forestry/tree_pipeline.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace treelobes::forestry {
+
+// Stem base of a tree (local frame) from its points and their heights above ground, for trees
+// whose segmentation gave none (an input treeID): when the scan reaches down to the stem (the
+// lowest point within `stem_reach` m of the ground), the median x, y of the points of the lowest
+// metre; otherwise (a crown seen from above) the x, y of the highest point. z is the terrain
+// there: the median of z - HAG of the points within 1 m horizontally (of all points when none).
+Eigen::Vector3d estimate_stem_base(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
+                                   float stem_reach = 2.0f);
+
+// One TreeInput per tree id > 0, ids ascending, each with the positions (no other attributes)
+// and heights of its points. Trees in `bases` take that base, others estimate_stem_base.
+// Throws Error(Internal) for mismatched sizes.
+std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std::int32_t> tree_id,
+                                   std::span<const float> height_above_ground, const std::map<int, Eigen::Vector3d>& bases);
+
+// A finished tree as the tables show it.
+struct TreeRow {
+    TreeMeasures measures;
+    std::string species;                      // voted species; empty without a model
+    std::optional<double> species_confidence; // the tree's own probability of that species
+    std::size_t lobes = 0;
+};
+
+// trees.csv: header then one row per tree; global coordinates (origin added) to the millimetre;
+// measures that are not available are empty cells. docs/tile.md lists the columns.
+std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin);
+// trees.geojson: a FeatureCollection of points (x, y, z in the tile's CRS) with the csv's values
+// as properties (null when not available); the tile's CRS as WKT in a "crs_wkt" member when known.
+std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin, const std::string& crs_wkt);
+
+// The record of one finished tree (trees/tree_<id>.json): its row in full precision plus the
+// options key it was made with. read_tree_record returns nullopt when the text is not such a
+// record or was made with another key (the tree is then processed again).
+std::string tree_record(const TreeRow& row, const Eigen::Vector3d& origin, const std::string& options_key);
+std::optional<TreeRow> read_tree_record(const std::string& text, const std::string& options_key);
+
+}  // namespace treelobes::forestry

@@ -1,0 +1,140 @@
+#include "forestry/tree_pipeline.hpp"
+
+#include "classify/feature_table.hpp"
+#include "classify/jointboost.hpp"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+
+namespace treelobes::forestry {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point& mark) {
+    const auto now = Clock::now();
+    const double s = std::chrono::duration<double>(now - mark).count();
+    mark = now;
+    return s;
+}
+
+std::string tree_name(int id) { return "tree " + std::to_string(id); }
+
+// The stem base: the DBH circle's centre when one was fitted (the stem itself), else the
+// segmentation's base; z stays the segmentation's (the terrain under the stem).
+Eigen::Vector3d stem_position(const TreeInput& tree, const DbhMeasure& dbh) {
+    Eigen::Vector3d p = tree.base;
+    if (dbh.diameter) p.head<2>() = dbh.centre;
+    return p;
+}
+
+std::vector<double> species_probabilities(const PointCloud& cloud, const TreePipelineOptions& options, const std::string& name) {
+    const std::vector<double> values = classify::compute_features(cloud, options.features, name);
+    classify::FeatureTable table;
+    table.feature_names = classify::feature_names();
+    table.add_row(name, values);
+    const classify::FeatureTable row = table.select_columns(options.model->feature_names, name);
+    return options.model->probabilities(row.row(0));
+}
+
+}  // namespace
+
+TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& options, TreeProducts& products) {
+    const std::string name = tree_name(tree.id);
+    if (tree.points.size() != tree.height_above_ground.size())
+        throw Error(ExitCode::Internal, name + ": one height above ground per point expected");
+    if (tree.points.size() < options.min_points)
+        throw Error::input(name, std::to_string(tree.points.size()) + " points, fewer than the " + std::to_string(options.min_points) +
+                                     " a tree model needs (--min-tree-points)");
+    TreeOutcome outcome;
+    outcome.id = tree.id;
+    auto mark = Clock::now();
+
+    const TreeReconstruction reconstruction = reconstruct_tree(tree.points, options.reconstruct, name);
+    outcome.seconds.emplace_back("reconstruct", seconds_since(mark));
+    products.skeleton = reconstruction.skeleton;
+    products.branches = build_branch_mesh(reconstruction.skeleton, options.mesh);
+    outcome.seconds.emplace_back("branch mesh", seconds_since(mark));
+
+    const lobes::LobeTree lobe_tree = lobes::build_lobe_tree(tree.points, reconstruction, options.reconstruct, {}, options.lobes);
+    products.tlobe = lobes::encode_tlobe(lobe_tree, options.tlobe);
+    products.lobes = lobe_tree.lobes.size();
+    outcome.seconds.emplace_back("lobes", seconds_since(mark));
+
+    const encode::StoredTree stored = encode::store_tree(reconstruction.skeleton, options.dbf6, name);
+    products.dbf6 = encode::write_tree_file_bytes(stored);
+    outcome.seconds.emplace_back("dbf6", seconds_since(mark));
+
+    TreeMeasures& m = outcome.measures;
+    m.id = tree.id;
+    m.points = tree.points.size();
+    m.height = *std::max_element(tree.height_above_ground.begin(), tree.height_above_ground.end());
+    m.dbh = measure_dbh(tree.points.positions, tree.height_above_ground, tree.base, options.dbh);
+    m.position = stem_position(tree, m.dbh);
+    m.crown = measure_crown(tree.points.positions, tree.height_above_ground, m.position, options.crown);
+    m.woody_volume = woody_volume(reconstruction.skeleton);
+    outcome.seconds.emplace_back("measures", seconds_since(mark));
+
+    if (options.model) {
+        m.species_probabilities = species_probabilities(tree.points, options, name);
+        outcome.seconds.emplace_back("species", seconds_since(mark));
+    }
+    outcome.skeleton = reconstruction.skeleton;
+    outcome.ok = true;
+    return outcome;
+}
+
+std::vector<TreeOutcome> process_trees(std::span<const TreeInput> trees, const TreePipelineOptions& options, const TreeDone& done) {
+    std::vector<TreeOutcome> outcomes(trees.size());
+    std::mutex report;
+    // Large trees first: the slowest work starts early, so the last thread does not wait alone.
+    std::vector<std::size_t> order(trees.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return trees[a].points.size() > trees[b].points.size(); });
+    tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t k) {
+        const std::size_t i = order[k];
+        TreeProducts products;
+        TreeOutcome outcome;
+        try {
+            outcome = process_tree(trees[i], options, products);
+        } catch (const Error& e) {
+            outcome = {};
+            outcome.failure = e.what();
+            outcome.failure_code = e.code();
+        } catch (const std::exception& e) {  // a bug in one tree must not lose the tile: reported as internal
+            outcome = {};
+            outcome.failure = std::string("internal error: ") + e.what();
+            outcome.failure_code = ExitCode::Internal;
+        }
+        outcome.id = trees[i].id;
+        {
+            const std::lock_guard lock(report);
+            if (done) done(outcome, outcome.ok ? &products : nullptr);
+        }
+        outcomes[i] = std::move(outcome);
+    });
+    return outcomes;
+}
+
+std::vector<int> vote_species(const std::vector<TreeOutcome>& outcomes, const classify::VotingOptions& options) {
+    std::vector<std::vector<double>> probabilities;
+    std::vector<Eigen::Vector2d> positions;
+    std::vector<std::size_t> index;
+    for (std::size_t i = 0; i < outcomes.size(); ++i) {
+        if (!outcomes[i].ok || outcomes[i].measures.species_probabilities.empty()) continue;
+        probabilities.push_back(outcomes[i].measures.species_probabilities);
+        positions.push_back(outcomes[i].measures.position.head<2>());
+        index.push_back(i);
+    }
+    std::vector<int> voted(outcomes.size(), -1);
+    if (probabilities.empty()) return voted;
+    const classify::VotingResult vote = classify::spatial_vote(probabilities, positions, options);
+    for (std::size_t k = 0; k < index.size(); ++k) voted[index[k]] = vote.species[k];
+    return voted;
+}
+
+}  // namespace treelobes::forestry

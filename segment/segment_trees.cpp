@@ -1,0 +1,628 @@
+#include "segment/segment_trees.hpp"
+
+#include "core/error.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/neighbour_graph.hpp"
+#include "geometry/ransac_fit.hpp"
+#include "geometry/shortest_paths.hpp"
+#include "geometry/union_find.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <limits>
+#include <optional>
+#include <queue>
+#include <tuple>
+#include <unordered_map>
+
+namespace treelobes {
+
+namespace {
+
+constexpr std::uint8_t kLowNoiseClass = 7, kHighNoiseClass = 18;
+
+void validate(const SegmentOptions& o) {
+    const auto positive = [](float v, const char* name) {
+        if (!(v > 0.0f) || !std::isfinite(v)) throw Error::usage(std::string("segment: ") + name + " must be > 0");
+    };
+    const auto share = [](float v, const char* name) {
+        if (!(v >= 0.0f && v <= 1.0f)) throw Error::usage(std::string("segment: ") + name + " must be in 0..1");
+    };
+    if (!(o.min_tree_height >= 0.0f) || !std::isfinite(o.min_tree_height)) throw Error::usage("segment: min tree height must be >= 0");
+    positive(o.terrestrial_density, "terrestrial density");
+    positive(o.chm_cell, "CHM cell");
+    if (!(o.point_radius >= 0.0f) || !std::isfinite(o.point_radius)) throw Error::usage("segment: point radius must be >= 0");
+    positive(o.pit_depth, "pit depth");
+    if (!(o.chm_smoothing >= 0.0f) || !std::isfinite(o.chm_smoothing)) throw Error::usage("segment: CHM smoothing must be >= 0");
+    positive(o.window_base, "window base");
+    if (!(o.window_per_metre >= 0.0f) || !std::isfinite(o.window_per_metre)) throw Error::usage("segment: window per metre must be >= 0");
+    positive(o.max_window, "max window");
+    if (!(o.min_top_prominence >= 0.0f) || !std::isfinite(o.min_top_prominence)) throw Error::usage("segment: min top prominence must be >= 0");
+    share(o.top_prominence_ratio, "top prominence ratio");
+    share(o.merge_pass_ratio, "merge pass ratio");
+    share(o.seed_ratio, "seed ratio");
+    share(o.crown_ratio, "crown ratio");
+    positive(o.max_crown_radius, "max crown radius");
+    if (!(o.stem_slice_high > o.stem_slice_low) || !std::isfinite(o.stem_slice_low) || !std::isfinite(o.stem_slice_high))
+        throw Error::usage("segment: the stem slice needs low < high");
+    positive(o.stem_cluster_distance, "stem cluster distance");
+    if (o.min_stem_points < 5) throw Error::usage("segment: min stem points must be >= 5");
+    positive(o.min_stem_radius, "min stem radius");
+    if (!(o.max_stem_radius > o.min_stem_radius)) throw Error::usage("segment: max stem radius must exceed min stem radius");
+    positive(o.circle_tolerance, "circle tolerance");
+    share(o.min_circle_inliers, "min circle inliers");
+    share(o.min_arc_coverage, "min arc coverage");
+    if (!(o.max_stem_lean >= 0.0f && o.max_stem_lean < 90.0f)) throw Error::usage("segment: max stem lean must be in 0..90 degrees");
+    positive(o.graph_voxel, "graph voxel");
+    if (o.graph_neighbours < 2 || o.graph_neighbours > 64) throw Error::usage("segment: graph neighbours must be in 2..64");
+    positive(o.max_gap, "max gap");
+    positive(o.graph_beta, "graph beta");
+    if (!(o.ground_clearance >= 0.0f) || !std::isfinite(o.ground_clearance)) throw Error::usage("segment: ground clearance must be >= 0");
+}
+
+std::string format(const char* pattern, double a, double b = 0, double c = 0) {
+    char text[256];
+    std::snprintf(text, sizeof text, pattern, a, b, c);
+    return text;
+}
+
+// Points that may belong to a tree: not ground, not noise, at least `clearance` above the DTM.
+std::vector<std::uint8_t> vegetation_points(const PointCloud& cloud, const Terrain& terrain, float clearance) {
+    std::vector<std::uint8_t> keep(cloud.size(), 0);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const bool noise = !cloud.classification.empty() &&
+                           (cloud.classification[i] == kLowNoiseClass || cloud.classification[i] == kHighNoiseClass);
+        keep[i] = !noise && !terrain.is_ground[i] && terrain.height_above_ground[i] >= clearance;
+    }
+    return keep;
+}
+
+// Airborne or terrestrial from the density of the vegetation points over the occupied 1 m cells:
+// an airborne survey gives tens of points per square metre, a terrestrial scan thousands.
+ScanMode choose_mode(const PointCloud& cloud, const std::vector<std::uint8_t>& vegetation, const SegmentOptions& options,
+                     std::string& reason) {
+    std::unordered_map<std::int64_t, std::uint32_t> cells;
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (!vegetation[i]) continue;
+        const auto x = static_cast<std::int64_t>(std::floor(cloud.positions[i].x()));
+        const auto y = static_cast<std::int64_t>(std::floor(cloud.positions[i].y()));
+        ++cells[x * 2000003 + y];
+        ++count;
+    }
+    const double density = cells.empty() ? 0.0 : static_cast<double>(count) / static_cast<double>(cells.size());
+    const bool terrestrial = density >= options.terrestrial_density;
+    reason = format("automatic: %.0f vegetation points per m^2 over %.0f occupied m^2 ", density, static_cast<double>(cells.size())) +
+             (terrestrial ? ">= " : "< ") + format("%.0f", options.terrestrial_density) +
+             (terrestrial ? " (dense: terrestrial)" : " (sparse: airborne)");
+    return terrestrial ? ScanMode::Terrestrial : ScanMode::Airborne;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Airborne: canopy height model, treetops, crowns.
+
+struct Raster {
+    double x0 = 0, y0 = 0;  // local xy of the corner of cell (0, 0)
+    float cell = 1;
+    int columns = 0, rows = 0;
+    std::vector<float> values;
+    std::size_t index(int c, int r) const { return static_cast<std::size_t>(r) * columns + c; }
+    int column_of(float x) const { return std::clamp(static_cast<int>(std::floor((x - x0) / cell)), 0, columns - 1); }
+    int row_of(float y) const { return std::clamp(static_cast<int>(std::floor((y - y0) / cell)), 0, rows - 1); }
+    Eigen::Vector2f centre(int c, int r) const {
+        return {static_cast<float>(x0 + (c + 0.5) * cell), static_cast<float>(y0 + (r + 0.5) * cell)};
+    }
+};
+
+// Highest height above ground per cell, each point drawn as a disc (lidR's p2r subcircle), so
+// that the gaps between sparse returns do not open pits in the crowns.
+Raster highest_points_raster(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
+                             const SegmentOptions& options) {
+    const auto [low, high] = cloud.bounds();
+    Raster chm;
+    chm.cell = options.chm_cell;
+    chm.x0 = std::floor(low.x() / chm.cell) * chm.cell;
+    chm.y0 = std::floor(low.y() / chm.cell) * chm.cell;
+    chm.columns = static_cast<int>(std::floor((high.x() - chm.x0) / chm.cell)) + 1;
+    chm.rows = static_cast<int>(std::floor((high.y() - chm.y0) / chm.cell)) + 1;
+    chm.values.assign(static_cast<std::size_t>(chm.columns) * chm.rows, std::numeric_limits<float>::quiet_NaN());
+    const float r = options.point_radius;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (!vegetation[i]) continue;
+        const Eigen::Vector3f& p = cloud.positions[i];
+        const float h = terrain.height_above_ground[i];
+        for (int row = chm.row_of(p.y() - r); row <= chm.row_of(p.y() + r); ++row)
+            for (int col = chm.column_of(p.x() - r); col <= chm.column_of(p.x() + r); ++col) {
+                const bool own = col == chm.column_of(p.x()) && row == chm.row_of(p.y());
+                if (!own && (chm.centre(col, row) - p.head<2>()).squaredNorm() > r * r) continue;
+                float& v = chm.values[chm.index(col, row)];
+                if (!(v >= h)) v = h;
+            }
+    }
+    return chm;
+}
+
+// Cells without returns or far below the median of their neighbours are pits (Ben-Arie et al.
+// 2009, §2): they take that median. Cells no neighbour covers are open ground (0).
+void fill_pits(Raster& chm, float depth) {
+    std::vector<float> out = chm.values;
+    std::vector<float> around;
+    for (int r = 0; r < chm.rows; ++r)
+        for (int c = 0; c < chm.columns; ++c) {
+            around.clear();
+            for (int dr = -1; dr <= 1; ++dr)
+                for (int dc = -1; dc <= 1; ++dc) {
+                    const int rr = r + dr, cc = c + dc;
+                    if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= chm.rows || cc >= chm.columns) continue;
+                    const float v = chm.values[chm.index(cc, rr)];
+                    if (std::isfinite(v)) around.push_back(v);
+                }
+            float& v = out[chm.index(c, r)];
+            if (around.size() < 5) {
+                if (!std::isfinite(v)) v = 0.0f;
+                continue;
+            }
+            std::nth_element(around.begin(), around.begin() + around.size() / 2, around.end());
+            const float median = around[around.size() / 2];
+            if (!std::isfinite(v) || v < median - depth) v = median;
+        }
+    chm.values.swap(out);
+}
+
+// Gaussian smoothing (separable, kernel to 3 sigma) of the CHM the tops are searched on: the
+// leaf clumps of a broad crown make many small maxima that smoothing removes while the peaks of
+// separate crowns stay (Popescu & Wynne 2004, §2.3 smooth their CHM the same way).
+Raster smoothed(const Raster& chm, float sigma) {
+    if (sigma <= 0.0f) return chm;
+    const float s = sigma / chm.cell;
+    const int reach = std::max(1, static_cast<int>(std::ceil(3.0f * s)));
+    std::vector<float> kernel(static_cast<std::size_t>(2 * reach + 1));
+    for (int k = -reach; k <= reach; ++k) kernel[static_cast<std::size_t>(k + reach)] = std::exp(-0.5f * k * k / (s * s));
+    const auto pass = [&](const std::vector<float>& in, bool along_rows) {
+        std::vector<float> out(in.size());
+        for (int r = 0; r < chm.rows; ++r)
+            for (int c = 0; c < chm.columns; ++c) {
+                double sum = 0, weights = 0;
+                for (int k = -reach; k <= reach; ++k) {
+                    const int cc = along_rows ? c + k : c, rr = along_rows ? r : r + k;
+                    if (cc < 0 || rr < 0 || cc >= chm.columns || rr >= chm.rows) continue;
+                    const double w = kernel[static_cast<std::size_t>(k + reach)];
+                    sum += w * in[chm.index(cc, rr)];
+                    weights += w;
+                }
+                out[chm.index(c, r)] = static_cast<float>(sum / weights);
+            }
+        return out;
+    };
+    Raster out = chm;
+    out.values = pass(pass(chm.values, true), false);
+    return out;
+}
+
+// Cells higher than every other cell within a window whose diameter grows with their height
+// (Popescu & Wynne 2004, §2.4). Of equal heights the first cell in row-major order wins.
+std::vector<std::size_t> find_treetops(const Raster& chm, const SegmentOptions& options) {
+    std::vector<std::size_t> tops;
+    for (int r = 0; r < chm.rows; ++r)
+        for (int c = 0; c < chm.columns; ++c) {
+            const std::size_t here = chm.index(c, r);
+            const float h = chm.values[here];
+            if (!(h >= options.min_tree_height)) continue;
+            const float diameter = std::min(options.max_window, options.window_base + options.window_per_metre * h);
+            const int reach = static_cast<int>(std::floor(0.5f * diameter / chm.cell));
+            const float reach_squared = (0.5f * diameter / chm.cell) * (0.5f * diameter / chm.cell);
+            bool highest = true;
+            for (int dr = -reach; dr <= reach && highest; ++dr)
+                for (int dc = -reach; dc <= reach; ++dc) {
+                    const int rr = r + dr, cc = c + dc;
+                    if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= chm.rows || cc >= chm.columns) continue;
+                    if (static_cast<float>(dr * dr + dc * dc) > reach_squared) continue;
+                    const std::size_t there = chm.index(cc, rr);
+                    const float v = chm.values[there];
+                    if (v > h || (v == h && there < here)) {
+                        highest = false;
+                        break;
+                    }
+                }
+            if (highest) tops.push_back(here);
+        }
+    // Highest first: ids follow the height order, and crowns grow from the highest tops first.
+    std::stable_sort(tops.begin(), tops.end(), [&](std::size_t a, std::size_t b) { return chm.values[a] > chm.values[b]; });
+    return tops;
+}
+
+// Regions flooded from the tops over the CHM, highest candidate cell first (a watershed from
+// markers, Li et al. 2012, §2.2 ordering): a neighbouring cell joins the region that reaches it
+// first when `admit(cell, region)` allows. Returns the region index + 1 per cell (0 = none).
+template <typename Admit>
+std::vector<std::int32_t> flood_from_tops(const Raster& chm, const std::vector<std::size_t>& tops, Admit admit) {
+    std::vector<std::int32_t> region(chm.values.size(), 0);
+    struct Candidate {
+        float height;
+        std::size_t cell;
+        std::int32_t region;
+        bool operator<(const Candidate& o) const {  // max-heap: highest, then lowest cell, then lowest region
+            if (height != o.height) return height < o.height;
+            if (cell != o.cell) return cell > o.cell;
+            return region > o.region;
+        }
+    };
+    std::priority_queue<Candidate> front;
+    for (std::size_t t = 0; t < tops.size(); ++t) front.push({chm.values[tops[t]], tops[t], static_cast<std::int32_t>(t + 1)});
+    while (!front.empty()) {
+        const Candidate next = front.top();
+        front.pop();
+        if (region[next.cell]) continue;
+        const auto t = static_cast<std::size_t>(next.region - 1);
+        if (next.cell != tops[t] && !admit(next.cell, t)) continue;
+        region[next.cell] = next.region;
+        const int c = static_cast<int>(next.cell % chm.columns), r = static_cast<int>(next.cell / chm.columns);
+        for (int dr = -1; dr <= 1; ++dr)
+            for (int dc = -1; dc <= 1; ++dc) {
+                const int rr = r + dr, cc = c + dc;
+                if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= chm.rows || cc >= chm.columns) continue;
+                const std::size_t there = chm.index(cc, rr);
+                if (!region[there]) front.push({chm.values[there], there, next.region});
+            }
+    }
+    return region;
+}
+
+float cell_distance(const Raster& chm, std::size_t a, std::size_t b) {
+    const int ac = static_cast<int>(a % chm.columns), ar = static_cast<int>(a / chm.columns);
+    const int bc = static_cast<int>(b % chm.columns), br = static_cast<int>(b / chm.columns);
+    return chm.cell * std::hypot(static_cast<float>(ac - bc), static_cast<float>(ar - br));
+}
+
+// Keeps the tops that stand out. Branch clusters of one broad crown make local maxima separated
+// by shallow saddles from a nearby higher top. The watershed basins of all tops are merged
+// across their highest passes, highest pass first (union-find, as in computing dynamics,
+// Grimaud 1992, §3): the group with the lower peak joins when its peak rises less than
+// max(min_top_prominence, top_prominence_ratio x its height) above the pass and the pass is
+// high in the other group's crown (at least merge_pass_ratio x its peak: a small tree touching
+// a tall neighbour's lower crown is still a tree). The peaks of the merged groups are the tops
+// that remain.
+std::vector<std::size_t> prominent_tops(const Raster& chm, const std::vector<std::size_t>& tops, const SegmentOptions& options) {
+    const std::vector<std::int32_t> basin =
+        flood_from_tops(chm, tops, [&](std::size_t cell, std::size_t) { return chm.values[cell] >= options.min_tree_height; });
+    // Highest pass between every pair of touching basins.
+    std::map<std::pair<std::int32_t, std::int32_t>, float> passes;
+    for (int r = 0; r < chm.rows; ++r)
+        for (int c = 0; c < chm.columns; ++c) {
+            const std::size_t here = chm.index(c, r);
+            if (!basin[here]) continue;
+            for (const auto& [dc, dr] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{-1, 1}}) {
+                const int cc = c + dc, rr = r + dr;
+                if (cc < 0 || cc >= chm.columns || rr >= chm.rows) continue;
+                const std::size_t there = chm.index(cc, rr);
+                if (!basin[there] || basin[there] == basin[here]) continue;
+                const auto key = std::minmax(basin[here], basin[there]);
+                const float pass = std::min(chm.values[here], chm.values[there]);
+                auto [it, added] = passes.emplace(key, pass);
+                if (!added) it->second = std::max(it->second, pass);
+            }
+        }
+    std::vector<std::tuple<float, std::int32_t, std::int32_t>> order;
+    for (const auto& [key, pass] : passes) order.emplace_back(pass, key.first, key.second);
+    std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+        return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : a < b;
+    });
+    UnionFind groups(tops.size());
+    std::vector<std::size_t> peak(tops.size());  // per group root: index into tops of its highest top
+    for (std::size_t t = 0; t < tops.size(); ++t) peak[t] = t;
+    for (const auto& [pass, a, b] : order) {
+        const int ra = groups.find(a - 1), rb = groups.find(b - 1);
+        if (ra == rb) continue;
+        const std::size_t pa = peak[static_cast<std::size_t>(ra)], pb = peak[static_cast<std::size_t>(rb)];
+        // tops are sorted highest first, so the smaller index is the higher peak.
+        const std::size_t high = std::min(pa, pb), low = std::max(pa, pb);
+        const float rise = chm.values[tops[low]] - pass;
+        const bool shallow = rise < std::max(options.min_top_prominence, options.top_prominence_ratio * chm.values[tops[low]]);
+        if (!shallow || pass < options.merge_pass_ratio * chm.values[tops[high]]) continue;
+        groups.unite(ra, rb);
+        peak[static_cast<std::size_t>(groups.find(ra))] = high;
+    }
+    std::vector<std::size_t> kept;
+    for (std::size_t t = 0; t < tops.size(); ++t)
+        if (groups.find(static_cast<int>(t)) == static_cast<int>(t)) kept.push_back(tops[peak[t]]);
+    std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) { return chm.values[a] > chm.values[b]; });
+    return kept;
+}
+
+// Crowns grown from the tops over the CHM (Dalponte & Coomes 2016, §2.3 admission rules): a cell
+// joins the neighbouring crown that reaches it when it is above min_tree_height, above
+// seed_ratio x the crown's top, above crown_ratio x the crown's mean height, not higher than the
+// top, and within max_crown_radius of it. Returns the crown index + 1 per cell (0 = none).
+std::vector<std::int32_t> grow_crowns(const Raster& chm, const std::vector<std::size_t>& tops, const SegmentOptions& options) {
+    std::vector<double> sum(tops.size(), 0.0);
+    std::vector<std::uint32_t> count(tops.size(), 0);
+    for (std::size_t t = 0; t < tops.size(); ++t) {
+        sum[t] = chm.values[tops[t]];
+        count[t] = 1;
+    }
+    return flood_from_tops(chm, tops, [&](std::size_t cell, std::size_t t) {
+        const float h = chm.values[cell], top = chm.values[tops[t]];
+        if (h < options.min_tree_height || h < options.seed_ratio * top || h < options.crown_ratio * sum[t] / count[t] || h > top ||
+            cell_distance(chm, cell, tops[t]) > options.max_crown_radius)
+            return false;
+        sum[t] += h;
+        ++count[t];
+        return true;
+    });
+}
+
+// Per-point labels -> trees: drops labels without points or lower than min_tree_height,
+// renumbers the rest 1.. in label order, and measures top, base and point count.
+std::vector<SegmentedTree> collect_trees(const PointCloud& cloud, const Terrain& terrain, std::vector<std::int32_t>& tree_id,
+                                         std::size_t labels, const std::vector<Eigen::Vector2f>& stem_xy,
+                                         const std::vector<float>& stem_radius, float min_tree_height) {
+    std::vector<std::size_t> count(labels + 1, 0);
+    std::vector<int> highest(labels + 1, -1);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const auto label = static_cast<std::size_t>(tree_id[i]);
+        if (!label) continue;
+        ++count[label];
+        if (highest[label] < 0 || terrain.height_above_ground[i] > terrain.height_above_ground[static_cast<std::size_t>(highest[label])])
+            highest[label] = static_cast<int>(i);
+    }
+    std::vector<std::int32_t> renumber(labels + 1, 0);
+    std::vector<SegmentedTree> trees;
+    for (std::size_t label = 1; label <= labels; ++label) {
+        if (!count[label] || terrain.height_above_ground[static_cast<std::size_t>(highest[label])] < min_tree_height) continue;
+        SegmentedTree tree;
+        tree.id = static_cast<std::int32_t>(trees.size() + 1);
+        tree.top = cloud.positions[static_cast<std::size_t>(highest[label])];
+        const Eigen::Vector2f xy = stem_xy.empty() ? Eigen::Vector2f(tree.top.head<2>()) : stem_xy[label - 1];
+        tree.base = Eigen::Vector3f(xy.x(), xy.y(), terrain.dtm.height_at(xy.x(), xy.y()));
+        tree.points = count[label];
+        tree.stem_radius = stem_radius.empty() ? 0.0f : stem_radius[label - 1];
+        renumber[label] = tree.id;
+        trees.push_back(tree);
+    }
+    for (auto& id : tree_id) id = renumber[static_cast<std::size_t>(id)];
+    return trees;
+}
+
+void segment_airborne(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
+                      const SegmentOptions& options, TreeSegmentation& result) {
+    Raster chm = highest_points_raster(cloud, terrain, vegetation, options);
+    fill_pits(chm, options.pit_depth);
+    const Raster smooth = smoothed(chm, options.chm_smoothing);
+    const std::vector<std::size_t> tops = prominent_tops(smooth, find_treetops(smooth, options), options);
+    const std::vector<std::int32_t> crown = grow_crowns(chm, tops, options);
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        if (vegetation[i]) result.tree_id[i] = crown[chm.index(chm.column_of(cloud.positions[i].x()), chm.row_of(cloud.positions[i].y()))];
+    result.trees = collect_trees(cloud, terrain, result.tree_id, tops.size(), {}, {}, options.min_tree_height);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Terrestrial: stems in a slice, then one multi-source Dijkstra over the plot.
+
+struct Stem {
+    Eigen::Vector2f centre;
+    float radius = 0;
+    std::size_t inliers = 0;
+    std::vector<int> points;  // indices into the cloud: the stem's slice points
+};
+
+// Euclidean clusters of the slice points (single linkage at `distance`), each as cloud indices.
+std::vector<std::vector<int>> cluster_slice(const PointCloud& cloud, const std::vector<int>& slice, float distance) {
+    std::vector<Eigen::Vector3f> points;
+    points.reserve(slice.size());
+    for (int i : slice) points.push_back(cloud.positions[static_cast<std::size_t>(i)]);
+    std::vector<std::vector<int>> clusters;
+    if (points.empty()) return clusters;
+    const KdTree index(points);
+    UnionFind sets(points.size());
+    std::vector<int> near;
+    std::vector<float> squared;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        index.radius_search(points[i], distance, near, squared, 16);
+        for (int j : near) sets.unite(static_cast<int>(i), j);
+    }
+    std::unordered_map<int, std::size_t> cluster_of_root;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const int root = sets.find(static_cast<int>(i));
+        const auto [it, added] = cluster_of_root.emplace(root, clusters.size());
+        if (added) clusters.emplace_back();
+        clusters[it->second].push_back(slice[i]);
+    }
+    return clusters;
+}
+
+// A stem stands upright: the centroids of the lower and upper halves of its slice points lie
+// above each other within `max_lean_degrees`. A low branch crossing the slice aslant can fit a
+// circle arc too, but its halves are offset by its horizontal run.
+bool upright(const PointCloud& cloud, const std::vector<int>& points, float max_lean_degrees) {
+    float low = std::numeric_limits<float>::infinity(), high = -low;
+    for (int i : points) {
+        low = std::min(low, cloud.positions[static_cast<std::size_t>(i)].z());
+        high = std::max(high, cloud.positions[static_cast<std::size_t>(i)].z());
+    }
+    const float middle = 0.5f * (low + high);
+    Eigen::Vector3d sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::size_t count[2] = {0, 0};
+    for (int i : points) {
+        const Eigen::Vector3f& p = cloud.positions[static_cast<std::size_t>(i)];
+        const int half = p.z() >= middle;
+        sum[half] += p.cast<double>();
+        ++count[half];
+    }
+    if (!count[0] || !count[1]) return false;
+    const Eigen::Vector3d step = sum[1] / count[1] - sum[0] / count[0];
+    const double tangent = std::tan(static_cast<double>(max_lean_degrees) * std::numbers::pi / 180.0);
+    return step.z() > 0 && step.head<2>().norm() <= tangent * step.z();
+}
+
+// A slice cluster is a stem when it spans most of the slice height and a circle of a plausible
+// radius holds enough of its points around enough of its circumference (Liang et al. 2012, §2.2).
+std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cluster, const SegmentOptions& options) {
+    if (static_cast<int>(cluster.size()) < options.min_stem_points) return std::nullopt;
+    float low = std::numeric_limits<float>::infinity(), high = -low;
+    std::vector<Eigen::Vector2f> xy;
+    xy.reserve(cluster.size());
+    for (int i : cluster) {
+        const Eigen::Vector3f& p = cloud.positions[static_cast<std::size_t>(i)];
+        xy.emplace_back(p.x(), p.y());
+        low = std::min(low, p.z());
+        high = std::max(high, p.z());
+    }
+    if (high - low < 0.5f * (options.stem_slice_high - options.stem_slice_low)) return std::nullopt;
+    const CircleFit circle = fit_circle(xy, options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
+    if (!circle.ok || static_cast<float>(circle.inliers) < options.min_circle_inliers * static_cast<float>(cluster.size()) ||
+        circle.coverage < options.min_arc_coverage)
+        return std::nullopt;
+    // Only the points on the circle seed the tree: a branch or a bush touching the stem in the
+    // slice must win its points through the graph like any other.
+    std::vector<int> on_circle;
+    for (std::size_t k = 0; k < cluster.size(); ++k)
+        if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circle.push_back(cluster[k]);
+    if (!upright(cloud, on_circle, options.max_stem_lean)) return std::nullopt;
+    return Stem{circle.centre, circle.radius, circle.inliers, std::move(on_circle)};
+}
+
+// Stems found in the slice, one per trunk: arcs of one trunk split by occlusion give circles
+// whose centres lie within each other; the one with more inliers stays.
+std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
+                             const SegmentOptions& options) {
+    std::vector<int> slice;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const float h = terrain.height_above_ground[i];
+        if (vegetation[i] && h >= options.stem_slice_low && h <= options.stem_slice_high) slice.push_back(static_cast<int>(i));
+    }
+    std::vector<Stem> stems;
+    for (const auto& cluster : cluster_slice(cloud, slice, options.stem_cluster_distance))
+        if (auto stem = fit_stem(cloud, cluster, options)) stems.push_back(std::move(*stem));
+    std::stable_sort(stems.begin(), stems.end(), [](const Stem& a, const Stem& b) { return a.inliers > b.inliers; });
+    std::vector<Stem> kept;
+    for (auto& stem : stems) {
+        const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Stem& k) {
+            return (k.centre - stem.centre).norm() < std::max(k.radius, stem.radius) + options.circle_tolerance;
+        });
+        if (!duplicate) kept.push_back(std::move(stem));
+    }
+    // Ids in a reproducible spatial order (south to north, then west to east).
+    std::sort(kept.begin(), kept.end(), [](const Stem& a, const Stem& b) {
+        return a.centre.y() != b.centre.y() ? a.centre.y() < b.centre.y() : a.centre.x() < b.centre.x();
+    });
+    return kept;
+}
+
+// Vegetation points thinned to a voxel grid: the graph is built on one point per voxel (the mean
+// of its points) and every point takes its voxel's label.
+struct Voxels {
+    std::vector<Eigen::Vector3f> centres;
+    std::vector<int> voxel_of_point;  // -1 for points outside the graph
+};
+
+Voxels voxelise(const PointCloud& cloud, const std::vector<std::uint8_t>& vegetation, float size) {
+    Voxels voxels;
+    voxels.voxel_of_point.assign(cloud.size(), -1);
+    std::unordered_map<std::uint64_t, int> index;
+    std::vector<Eigen::Vector3d> sums;
+    std::vector<std::uint32_t> counts;
+    const auto key_part = [size](float v) {
+        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / size)) & 0x1FFFFF);
+    };
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (!vegetation[i]) continue;
+        const Eigen::Vector3f& p = cloud.positions[i];
+        const std::uint64_t key = key_part(p.x()) | key_part(p.y()) << 21 | key_part(p.z()) << 42;
+        const auto [it, added] = index.emplace(key, static_cast<int>(sums.size()));
+        if (added) {
+            sums.emplace_back(0, 0, 0);
+            counts.push_back(0);
+        }
+        sums[static_cast<std::size_t>(it->second)] += p.cast<double>();
+        ++counts[static_cast<std::size_t>(it->second)];
+        voxels.voxel_of_point[i] = it->second;
+    }
+    voxels.centres.reserve(sums.size());
+    for (std::size_t v = 0; v < sums.size(); ++v) voxels.centres.push_back((sums[v] / counts[v]).cast<float>());
+    return voxels;
+}
+
+void segment_terrestrial(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
+                         const SegmentOptions& options, TreeSegmentation& result) {
+    const std::vector<Stem> stems = find_stems(cloud, terrain, vegetation, options);
+    if (stems.empty()) return;
+    const Voxels voxels = voxelise(cloud, vegetation, options.graph_voxel);
+
+    // Every voxel of a stem's slice points is a source of that stem.
+    std::vector<int> sources, source_stem;
+    std::vector<std::uint8_t> is_source(voxels.centres.size(), 0);
+    for (std::size_t s = 0; s < stems.size(); ++s)
+        for (int i : stems[s].points) {
+            const int v = voxels.voxel_of_point[static_cast<std::size_t>(i)];
+            if (is_source[static_cast<std::size_t>(v)]) continue;
+            is_source[static_cast<std::size_t>(v)] = 1;
+            sources.push_back(v);
+            source_stem.push_back(static_cast<int>(s));
+        }
+
+    NeighbourGraphOptions graph_options;
+    graph_options.neighbours = std::min(options.graph_neighbours, std::max(2, static_cast<int>(voxels.centres.size()) - 1));
+    graph_options.max_edge_length = options.max_gap;
+    graph_options.join_components = false;  // a gap wider than max_gap separates: what lies beyond stays 0
+    graph_options.beta = options.graph_beta;
+    const NeighbourGraph graph = build_neighbour_graph(voxels.centres, graph_options);
+    const ShortestPaths paths = shortest_paths(graph, sources, EdgeCost::Weight);
+
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const int v = voxels.voxel_of_point[i];
+        if (v < 0) continue;
+        const int source = paths.source[static_cast<std::size_t>(v)];
+        if (source >= 0) result.tree_id[i] = source_stem[static_cast<std::size_t>(source)] + 1;
+    }
+    std::vector<Eigen::Vector2f> stem_xy;
+    std::vector<float> stem_radius;
+    for (const auto& stem : stems) {
+        stem_xy.push_back(stem.centre);
+        stem_radius.push_back(stem.radius);
+    }
+    result.trees = collect_trees(cloud, terrain, result.tree_id, stems.size(), stem_xy, stem_radius, options.min_tree_height);
+}
+
+}  // namespace
+
+const char* scan_mode_name(ScanMode mode) {
+    switch (mode) {
+    case ScanMode::Automatic: return "auto";
+    case ScanMode::Airborne: return "als";
+    case ScanMode::Terrestrial: return "tls";
+    }
+    return "auto";
+}
+
+ScanMode parse_scan_mode(std::string_view text) {
+    if (text == "auto") return ScanMode::Automatic;
+    if (text == "als") return ScanMode::Airborne;
+    if (text == "tls") return ScanMode::Terrestrial;
+    throw Error::usage("unknown scan mode '" + std::string(text) + "': expected auto, als or tls");
+}
+
+TreeSegmentation segment_trees(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options) {
+    validate(options);
+    if (terrain.height_above_ground.size() != cloud.size() || terrain.is_ground.size() != cloud.size())
+        throw Error(ExitCode::Internal, "segment: the terrain was computed for another cloud (" +
+                                            std::to_string(terrain.height_above_ground.size()) + " heights for " +
+                                            std::to_string(cloud.size()) + " points)");
+    TreeSegmentation result;
+    result.tree_id.assign(cloud.size(), 0);
+    const std::vector<std::uint8_t> vegetation = vegetation_points(cloud, terrain, options.ground_clearance);
+    if (options.mode == ScanMode::Automatic) {
+        result.mode_used = choose_mode(cloud, vegetation, options, result.mode_reason);
+    } else {
+        result.mode_used = options.mode;
+        result.mode_reason = std::string("requested: ") + scan_mode_name(options.mode);
+    }
+    if (cloud.empty()) return result;
+    if (result.mode_used == ScanMode::Terrestrial) segment_terrestrial(cloud, terrain, vegetation, options, result);
+    else segment_airborne(cloud, terrain, vegetation, options, result);
+    return result;
+}
+
+}  // namespace treelobes

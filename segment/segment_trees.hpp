@@ -1,0 +1,104 @@
+// Individual tree segmentation of a tile (after analyse_terrain).
+//
+// Airborne scans see crowns from above: a pit-free canopy height model (highest point per cell
+// with each point drawn as a small disc, pits filled from their neighbours' median, Ben-Arie et
+// al. 2009), treetops as local maxima in a window that widens with height (Popescu & Wynne 2004,
+// §2.4) that also stand out from the saddles to higher tops (dynamics, Grimaud 1992), crowns grown from the tops over the CHM (Dalponte & Coomes 2016, §2.3: a cell joins a
+// neighbouring crown when it is high enough relative to that crown's top and near it); every
+// point above `min_tree_height` goes to the crown of its CHM cell, including points below the
+// crown surface.
+//
+// Terrestrial (dense) scans see stems: the points of a slice above the DTM are clustered, and
+// clusters that fit circles are stems (Liang et al. 2012, §2.2); then one multi-source Dijkstra
+// over the whole plot's neighbour graph, from all stem bases at once (the multi-root variant of
+// the skeleton's shortest paths, Livny et al. 2010, §3), gives every point to the base it
+// reaches most cheaply. The graph is built on a voxel-thinned copy of the non-ground points
+// with no edge longer than `max_gap`, and every point takes the label of its voxel: points
+// no base reaches (understory apart from the trees, clutter beyond a gap) stay 0.
+#pragma once
+
+#include "core/point_cloud.hpp"
+#include "segment/terrain.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace treelobes {
+
+enum class ScanMode { Automatic, Airborne, Terrestrial };
+
+// "auto", "als", "tls".
+const char* scan_mode_name(ScanMode mode);
+// Parses "auto", "als" or "tls"; throws Error(Usage) otherwise.
+ScanMode parse_scan_mode(std::string_view text);
+
+struct SegmentOptions {
+    ScanMode mode = ScanMode::Automatic;
+    float min_tree_height = 2.0f;        // trees whose top is lower are not trees (metres above ground)
+    // Automatic choice: terrestrial when the non-ground points are at least this dense over the
+    // tile's occupied footprint (points per square metre); airborne otherwise.
+    float terrestrial_density = 800.0f;
+
+    // Airborne (canopy height model and crowns).
+    float chm_cell = 0.5f;               // CHM cell edge (metres)
+    float point_radius = 0.15f;          // each point drawn as a disc of this radius (pit-free CHM)
+    float pit_depth = 1.0f;              // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
+    float chm_smoothing = 0.5f;          // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
+    float window_base = 2.0f;            // treetop window diameter at 0 m height (metres) ...
+    float window_per_metre = 0.1f;       // ... plus this much per metre of height (Popescu & Wynne 2004)
+    float max_window = 20.0f;            // cap of the treetop window diameter (metres)
+    // A top is part of a higher neighbour's crown when it rises less than
+    // max(min_top_prominence, top_prominence_ratio x its height) above the highest pass between
+    // them (its dynamics, Grimaud 1992) and that pass is at least merge_pass_ratio x the higher top.
+    // The defaults suit broad crowns (the synthetic species library); for dense conifer stands
+    // such as lidR's MixedConifer set min_top_prominence = 0 and chm_smoothing = 0 (docs/segment.md).
+    float min_top_prominence = 3.0f;     // metres
+    float top_prominence_ratio = 0.0f;
+    float merge_pass_ratio = 0.5f;
+    float seed_ratio = 0.45f;            // a crown cell must be higher than this share of its top (Dalponte 2016: th_seed)
+    float crown_ratio = 0.55f;           // ... and higher than this share of the crown's mean height (th_cr)
+    float max_crown_radius = 15.0f;      // no crown cell farther than this from its top (metres)
+
+    // Terrestrial (stems and plot-wide shortest paths).
+    float stem_slice_low = 1.0f;         // stem slice, metres above ground: from ...
+    float stem_slice_high = 2.0f;        // ... to
+    float stem_cluster_distance = 0.1f;  // slice points closer than this belong to one cluster (metres)
+    int min_stem_points = 15;            // smaller slice clusters are not stems
+    float min_stem_radius = 0.025f;      // accepted circle radii (metres)
+    float max_stem_radius = 0.8f;
+    float circle_tolerance = 0.03f;      // circle inlier band (metres)
+    float min_circle_inliers = 0.5f;     // share of the cluster's points on the circle
+    float min_arc_coverage = 0.2f;       // share of the circle's 10-degree sectors that hold inliers
+    float max_stem_lean = 30.0f;         // degrees from vertical between the lower and upper half of a stem's slice points
+    float graph_voxel = 0.1f;            // voxel edge of the thinned cloud the plot graph is built on (metres)
+    int graph_neighbours = 10;           // k of the kNN graph
+    float graph_beta = 2.0f;             // an edge costs length^beta: > 1 makes jumps across the sparse contact of two crowns dear
+    float max_gap = 0.5f;                // longest graph edge (metres): points beyond wider gaps stay 0
+    float ground_clearance = 0.3f;       // points lower than this above the DTM stay out of the graph (metres)
+};
+
+struct SegmentedTree {
+    std::int32_t id = 0;                 // 1.. in the order the trees were found; the treeID of its points
+    Eigen::Vector3f base{0, 0, 0};       // local frame, on the DTM: stem centre (terrestrial) or below the top (airborne)
+    Eigen::Vector3f top{0, 0, 0};        // local frame: highest point of the tree
+    std::size_t points = 0;              // points with this id
+    float stem_radius = 0.0f;            // radius of the stem circle that seeded the tree (terrestrial); 0 for airborne
+};
+
+struct TreeSegmentation {
+    std::vector<std::int32_t> tree_id;   // per point; 0 = no tree (ground, understory, unreachable)
+    std::vector<SegmentedTree> trees;    // trees[i].id == i + 1
+    ScanMode mode_used = ScanMode::Airborne;
+    std::string mode_reason;             // why this mode ("requested", or the density that decided it)
+};
+
+// Segments the tile into trees. `terrain` must come from analyse_terrain on the same cloud
+// (Error(Internal) when its sizes differ). An empty cloud, or one without points above
+// `min_tree_height`, gives no trees and all ids 0. Throws Error(Usage) for invalid options.
+TreeSegmentation segment_trees(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options);
+
+}  // namespace treelobes

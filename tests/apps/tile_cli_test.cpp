@@ -1,0 +1,245 @@
+// End-to-end: `treelobes tile` on a small synthetic tile (outputs present and consistent with
+// each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, failures.jsonl
+// with exit 3) and on bad tiles (empty, all ground, one tree, no CRS, NaN coordinates).
+#include "core/cloud_io.hpp"
+#include "core/skeleton_io.hpp"
+#include "encode/forest_file.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+using namespace treelobes;
+using test::quoted;
+using test::run_cli;
+using test::TempDir;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty()) lines.push_back(line);
+    return lines;
+}
+
+const std::string kWkt = "PROJCS[\"WGS 84 / UTM zone 32N\",AUTHORITY[\"EPSG\",\"32632\"]]";
+
+// A small airborne tile with truth labels (treeID), made once for the whole suite, with a CRS
+// added so that its passing through can be checked.
+const fs::path& small_tile() {
+    static TempDir dir;
+    static const fs::path tile = [] {
+        const auto r = run_cli("--log-level warn synth tile --trees 5 --size 20 --seed 11 --pulse-density 20 --max-leaves 2000 "
+                               "--species pine birch --origin 500000 5400000 300 --out " + quoted(dir / "synth"));
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        PointCloud cloud = read_point_cloud(dir / "synth" / "tile.las");
+        cloud.georef.crs_wkt = kWkt;
+        write_point_cloud(cloud, dir / "tile.las");
+        return dir / "tile.las";
+    }();
+    return tile;
+}
+
+std::string run_tile(const fs::path& out, const std::string& extra = "--use-input-segmentation") {
+    return "tile " + quoted(small_tile()) + " --out " + quoted(out) + " " + extra;
+}
+
+}  // namespace
+
+TEST(TileCli, OutputsArePresentAndConsistent) {
+    TempDir dir;
+    const auto r = run_cli("--json " + run_tile(dir / "out"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary, nlohmann::json::parse(slurp(dir / "out" / "summary.json")));
+    const int trees = summary["counts"]["trees"].get<int>();
+    EXPECT_EQ(trees, 5);
+    for (const char* key : {"read", "terrain", "segmentation", "trees", "outputs", "total"}) EXPECT_TRUE(summary["seconds"].contains(key)) << key;
+    EXPECT_GT(summary["peak_memory_mb"].get<double>(), 0.0);
+    EXPECT_EQ(summary["options"]["mode_used"], "input");
+    EXPECT_FALSE(fs::exists(dir / "out" / "failures.jsonl"));
+
+    // One row, one feature, one forest tree and one set of files per tree.
+    const auto csv = lines_of(slurp(dir / "out" / "trees.csv"));
+    ASSERT_EQ(csv.size(), static_cast<std::size_t>(trees + 1));
+    EXPECT_EQ(csv[0].rfind("tree_id,x,y,z,height_m,dbh_m,dbh_quality,", 0), 0u);
+    const auto geojson = nlohmann::json::parse(slurp(dir / "out" / "trees.geojson"));
+    ASSERT_EQ(geojson["features"].size(), static_cast<std::size_t>(trees));
+    EXPECT_EQ(geojson["crs_wkt"], kWkt);
+    encode::ForestReader forest(dir / "out" / "tile.forest");
+    EXPECT_EQ(forest.size(), static_cast<std::size_t>(trees));
+    for (const auto& feature : geojson["features"]) {
+        char stem[32];
+        std::snprintf(stem, sizeof stem, "tree_%04d", feature["properties"]["tree_id"].get<int>());
+        for (const std::string suffix : {"_skeleton.ply", "_branches.ply", ".tlobe", ".dbf6", ".json"})
+            EXPECT_TRUE(fs::exists(dir / "out" / "trees" / (stem + suffix))) << stem << suffix;
+        // Coordinates in the tile's frame (the synthetic origin), heights plausible.
+        const auto xyz = feature["geometry"]["coordinates"];
+        EXPECT_GT(xyz[0].get<double>(), 500000.0);
+        EXPECT_LT(xyz[0].get<double>(), 500020.0);
+        EXPECT_GT(xyz[1].get<double>(), 5400000.0);
+        EXPECT_GT(feature["properties"]["height_m"].get<double>(), 2.0);
+        EXPECT_TRUE(feature["properties"]["dbh_quality"].is_string());
+    }
+    for (const char* file : {"dtm.asc", "hillshade.png", "top_view.png", "points.las"}) EXPECT_TRUE(fs::exists(dir / "out" / file)) << file;
+
+    // The labelled points: treeID (int32), ground class 2, heights; scale/offset and CRS kept.
+    const PointCloud input = read_point_cloud(small_tile());
+    const PointCloud points = read_point_cloud(dir / "out" / "points.las");
+    ASSERT_EQ(points.size(), input.size());
+    const ExtraAttribute* ids = points.extra("treeID");
+    ASSERT_NE(ids, nullptr);
+    EXPECT_EQ(ids->type, AttributeType::Int32);
+    EXPECT_EQ(ids->values, input.extra("treeID")->values);  // taken as they are
+    ASSERT_NE(points.extra("HeightAboveGround"), nullptr);
+    ASSERT_EQ(points.classification.size(), points.size());
+    std::size_t ground = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        ground += points.classification[i] == 2;
+        if (points.classification[i] == 2) EXPECT_LT(std::abs(points.extra("HeightAboveGround")->values[i]), 0.5);
+    }
+    EXPECT_GT(ground, points.size() / 10);
+    EXPECT_EQ(points.georef.crs_wkt, kWkt);
+    EXPECT_EQ(points.source.las_scale, input.source.las_scale);
+    EXPECT_EQ(points.source.las_offset, input.source.las_offset);
+    EXPECT_NEAR((points.global(0) - input.global(0)).norm(), 0.0, 1e-3);
+}
+
+TEST(TileCli, ResumeKeepsFinishedOutputsAndOverwriteRedoesThemIdentically) {
+    TempDir dir;
+    ASSERT_EQ(run_cli(run_tile(dir / "a")).exit_code, 0);
+    const fs::path skeleton = dir / "a" / "trees" / "tree_0001_skeleton.ply";
+    const auto made = fs::last_write_time(skeleton);
+    const std::string csv = slurp(dir / "a" / "trees.csv");
+
+    const auto again = run_cli("--json " + run_tile(dir / "a"));
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_EQ(nlohmann::json::parse(again.out)["counts"]["trees_reused"], 5);
+    EXPECT_EQ(fs::last_write_time(skeleton), made);
+    EXPECT_EQ(slurp(dir / "a" / "trees.csv"), csv);
+
+    const auto redo = run_cli("--json " + run_tile(dir / "a", "--use-input-segmentation --overwrite"));
+    ASSERT_EQ(redo.exit_code, 0) << redo.err;
+    EXPECT_EQ(nlohmann::json::parse(redo.out)["counts"]["trees_reused"], 0);
+    EXPECT_NE(fs::last_write_time(skeleton), made);
+
+    // A fresh run elsewhere gives the same bytes (deterministic, whatever the thread schedule).
+    ASSERT_EQ(run_cli("--threads 1 " + run_tile(dir / "b")).exit_code, 0);
+    for (const char* file : {"trees.csv", "trees.geojson", "tile.forest", "dtm.asc", "top_view.png", "trees/tree_0002.dbf6",
+                             "trees/tree_0002.tlobe", "trees/tree_0002_skeleton.ply", "trees/tree_0002.json"})
+        EXPECT_EQ(slurp(dir / "a" / file), slurp(dir / "b" / file)) << file;
+}
+
+TEST(TileCli, ATreeThatFailsIsListedAndTheOthersGoOn) {
+    TempDir dir;
+    const PointCloud input = read_point_cloud(small_tile());
+    std::map<int, std::size_t> sizes;
+    for (double id : input.extra("treeID")->values)
+        if (id > 0) ++sizes[static_cast<int>(id)];
+    std::vector<std::size_t> counts;
+    for (const auto& [id, n] : sizes) counts.push_back(n);
+    std::sort(counts.begin(), counts.end());
+    const std::size_t limit = counts.front() + 1;  // the smallest tree is too small
+    const auto r = run_cli(run_tile(dir / "out", "--use-input-segmentation --min-tree-points " + std::to_string(limit)));
+    EXPECT_EQ(r.exit_code, 3) << r.err;
+    const auto failures = lines_of(slurp(dir / "out" / "failures.jsonl"));
+    ASSERT_EQ(failures.size(), 1u);
+    const auto failure = nlohmann::json::parse(failures[0]);
+    EXPECT_NE(failure["reason"].get<std::string>().find("--min-tree-points"), std::string::npos);
+    EXPECT_EQ(sizes.at(failure["tree_id"].get<int>()), counts.front());
+    EXPECT_EQ(lines_of(slurp(dir / "out" / "trees.csv")).size(), sizes.size());  // header + the others
+    EXPECT_EQ(encode::ForestReader(dir / "out" / "tile.forest").size(), sizes.size() - 1);
+}
+
+TEST(TileCli, UsageErrors) {
+    TempDir dir;
+    EXPECT_EQ(run_cli("tile " + quoted(small_tile())).exit_code, 1);  // no --out
+    EXPECT_EQ(run_cli(run_tile(dir / "o", "--mode xyz")).exit_code, 1);
+    EXPECT_EQ(run_cli(run_tile(dir / "o", "--dtm-cell nan")).exit_code, 1);
+    const auto help = run_cli("tile --help");
+    EXPECT_EQ(help.exit_code, 0);
+    EXPECT_NE(help.out.find("--use-input-segmentation"), std::string::npos);
+}
+
+TEST(TileCli, InputSegmentationNeedsATreeIdAttribute) {
+    TempDir dir;
+    std::ofstream(dir / "plain.xyz") << "0 0 0\n1 0 0\n0 1 0\n1 1 5\n";
+    const auto r = run_cli("tile " + quoted(dir / "plain.xyz") + " --out " + quoted(dir / "o") + " --use-input-segmentation");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("treeID"), std::string::npos);
+}
+
+// ---- bad tiles -------------------------------------------------------------------------
+
+TEST(TileCliBadTiles, EmptyTileIsAClearError) {
+    TempDir dir;
+    std::ofstream(dir / "empty.xyz") << "";
+    const auto r = run_cli("tile " + quoted(dir / "empty.xyz") + " --out " + quoted(dir / "o"));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_FALSE(r.err.empty());
+}
+
+TEST(TileCliBadTiles, NanCoordinatesAreDroppedAndAllNanIsAnError) {
+    TempDir dir;
+    std::ofstream(dir / "nan.xyz") << "nan nan nan\nnan 1 2\n";
+    const auto all = run_cli("tile " + quoted(dir / "nan.xyz") + " --out " + quoted(dir / "o"));
+    EXPECT_EQ(all.exit_code, 2) << all.err;
+    // The synthetic tile with a few NaN rows: they are dropped and counted, the rest goes on.
+    PointCloud cloud = read_point_cloud(small_tile());
+    std::string text;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3d p = cloud.global(i);
+        text += std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
+        if (i % 5000 == 0) text += "nan 0 0\n";
+    }
+    std::ofstream(dir / "some_nan.xyz") << text;
+    const auto r = run_cli("--json tile " + quoted(dir / "some_nan.xyz") + " --out " + quoted(dir / "p"));
+    ASSERT_TRUE(r.exit_code == 0 || r.exit_code == 3) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_GT(summary["counts"]["non_finite_dropped"].get<int>(), 0);
+    EXPECT_TRUE(summary["crs"].is_null());  // a text file has no CRS
+    EXPECT_FALSE(nlohmann::json::parse(slurp(dir / "p" / "trees.geojson")).contains("crs_wkt"));
+}
+
+TEST(TileCliBadTiles, AllGroundGivesTheDocumentedEmptyResult) {
+    TempDir dir;
+    std::string text;
+    for (int x = 0; x < 60; ++x)
+        for (int y = 0; y < 60; ++y) text += std::to_string(x * 0.5) + " " + std::to_string(y * 0.5) + " " + std::to_string(0.1 * x * 0.5) + "\n";
+    std::ofstream(dir / "ground.xyz") << text;
+    const auto r = run_cli("--json tile " + quoted(dir / "ground.xyz") + " --out " + quoted(dir / "o"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["counts"]["trees"], 0);
+    EXPECT_NE(r.err.find("no trees found"), std::string::npos);
+    EXPECT_EQ(lines_of(slurp(dir / "o" / "trees.csv")).size(), 1u);  // the header only
+    EXPECT_TRUE(nlohmann::json::parse(slurp(dir / "o" / "trees.geojson"))["features"].empty());
+    EXPECT_EQ(encode::ForestReader(dir / "o" / "tile.forest").size(), 0u);
+    for (const char* file : {"dtm.asc", "points.las", "top_view.png", "summary.json"}) EXPECT_TRUE(fs::exists(dir / "o" / file)) << file;
+}
+
+TEST(TileCliBadTiles, ASingleTree) {
+    TempDir dir;
+    ASSERT_EQ(run_cli("--log-level warn synth tile --trees 1 --size 12 --seed 5 --pulse-density 20 --max-leaves 2000 --species pine --out " +
+                      quoted(dir / "synth")).exit_code, 0);
+    const auto r = run_cli("--json tile " + quoted(dir / "synth" / "tile.las") + " --out " + quoted(dir / "o") + " --use-input-segmentation");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["counts"]["trees"], 1);
+    EXPECT_EQ(lines_of(slurp(dir / "o" / "trees.csv")).size(), 2u);
+}

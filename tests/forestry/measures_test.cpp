@@ -1,0 +1,134 @@
+// Forestry measures on clouds with known answers: a stem cylinder seen all round, from one
+// side, or not at all; a cone crown; the cylinders of a two-node skeleton.
+#include "forestry/measures.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+namespace treelobes::forestry {
+namespace {
+
+struct TreeCloud {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<float> hag;  // flat terrain at z = 0
+    void add(const Eigen::Vector3f& p) {
+        points.push_back(p);
+        hag.push_back(p.z());
+    }
+};
+
+// Points on a vertical cylinder of `radius` around (cx, cy) from z = 0 to `height`, over the
+// azimuths [0, arc) with 5 mm noise.
+void add_stem(TreeCloud& cloud, double cx, double cy, double radius, double height, double arc, std::mt19937& random) {
+    std::uniform_real_distribution<double> angle(0.0, arc), z(0.0, height);
+    std::normal_distribution<double> noise(0.0, 0.005);
+    for (int i = 0; i < 4000; ++i) {
+        const double a = angle(random), r = radius + noise(random);
+        cloud.add(Eigen::Vector3f(static_cast<float>(cx + r * std::cos(a)), static_cast<float>(cy + r * std::sin(a)),
+                                  static_cast<float>(z(random))));
+    }
+}
+
+// A solid cone of crown points from z0 up to z1, base radius `radius`, around (cx, cy).
+void add_cone_crown(TreeCloud& cloud, double cx, double cy, double radius, double z0, double z1, std::mt19937& random) {
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    for (int i = 0; i < 6000; ++i) {
+        const double t = unit(random), a = 2 * std::numbers::pi * unit(random);
+        const double r = radius * (1 - t) * std::sqrt(unit(random));
+        cloud.add(Eigen::Vector3f(static_cast<float>(cx + r * std::cos(a)), static_cast<float>(cy + r * std::sin(a)),
+                                  static_cast<float>(z0 + t * (z1 - z0))));
+    }
+}
+
+TEST(Dbh, FullCylinderIsOkWithItsDiameter) {
+    std::mt19937 random(1);
+    TreeCloud cloud;
+    add_stem(cloud, 3.0, -2.0, 0.15, 4.0, 2 * std::numbers::pi, random);
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {3.1, -2.1, 0.0});
+    EXPECT_EQ(m.quality, DbhQuality::Ok) << m.reason;
+    ASSERT_TRUE(m.diameter);
+    EXPECT_NEAR(*m.diameter, 0.30, 0.01);
+    EXPECT_NEAR(m.centre.x(), 3.0, 0.01);
+    EXPECT_NEAR(m.centre.y(), -2.0, 0.01);
+    EXPECT_GT(m.coverage, 0.9);
+}
+
+TEST(Dbh, HalfArcIsPartial) {
+    std::mt19937 random(2);
+    TreeCloud cloud;
+    add_stem(cloud, 0.0, 0.0, 0.2, 3.0, std::numbers::pi, random);
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    EXPECT_EQ(m.quality, DbhQuality::PartialArc) << m.reason;
+    ASSERT_TRUE(m.diameter);
+    EXPECT_NEAR(*m.diameter, 0.40, 0.03);
+}
+
+TEST(Dbh, NoStemPointsIsNotVisibleWithoutANumber) {
+    std::mt19937 random(3);
+    TreeCloud cloud;
+    add_cone_crown(cloud, 0.0, 0.0, 3.0, 6.0, 15.0, random);  // an airborne tree: crown only
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    EXPECT_EQ(m.quality, DbhQuality::NotVisible);
+    EXPECT_FALSE(m.diameter);
+    EXPECT_FALSE(m.reason.empty());
+    EXPECT_STREQ(dbh_quality_name(m.quality), "not_visible");
+}
+
+TEST(Dbh, ScatteredLeavesAtBreastHeightAreNotAStem) {
+    std::mt19937 random(4);
+    TreeCloud cloud;
+    add_cone_crown(cloud, 0.0, 0.0, 1.5, 0.0, 3.0, random);  // a bush: points at 1.3 m but no circle
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    EXPECT_EQ(m.quality, DbhQuality::NotVisible);
+    EXPECT_FALSE(m.diameter);
+}
+
+TEST(Crown, ConeCrownOverAStem) {
+    std::mt19937 random(5);
+    TreeCloud cloud;
+    add_stem(cloud, 0.0, 0.0, 0.15, 6.0, 2 * std::numbers::pi, random);
+    add_cone_crown(cloud, 0.0, 0.0, 3.0, 6.0, 15.0, random);
+    const CrownMeasure m = measure_crown(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    ASSERT_TRUE(m.base_height);
+    EXPECT_NEAR(*m.base_height, 6.5, 0.7);  // the crown's lowest points more than 0.5 m from the stem
+    ASSERT_TRUE(m.projected_area);
+    EXPECT_NEAR(*m.projected_area, std::numbers::pi * 9.0, 0.1 * std::numbers::pi * 9.0);
+    ASSERT_TRUE(m.diameter);
+    EXPECT_NEAR(*m.diameter, 6.0, 0.3);
+    ASSERT_TRUE(m.volume) << m.volume_failure;
+    const double cone = std::numbers::pi * 9.0 * 9.0 / 3.0;  // 84.8 m^3
+    EXPECT_GT(*m.volume, 0.7 * cone);
+    EXPECT_LT(*m.volume, 1.2 * cone);
+}
+
+TEST(Crown, TooFewPointsGivesNoMeasures) {
+    TreeCloud cloud;
+    cloud.add({0, 0, 5});
+    cloud.add({1, 0, 5});
+    const CrownMeasure m = measure_crown(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    EXPECT_FALSE(m.base_height);
+    EXPECT_FALSE(m.volume);
+    EXPECT_FALSE(m.diameter);
+}
+
+TEST(WoodyVolume, FrustaOfTheSkeleton) {
+    TreeGraph skeleton;
+    skeleton.add_node({0, 0, 0}, 0.2f, -1);
+    skeleton.add_node({0, 0, 2}, 0.1f, 0);
+    skeleton.add_node({1, 0, 2}, 0.1f, 1);
+    const double frustum = std::numbers::pi / 3.0 * 2.0 * (0.04 + 0.02 + 0.01);
+    const double cylinder = std::numbers::pi * 0.01 * 1.0;
+    EXPECT_NEAR(woody_volume(skeleton), frustum + cylinder, 1e-6);
+}
+
+TEST(ProjectedArea, SquareOfPoints) {
+    const std::vector<Eigen::Vector3f> points{{0, 0, 1}, {2, 0, 3}, {2, 2, 0}, {0, 2, 5}, {1, 1, 9}};
+    EXPECT_NEAR(projected_hull_area(points), 4.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace treelobes::forestry

@@ -1,0 +1,177 @@
+// Tree segmentation on toy tiles: two airborne crowns, two terrestrial stems sharing a crown
+// space (multi-source Dijkstra), the automatic mode, and the degenerate tiles.
+#include "segment/segment_trees.hpp"
+
+#include "core/error.hpp"
+#include "segment/segmentation_score.hpp"
+#include "support/test_support.hpp"
+#include "toy_tiles.hpp"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+using namespace treelobes;
+using test::ToyTile;
+
+namespace {
+
+// Ground 20 x 12 m at 0.3 m spacing (about 11 returns per m^2, some reaching the ground
+// under the crowns) with two conical crowns.
+ToyTile two_crowns_airborne() {
+    ToyTile tile;
+    test::add_ground(tile, 0, 20, 0, 12, 0.3f, 5.0f, 0.1f, [](float x, float) { return static_cast<int>(x * 10) % 2; });
+    test::add_cone_crown(tile, 5, 6, 15, 3, 0.3f, 5.0f, 0.1f, 1);
+    test::add_cone_crown(tile, 12.5f, 6, 12, 3, 0.3f, 5.0f, 0.1f, 2);
+    return tile;
+}
+
+// Two stems 3 m apart whose ball crowns overlap by 2 m, a bush 4 m from both, dense ground.
+ToyTile two_stems_terrestrial() {
+    ToyTile tile;
+    test::add_ground(tile, -4, 7, -4, 6, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    test::add_stem_and_ball(tile, 0, 0, 0.15f, 8, 2.5f, 0.15f, 1);
+    test::add_stem_and_ball(tile, 3, 0, 0.12f, 8, 2.5f, 0.15f, 2);
+    for (float z = 0.35f; z <= 1.0f; z += 0.05f)
+        for (float y = 3.6f; y <= 4.4f; y += 0.05f)
+            for (float x = 1.1f; x <= 1.9f; x += 0.05f) tile.add({x, y, z}, 0);
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    return tile;
+}
+
+// Share of each true tree's points carrying the id found most often among them, and that id.
+std::map<std::int32_t, std::pair<std::int32_t, double>> dominant_ids(const ToyTile& tile, const TreeSegmentation& result) {
+    std::map<std::int32_t, std::map<std::int32_t, std::size_t>> counts;
+    for (std::size_t i = 0; i < tile.truth.size(); ++i)
+        if (tile.truth[i]) ++counts[tile.truth[i]][result.tree_id[i]];
+    std::map<std::int32_t, std::pair<std::int32_t, double>> dominant;
+    for (const auto& [truth, ids] : counts) {
+        std::size_t total = 0, best = 0;
+        std::int32_t best_id = 0;
+        for (const auto& [id, n] : ids) {
+            total += n;
+            if (n > best) {
+                best = n;
+                best_id = id;
+            }
+        }
+        dominant[truth] = {best_id, static_cast<double>(best) / static_cast<double>(total)};
+    }
+    return dominant;
+}
+
+}  // namespace
+
+TEST(SegmentTrees, AirborneSeparatesTwoCrownsHighestFirst) {
+    const ToyTile tile = two_crowns_airborne();
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    SegmentOptions options;
+    options.mode = ScanMode::Airborne;
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, options);
+    ASSERT_EQ(result.trees.size(), 2u);
+    EXPECT_EQ(result.mode_used, ScanMode::Airborne);
+    const auto dominant = dominant_ids(tile, result);
+    EXPECT_EQ(dominant.at(1).first, 1);  // the higher tree is found first
+    EXPECT_EQ(dominant.at(2).first, 2);
+    EXPECT_EQ(dominant.at(1).second, 1.0);  // every crown and stem point, none lost
+    EXPECT_EQ(dominant.at(2).second, 1.0);
+    EXPECT_NEAR(result.trees[0].top.x(), 5.0f, 0.2f);
+    EXPECT_NEAR(result.trees[0].top.z() - result.trees[0].base.z(), 15.0f, 0.2f);
+    EXPECT_NEAR(result.trees[1].top.x(), 12.5f, 0.2f);
+    for (std::size_t i = 0; i < tile.truth.size(); ++i)
+        if (!tile.truth[i]) ASSERT_EQ(result.tree_id[i], 0) << "ground point " << i;
+}
+
+TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
+    const ToyTile tile = two_stems_terrestrial();
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    EXPECT_EQ(result.mode_used, ScanMode::Terrestrial) << result.mode_reason;
+    ASSERT_EQ(result.trees.size(), 2u);
+    EXPECT_NEAR(result.trees[0].base.x(), 0.0f, 0.02f);
+    EXPECT_NEAR(result.trees[0].stem_radius, 0.15f, 0.01f);
+    EXPECT_NEAR(result.trees[1].base.x(), 3.0f, 0.02f);
+    EXPECT_NEAR(result.trees[1].stem_radius, 0.12f, 0.01f);
+    const auto dominant = dominant_ids(tile, result);
+    EXPECT_EQ(dominant.at(1).first, 1);
+    EXPECT_EQ(dominant.at(2).first, 2);
+    // The crowns overlap by 2 m: the shared lattice points go to one or the other.
+    EXPECT_GT(dominant.at(1).second, 0.8);
+    EXPECT_GT(dominant.at(2).second, 0.8);
+    // Crown points on the far side of each ball belong to their own tree.
+    for (std::size_t i = 0; i < tile.truth.size(); ++i) {
+        const Eigen::Vector3f& p = tile.cloud.positions[i];
+        if (p.z() > 6.0f && p.x() < -0.5f) ASSERT_EQ(result.tree_id[i], 1);
+        if (p.z() > 6.0f && p.x() > 3.5f) ASSERT_EQ(result.tree_id[i], 2);
+    }
+    // The bush is out of reach (more than max_gap from any tree), the ground is not a tree.
+    for (std::size_t i = 0; i < tile.truth.size(); ++i)
+        if (!tile.truth[i]) ASSERT_EQ(result.tree_id[i], 0) << "point " << i;
+    const SegmentationScore score = score_segmentation(tile.truth, result.tree_id, terrain.height_above_ground, 5.0f);
+    EXPECT_EQ(score.f1, 1.0);
+    EXPECT_GT(score.points_right, 0.85);
+}
+
+TEST(SegmentTrees, AutomaticModeFollowsPointDensity) {
+    const ToyTile airborne = two_crowns_airborne();
+    const TreeSegmentation als = segment_trees(airborne.cloud, analyse_terrain(airborne.cloud, {}), {});
+    EXPECT_EQ(als.mode_used, ScanMode::Airborne);
+    EXPECT_NE(als.mode_reason.find("airborne"), std::string::npos);
+    SegmentOptions forced;
+    forced.mode = ScanMode::Terrestrial;
+    const TreeSegmentation tls = segment_trees(airborne.cloud, analyse_terrain(airborne.cloud, {}), forced);
+    EXPECT_EQ(tls.mode_used, ScanMode::Terrestrial);
+    EXPECT_EQ(tls.mode_reason, "requested: tls");
+    EXPECT_TRUE(tls.trees.empty());  // an airborne scan shows no stem circles
+}
+
+TEST(SegmentTrees, SingleTreeAndTreesBelowTheMinimumHeight) {
+    ToyTile tile;
+    test::add_ground(tile, 0, 10, 0, 10, 0.3f, 0.0f, 0.0f, [](float x, float y) { return std::hypot(x - 5, y - 5) < 2.2f; });
+    test::add_cone_crown(tile, 5, 5, 9, 2, 0.3f, 0.0f, 0.0f, 1);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    SegmentOptions options;
+    options.mode = ScanMode::Airborne;
+    EXPECT_EQ(segment_trees(tile.cloud, terrain, options).trees.size(), 1u);
+    options.min_tree_height = 10.0f;
+    const TreeSegmentation none = segment_trees(tile.cloud, terrain, options);
+    EXPECT_TRUE(none.trees.empty());
+    EXPECT_EQ(std::count(none.tree_id.begin(), none.tree_id.end(), 0), static_cast<std::ptrdiff_t>(tile.cloud.size()));
+}
+
+TEST(SegmentTrees, AllGroundAndEmptyTilesGiveNoTrees) {
+    ToyTile ground;
+    test::add_ground(ground, 0, 10, 0, 10, 0.2f, 10.0f, 0.1f, [](float, float) { return false; });
+    for (ScanMode mode : {ScanMode::Automatic, ScanMode::Airborne, ScanMode::Terrestrial}) {
+        SegmentOptions options;
+        options.mode = mode;
+        const TreeSegmentation result = segment_trees(ground.cloud, analyse_terrain(ground.cloud, {}), options);
+        EXPECT_TRUE(result.trees.empty());
+        EXPECT_EQ(result.tree_id.size(), ground.cloud.size());
+    }
+    const TreeSegmentation empty = segment_trees(PointCloud{}, analyse_terrain(PointCloud{}, {}), {});
+    EXPECT_TRUE(empty.trees.empty());
+    EXPECT_TRUE(empty.tree_id.empty());
+}
+
+TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
+    const ToyTile tile = two_crowns_airborne();
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    SegmentOptions bad;
+    bad.chm_cell = 0;
+    EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
+    bad = {};
+    bad.stem_slice_high = bad.stem_slice_low;
+    EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
+    EXPECT_EQ(test::error_code_of([&] { segment_trees(PointCloud{}, terrain, {}); }), ExitCode::Internal);
+}
+
+TEST(SegmentTrees, ScanModeNames) {
+    EXPECT_EQ(parse_scan_mode("als"), ScanMode::Airborne);
+    EXPECT_EQ(parse_scan_mode("tls"), ScanMode::Terrestrial);
+    EXPECT_EQ(parse_scan_mode("auto"), ScanMode::Automatic);
+    EXPECT_STREQ(scan_mode_name(ScanMode::Terrestrial), "tls");
+    EXPECT_EQ(test::error_code_of([] { parse_scan_mode("mls"); }), ExitCode::Usage);
+}
