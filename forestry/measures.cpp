@@ -3,7 +3,7 @@
 #include "core/error.hpp"
 #include "core/grid_thinning.hpp"
 #include "lobes/alpha_shape.hpp"
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/ransac_fit.hpp"
 
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_point.hpp>

@@ -16,7 +16,7 @@
 #include "forestry/measures.hpp"
 #include "lobes/lobe_tree.hpp"
 #include "lobes/tlobe_io.hpp"
-#include "reconstruct/branch_mesh.hpp"
+#include "geometry/branch_mesh.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
 
 #include <Eigen/Core>

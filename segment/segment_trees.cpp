@@ -1,11 +1,11 @@
 #include "segment/segment_trees.hpp"
 
 #include "core/error.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/neighbour_graph.hpp"
-#include "reconstruct/ransac_fit.hpp"
-#include "reconstruct/shortest_paths.hpp"
-#include "reconstruct/union_find.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/neighbour_graph.hpp"
+#include "geometry/ransac_fit.hpp"
+#include "geometry/shortest_paths.hpp"
+#include "geometry/union_find.hpp"
 
 #include <algorithm>
 #include <cmath>

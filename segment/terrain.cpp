@@ -2,8 +2,8 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/ransac_fit.hpp"
 #include "render/image.hpp"
 
 #include <Eigen/Cholesky>

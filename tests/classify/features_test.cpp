@@ -5,8 +5,8 @@
 #include "config/species_profile.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/random.hpp"
 #include "support/test_support.hpp"
-#include "synth/random.hpp"
 #include "synth/scanner.hpp"
 
 #include <gtest/gtest.h>
@@ -58,7 +58,7 @@ PointCloud transformed(const PointCloud& cloud, double heading_deg, const Eigen:
 }
 
 PointCloud random_half(const PointCloud& cloud, std::uint64_t seed) {
-    synth::Rng rng(seed);
+    Rng rng(seed);
     PointCloud out;
     for (const auto& p : cloud.positions)
         if (rng.uniform(0, 1) < 0.5) out.positions.push_back(p);
@@ -231,7 +231,7 @@ TEST(ClassifyFeatures, RejectsCloudsThatAreNotTrees) {
     for (int i = 0; i < 20; ++i) few.positions.emplace_back(i * 0.1f, 0.0f, i * 0.2f);
     EXPECT_EQ(test::error_code_of([&] { compute_features(few, {}, "few.xyz"); }), ExitCode::InvalidInput);
     PointCloud flat;
-    synth::Rng rng(2);
+    Rng rng(2);
     for (int i = 0; i < 2000; ++i)
         flat.positions.emplace_back(static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.normal(0, 0.02)));
     try {
