@@ -1,7 +1,7 @@
 #include "forestry/measures.hpp"
 
 #include "core/error.hpp"
-#include "core/grid_thinning.hpp"
+#include "geometry/grid_thinning.hpp"
 #include "lobes/alpha_shape.hpp"
 #include "geometry/ransac_fit.hpp"
 
