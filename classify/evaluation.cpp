@@ -386,7 +386,7 @@ EvaluationReport evaluate_train_test(const LabelledSet& set, const std::vector<N
     for (auto r : train) ++train_counts[set.labels[r]];
     for (const auto& classifier : classifiers) {
         ScoreAccumulator acc(classes, set.labels.size());
-        score_experiment(set, test, run_experiment(set, classifier.run, train, test, synth::stream_seed(options.seed, 0)), options, acc);
+        score_experiment(set, test, run_experiment(set, classifier.run, train, test, stream_seed(options.seed, 0)), options, acc);
         ClassifierReport r;
         r.name = classifier.name;
         r.random_splits = acc.scores(set.labels, train_counts);

@@ -1,5 +1,5 @@
 // Renderable geometry of a tree at several levels of detail: branch tubes (generalized
-// cylinders, reconstruct/branch_mesh.hpp) and foliage (the tree's lobes, or leaf cards at the
+// cylinders, geometry/branch_mesh.hpp) and foliage (the tree's lobes, or leaf cards at the
 // twig tips of a bare skeleton).
 //
 // LOD k of n (k = 0 is full detail) keeps the branch axes whose base radius reaches the k/n

@@ -319,7 +319,7 @@ TEST(ClassifyFeatures, AirborneGroupInvariantToPositionHeadingAndDensity) {
         for (auto& p : moved.positions) p = turn37 * p + Eigen::Vector3f(120.0f, -80.0f, 15.0f);
         for (auto& p : turned.positions) p = turn200 * p;
         std::vector<bool> keep(scans[s].size());
-        synth::Rng rng(4);
+        Rng rng(4);
         for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = rng.uniform(0, 1) < 0.5;
         const auto half = airborne(compute_features(scans[s].subset(keep)));
         EXPECT_LT(scaled_distance(vectors[s], airborne(compute_features(moved)), scale), 0.05);

@@ -585,7 +585,7 @@ TEST(JointBoost, ProbabilityAveragingEnsembleKeepsItsMembersThroughTheFile) {
 TEST(JointBoost, LearnsWhichSideMissingValuesGo) {
     FeatureTable t = empty_table(2);
     std::vector<int> y;
-    synth::Rng rng(3);
+    Rng rng(3);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (int i = 0; i < 30; ++i) {
         const double missing_or_high[2] = {i % 2 ? nan : rng.uniform(3, 4), rng.normal()};
@@ -619,7 +619,7 @@ TEST(JointBoost, LearnsWhichSideMissingValuesGo) {
 TEST(JointBoost, BalancedClassWeightsFavourTheRareClass) {
     FeatureTable t = empty_table(1);
     std::vector<int> y;
-    synth::Rng rng(8);
+    Rng rng(8);
     for (int i = 0; i < 40; ++i) {
         const double v[1] = {rng.normal(0, 1)};
         t.add_row(test::numbered("a", static_cast<std::size_t>(i)), v), y.push_back(0);
