@@ -139,14 +139,16 @@ std::string without_report_timings(const std::string& text) {
     return out;
 }
 
-// The folder's files by relative path; JSON files reduced as above, the rest byte for byte.
+// The folder's files by relative path, the folder's own path in them written {out}; JSON files
+// reduced as above, the rest byte for byte.
 std::map<std::string, std::string> outputs_of(const fs::path& folder) {
     std::map<std::string, std::string> files;
     if (!fs::exists(folder)) return files;
     for (const auto& entry : fs::recursive_directory_iterator(folder)) {
         if (!entry.is_regular_file()) continue;
         std::ifstream in(entry.path(), std::ios::binary);
-        std::string bytes{std::istreambuf_iterator<char>(in), {}};
+        // Summaries name the output files, which lie in this run's folder.
+        std::string bytes = replaced({std::istreambuf_iterator<char>(in), {}}, folder.string(), "{out}");
         if (entry.path().extension() == ".json") bytes = without_run_values(nlohmann::json::parse(bytes)).dump(1);
         if (entry.path().filename() == "report.md") bytes = without_report_timings(bytes);
         files[fs::relative(entry.path(), folder).string()] = std::move(bytes);
