@@ -3,7 +3,8 @@
 // compared. JSON summaries are compared without their timing and memory fields (the only
 // values allowed to differ, DESIGN.md "summary.json") and without the thread count; the one
 // other file with timings, the report.md of `classify evaluate` (its run time and the train and
-// CPU seconds per split), is compared with exactly those masked.
+// CPU seconds per split), is compared with exactly those masked, and so are the run times of the
+// human summaries on stdout.
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -138,14 +139,16 @@ std::string without_report_timings(const std::string& text) {
     return out;
 }
 
-// The folder's files by relative path; JSON files reduced as above, the rest byte for byte.
+// The folder's files by relative path, the folder's own path in them written {out}; JSON files
+// reduced as above, the rest byte for byte.
 std::map<std::string, std::string> outputs_of(const fs::path& folder) {
     std::map<std::string, std::string> files;
     if (!fs::exists(folder)) return files;
     for (const auto& entry : fs::recursive_directory_iterator(folder)) {
         if (!entry.is_regular_file()) continue;
         std::ifstream in(entry.path(), std::ios::binary);
-        std::string bytes{std::istreambuf_iterator<char>(in), {}};
+        // Summaries name the output files, which lie in this run's folder.
+        std::string bytes = replaced({std::istreambuf_iterator<char>(in), {}}, folder.string(), "{out}");
         if (entry.path().extension() == ".json") bytes = without_run_values(nlohmann::json::parse(bytes)).dump(1);
         if (entry.path().filename() == "report.md") bytes = without_report_timings(bytes);
         files[fs::relative(entry.path(), folder).string()] = std::move(bytes);
@@ -153,10 +156,11 @@ std::map<std::string, std::string> outputs_of(const fs::path& folder) {
     return files;
 }
 
-// stdout with the --json summary's run values removed (plain text stays as it is).
+// stdout with the --json summary's run values removed; a human summary with its run times
+// masked as in report.md (the classify commands print "(1.6 s)" and the evaluation table).
 std::string comparable_stdout(const std::string& out, const std::string& folder) {
     const std::string text = replaced(out, folder, "{out}");
-    if (text.empty() || (text[0] != '{' && text[0] != '[')) return text;
+    if (text.empty() || (text[0] != '{' && text[0] != '[')) return without_report_timings(text);
     return without_run_values(nlohmann::json::parse(text)).dump(1);
 }
 
