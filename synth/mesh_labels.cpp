@@ -43,24 +43,26 @@ double face_area(const TriangleMesh& mesh, const std::array<int, 3>& f) {
     return 0.5 * (b - a).cross(c - a).norm();
 }
 
-// Scatter of a part's vertices, accumulated vertex by vertex.
+// A part's area and the area-weighted scatter of its face normals. A leaf blade, flat or gently
+// bent, single- or double-sided, has normals along one line (largest eigenvalue of the scatter
+// near 1); a tube's normals turn around its axis (about 1/2), a solid's point everywhere (1/3).
+// The vertices' spread would not do: a long, thin, curved twig tube lies in a plane too.
 struct PartShape {
     double area = 0;
-    double count = 0;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    Eigen::Matrix3d normals = Eigen::Matrix3d::Zero();
 
-    void add_vertex(const Eigen::Vector3d& p) {
-        count += 1;
-        sum += p;
-        outer += p * p.transpose();
+    void add_face(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c) {
+        const Eigen::Vector3d cross = (b - a).cross(c - a);
+        const double twice_area = cross.norm();
+        if (!(twice_area > 0)) return;
+        area += 0.5 * twice_area;
+        const Eigen::Vector3d n = cross / twice_area;
+        normals += 0.5 * twice_area * n * n.transpose();
     }
-    bool flat(double ratio) const {
-        if (count < 3) return true;  // a lone triangle's corners always lie in a plane
-        const Eigen::Vector3d mean = sum / count;
-        const Eigen::Matrix3d scatter = outer / count - mean * mean.transpose();
-        const Eigen::Vector3d eigen = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter, Eigen::EigenvaluesOnly).eigenvalues();
-        return std::max(0.0, eigen[0]) <= ratio * ratio * std::max(0.0, eigen[1]);
+    bool flat(double min_alignment) const {
+        if (!(area > 0)) return true;  // degenerate slivers only: no surface either way
+        const Eigen::Vector3d eigen = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(normals / area, Eigen::EigenvaluesOnly).eigenvalues();
+        return eigen[2] >= min_alignment;
     }
 };
 
@@ -68,33 +70,30 @@ struct PartShape {
 void label_by_geometry(const TriangleMesh& mesh, const std::vector<bool>& pending, const MeshLabelOptions& o,
                        std::vector<std::uint8_t>& labels, MeshLabelReport& report) {
     UnionFind parts(mesh.vertices.size());
-    std::vector<bool> used(mesh.vertices.size(), false);
     for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
         if (!pending[f]) continue;
         const auto& face = mesh.faces[f];
         parts.unite(face[0], face[1]);
         parts.unite(face[0], face[2]);
-        for (int c : face) used[c] = true;
     }
     std::vector<int> part_of_root(mesh.vertices.size(), -1);
     std::vector<PartShape> shapes;
-    for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
-        if (!used[v]) continue;
-        int& part = part_of_root[parts.find(static_cast<int>(v))];
+    for (std::size_t f = 0; f < mesh.faces.size(); ++f) {
+        if (!pending[f]) continue;
+        const auto& face = mesh.faces[f];
+        int& part = part_of_root[parts.find(face[0])];
         if (part < 0) {
             part = static_cast<int>(shapes.size());
             shapes.emplace_back();
         }
-        shapes[part].add_vertex(mesh.vertices[v].cast<double>());
+        shapes[part].add_face(mesh.vertices[face[0]].cast<double>(), mesh.vertices[face[1]].cast<double>(), mesh.vertices[face[2]].cast<double>());
     }
     double total_area = 0;
     for (const auto& face : mesh.faces) total_area += face_area(mesh, face);
-    for (std::size_t f = 0; f < mesh.faces.size(); ++f)
-        if (pending[f]) shapes[part_of_root[parts.find(mesh.faces[f][0])]].area += face_area(mesh, mesh.faces[f]);
 
     std::vector<std::uint8_t> part_label(shapes.size(), kWood);
     for (std::size_t p = 0; p < shapes.size(); ++p) {
-        const bool leaf = shapes[p].area <= o.max_leaf_area_fraction * total_area && shapes[p].flat(o.flat_ratio);
+        const bool leaf = shapes[p].area <= o.max_leaf_area_fraction * total_area && shapes[p].flat(o.min_normal_alignment);
         part_label[p] = leaf ? kLeaf : kWood;
         report.leaf_parts += leaf ? 1 : 0;
     }

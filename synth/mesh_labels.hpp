@@ -8,9 +8,9 @@
 //
 // By geometry for the faces whose names say nothing (no names, or "Material.001"): the faces
 // are split into parts (connected through shared vertices); leaves are small, flat and
-// numerous, so a part is a leaf when it is flat (thickness, the square root of the smallest
-// eigenvalue of its vertices' scatter, below flat_ratio x the square root of the middle one)
-// and small (its area below max_leaf_area_fraction of the whole mesh's area). Everything else
+// numerous, so a part is a leaf when it is flat (its face normals agree: the largest eigenvalue
+// of their area-weighted scatter n n^T is at least min_normal_alignment; 1 for a plane, 1/2 for
+// a tube, 1/3 for a solid) and small (its area below max_leaf_area_fraction of the whole mesh's). Everything else
 // (tubes of branches, a trunk, a fused crown) is wood. A model whose leaves are welded onto the
 // branches is one part and comes out as wood: name its materials or pass --leaf-materials.
 #pragma once
@@ -27,7 +27,7 @@ struct MeshLabelOptions {
     std::vector<std::string> leaf_words{"leaf", "leaves", "foliage", "needle", "frond", "blatt", "laub"};
     std::vector<std::string> wood_words{"bark", "trunk", "branch", "wood", "stem", "twig", "stalk", "limb"};
     bool named_faces_default_to_wood = false;  // true with user leaf words: named faces matching none are wood
-    double flat_ratio = 0.3;
+    double min_normal_alignment = 0.8;
     double max_leaf_area_fraction = 0.01;
 };
 

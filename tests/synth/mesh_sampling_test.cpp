@@ -4,6 +4,8 @@
 #include "support/test_support.hpp"
 #include "synth/mesh_labels.hpp"
 #include "synth/mesh_sampling.hpp"
+#include "synth/tree_mesh.hpp"
+#include "config/species_profile.hpp"
 
 #include <gtest/gtest.h>
 
@@ -101,6 +103,27 @@ TEST(MeshLabels, GeometryTellsSmallFlatLeavesFromTubes) {
     strict.max_leaf_area_fraction = 1e-6;
     label_faces(m, strict, &report);
     EXPECT_EQ(report.leaf_by_geometry, 0u);
+}
+
+TEST(MeshLabels, GeometryAgreesWithTheMaterialsOfSyntheticTrees) {
+    // Palm (long curved frond stalks, whose vertices lie nearly in a plane) and birch (thin twigs).
+    const auto profiles = load_species_profiles(default_species_file());
+    for (const char* name : {"palm", "birch"}) {
+        GrowOptions grow;
+        grow.max_leaves = 3000;
+        grow.height_m = 6;
+        const TreeMesh tree = tree_mesh(synth::grow(find_species_profile(profiles, name), 3, grow));
+        const std::vector<std::uint8_t> by_name = label_faces(tree.named());
+        NamedMesh unnamed;
+        unnamed.mesh = tree.combined();
+        MeshLabelReport report;
+        const std::vector<std::uint8_t> by_geometry = label_faces(unnamed, {}, &report);
+        ASSERT_EQ(by_geometry.size(), by_name.size());
+        std::size_t disagree = 0;
+        for (std::size_t f = 0; f < by_name.size(); ++f) disagree += by_name[f] != by_geometry[f];
+        EXPECT_EQ(disagree, 0u) << name;
+        EXPECT_EQ(report.leaf_by_geometry, tree.leaves.faces.size()) << name;
+    }
 }
 
 TEST(MeshSampling, UniformGivesTheCountWeightedByArea) {
