@@ -3,8 +3,10 @@
 # through a small program: terrain, segmentation, scoring against per-point reference labels):
 #   1. synthetic tiles with truth (`treelobes synth tile`: mixed species of the library, 20-degree
 #      slope, 1 m roughness, understory): detection F1 of trees taller than 5 m and the share of
-#      points assigned to the right tree, ALS (open and crowded stands) and TLS, with the input's
-#      ground class and with the ground filtered afresh (--ignore-classification);
+#      points assigned to the right tree, ALS and TLS, open stands (25 trees on 1 ha, 10 on
+#      40 x 40 m) and crowded ones (30 on 80 x 80 m, 12 on 30 x 30 m: the synth tile relaxes its
+#      spacing and broad crowns interpenetrate), with the input's ground class and with the ground
+#      filtered afresh (--ignore-classification);
 #   2. lidR/MixedConifer.las against lidR's treeID (defaults and the conifer setting);
 #   3. treels/pine_plot.las: stems found, with their positions and diameters;
 #   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
@@ -37,7 +39,8 @@ tile() {
 }
 for s in 11 12 13 14; do tile "als_open_$s" "$s" --trees 25 --size 100 --scanner als; done
 for s in 1 2 3 4; do tile "als_crowded_$s" "$s" --trees 30 --size 80 --scanner als; done
-for s in 1 2 3; do tile "tls_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
+for s in 21 22 23; do tile "tls_open_$s" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25; done
+for s in 1 2 3; do tile "tls_crowded_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
 
 # row LABEL ARGS...: one table row from one segment_eval run.
 row() {
@@ -62,8 +65,9 @@ header "tile"
 for s in 11 12 13 14; do row "ALS open, seed $s" "$WORK/als_open_$s/tile.las" --reference treeID; done
 for s in 11 12 13 14; do row "ALS open, seed $s, ground filtered" "$WORK/als_open_$s/tile.las" --reference treeID --ignore-classification; done
 for s in 1 2 3 4; do row "ALS crowded, seed $s" "$WORK/als_crowded_$s/tile.las" --reference treeID; done
-for s in 1 2 3; do row "TLS, seed $s" "$WORK/tls_$s/tile.las" --reference treeID; done
-for s in 1 2 3; do row "TLS, seed $s, ground filtered" "$WORK/tls_$s/tile.las" --reference treeID --ignore-classification; done
+for s in 21 22 23; do row "TLS open, seed $s" "$WORK/tls_open_$s/tile.las" --reference treeID; done
+for s in 21 22 23; do row "TLS open, seed $s, ground filtered" "$WORK/tls_open_$s/tile.las" --reference treeID --ignore-classification; done
+for s in 1 2 3; do row "TLS crowded, seed $s" "$WORK/tls_crowded_$s/tile.las" --reference treeID; done
 
 echo
 echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
@@ -110,4 +114,5 @@ PY
 scale "ALS x1" "$WORK/als_open_11/tile.las"
 scale "ALS x4 (2 x 2 copies)" "$WORK/als_open_11/tile.las" --replicate 2
 scale "ALS x16 (4 x 4 copies)" "$WORK/als_open_11/tile.las" --replicate 4
-for s in 1 2 3; do scale "TLS seed $s" "$WORK/tls_$s/tile.las"; done
+for s in 21 22 23; do scale "TLS open seed $s" "$WORK/tls_open_$s/tile.las"; done
+for s in 1 2 3; do scale "TLS crowded seed $s" "$WORK/tls_crowded_$s/tile.las"; done

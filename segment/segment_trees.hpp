@@ -40,8 +40,10 @@ struct SegmentOptions {
     ScanMode mode = ScanMode::Automatic;
     float min_tree_height = 2.0f;        // trees whose top is lower are not trees (metres above ground)
     // Automatic choice: terrestrial when the non-ground points are at least this dense over the
-    // tile's occupied footprint (points per square metre); airborne otherwise.
-    float terrestrial_density = 800.0f;
+    // tile's occupied footprint (points per square metre); airborne otherwise. Airborne surveys
+    // give 1-100 per m^2 (dense drone surveys more: pass the mode then), terrestrial plots
+    // hundreds to thousands.
+    float terrestrial_density = 200.0f;
 
     // Airborne (canopy height model and crowns).
     float chm_cell = 0.5f;               // CHM cell edge (metres)
