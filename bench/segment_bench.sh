@@ -55,10 +55,13 @@ if s:
     score = f"{s['reference_trees']:5d} {s['found_trees']:5d} {s['matched']:5d} {s['f1']:6.3f} {100 * s['points_right']:6.1f}"
 else:
     score = "    -     -     -      -      -"
-print(f"{sys.argv[1]:<34} {d['ground_source']:<10} {d['mode']:<4} {score} {d['seconds']['total']:7.2f} {d['peak_memory_mb']:7.0f}")
+g = d.get("ground_check")
+ground = f"{100 * g['found_as_ground']:6.1f} {g['rms_height_m']:6.3f}" if g else "     -      -"
+print(f"{sys.argv[1]:<34} {d['ground_source']:<10} {d['mode']:<4} {score} {ground} {d['seconds']['total']:7.2f} {d['peak_memory_mb']:7.0f}")
 PY
 }
-header() { printf '%-34s %-10s %-4s %5s %5s %5s %6s %6s %7s %7s\n' "$1" ground mode true found match F1 right% seconds peak_MB; }
+# g_found% / g_rms_m: the input's class-2 points found as ground / their RMS height above the DTM.
+header() { printf '%-34s %-10s %-4s %5s %5s %5s %6s %6s %6s %6s %7s %7s\n' "$1" ground mode true found match F1 right% g_fnd% g_rms seconds peak_MB; }
 
 echo "== synthetic tiles (trees > 5 m; right% = points of those trees in their matched tree)"
 header "tile"
@@ -98,7 +101,7 @@ for t in d["tree_list"]:
 PY
 
 echo
-echo "== scaling (ALS open seed 11 and its 2 x 2 and 4 x 4 copies; TLS tiles as generated)"
+echo "== scaling (ALS open seed 11 and its 2 x 2, 3 x 3 and 6 x 6 copies; TLS tiles as generated)"
 printf '%-34s %9s %9s %9s %9s %8s\n' input points terrain_s segment_s total_s peak_MB
 scale() {
   local label=$1 result
@@ -113,6 +116,7 @@ PY
 }
 scale "ALS x1" "$WORK/als_open_11/tile.las"
 scale "ALS x4 (2 x 2 copies)" "$WORK/als_open_11/tile.las" --replicate 2
-scale "ALS x16 (4 x 4 copies)" "$WORK/als_open_11/tile.las" --replicate 4
+scale "ALS x9 (3 x 3 copies)" "$WORK/als_open_11/tile.las" --replicate 3
+scale "ALS x36 (6 x 6 copies)" "$WORK/als_open_11/tile.las" --replicate 6
 for s in 21 22 23; do scale "TLS open seed $s" "$WORK/tls_open_$s/tile.las"; done
 for s in 1 2 3; do scale "TLS crowded seed $s" "$WORK/tls_crowded_$s/tile.las"; done
