@@ -3,8 +3,10 @@
 # through a small program: terrain, segmentation, scoring against per-point reference labels):
 #   1. synthetic tiles with truth (`treelobes synth tile`: mixed species of the library, 20-degree
 #      slope, 1 m roughness, understory): detection F1 of trees taller than 5 m and the share of
-#      points assigned to the right tree, ALS (open and crowded stands) and TLS, with the input's
-#      ground class and with the ground filtered afresh (--ignore-classification);
+#      points assigned to the right tree, ALS and TLS, open stands (25 trees on 1 ha, 10 on
+#      40 x 40 m) and crowded ones (30 on 80 x 80 m, 12 on 30 x 30 m: the synth tile relaxes its
+#      spacing and broad crowns interpenetrate), with the input's ground class and with the ground
+#      filtered afresh (--ignore-classification);
 #   2. lidR/MixedConifer.las against lidR's treeID (defaults and the conifer setting);
 #   3. treels/pine_plot.las: stems found, with their positions and diameters;
 #   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
@@ -37,7 +39,8 @@ tile() {
 }
 for s in 11 12 13 14; do tile "als_open_$s" "$s" --trees 25 --size 100 --scanner als; done
 for s in 1 2 3 4; do tile "als_crowded_$s" "$s" --trees 30 --size 80 --scanner als; done
-for s in 1 2 3; do tile "tls_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
+for s in 21 22 23; do tile "tls_open_$s" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25; done
+for s in 1 2 3; do tile "tls_crowded_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
 
 # row LABEL ARGS...: one table row from one segment_eval run.
 row() {
@@ -52,18 +55,22 @@ if s:
     score = f"{s['reference_trees']:5d} {s['found_trees']:5d} {s['matched']:5d} {s['f1']:6.3f} {100 * s['points_right']:6.1f}"
 else:
     score = "    -     -     -      -      -"
-print(f"{sys.argv[1]:<34} {d['ground_source']:<10} {d['mode']:<4} {score} {d['seconds']['total']:7.2f} {d['peak_memory_mb']:7.0f}")
+g = d.get("ground_check")
+ground = f"{100 * g['found_as_ground']:6.1f} {g['rms_height_m']:6.3f}" if g else "     -      -"
+print(f"{sys.argv[1]:<34} {d['ground_source']:<10} {d['mode']:<4} {score} {ground} {d['seconds']['total']:7.2f} {d['peak_memory_mb']:7.0f}")
 PY
 }
-header() { printf '%-34s %-10s %-4s %5s %5s %5s %6s %6s %7s %7s\n' "$1" ground mode true found match F1 right% seconds peak_MB; }
+# g_found% / g_rms_m: the input's class-2 points found as ground / their RMS height above the DTM.
+header() { printf '%-34s %-10s %-4s %5s %5s %5s %6s %6s %6s %6s %7s %7s\n' "$1" ground mode true found match F1 right% g_fnd% g_rms seconds peak_MB; }
 
 echo "== synthetic tiles (trees > 5 m; right% = points of those trees in their matched tree)"
 header "tile"
 for s in 11 12 13 14; do row "ALS open, seed $s" "$WORK/als_open_$s/tile.las" --reference treeID; done
 for s in 11 12 13 14; do row "ALS open, seed $s, ground filtered" "$WORK/als_open_$s/tile.las" --reference treeID --ignore-classification; done
 for s in 1 2 3 4; do row "ALS crowded, seed $s" "$WORK/als_crowded_$s/tile.las" --reference treeID; done
-for s in 1 2 3; do row "TLS, seed $s" "$WORK/tls_$s/tile.las" --reference treeID; done
-for s in 1 2 3; do row "TLS, seed $s, ground filtered" "$WORK/tls_$s/tile.las" --reference treeID --ignore-classification; done
+for s in 21 22 23; do row "TLS open, seed $s" "$WORK/tls_open_$s/tile.las" --reference treeID; done
+for s in 21 22 23; do row "TLS open, seed $s, ground filtered" "$WORK/tls_open_$s/tile.las" --reference treeID --ignore-classification; done
+for s in 1 2 3; do row "TLS crowded, seed $s" "$WORK/tls_crowded_$s/tile.las" --reference treeID; done
 
 echo
 echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
@@ -94,7 +101,7 @@ for t in d["tree_list"]:
 PY
 
 echo
-echo "== scaling (ALS open seed 11 and its 2 x 2 and 4 x 4 copies; TLS tiles as generated)"
+echo "== scaling (ALS open seed 11 and its 2 x 2, 3 x 3 and 6 x 6 copies; TLS tiles as generated)"
 printf '%-34s %9s %9s %9s %9s %8s\n' input points terrain_s segment_s total_s peak_MB
 scale() {
   local label=$1 result
@@ -109,5 +116,7 @@ PY
 }
 scale "ALS x1" "$WORK/als_open_11/tile.las"
 scale "ALS x4 (2 x 2 copies)" "$WORK/als_open_11/tile.las" --replicate 2
-scale "ALS x16 (4 x 4 copies)" "$WORK/als_open_11/tile.las" --replicate 4
-for s in 1 2 3; do scale "TLS seed $s" "$WORK/tls_$s/tile.las"; done
+scale "ALS x9 (3 x 3 copies)" "$WORK/als_open_11/tile.las" --replicate 3
+scale "ALS x36 (6 x 6 copies)" "$WORK/als_open_11/tile.las" --replicate 6
+for s in 21 22 23; do scale "TLS open seed $s" "$WORK/tls_open_$s/tile.las"; done
+for s in 1 2 3; do scale "TLS crowded seed $s" "$WORK/tls_crowded_$s/tile.las"; done

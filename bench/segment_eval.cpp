@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -151,6 +152,20 @@ int run(int argc, char** argv) {
                 {"seconds", {{"terrain", terrain_seconds}, {"segment", total_seconds - terrain_seconds}, {"total", total_seconds}}},
                 {"peak_memory_mb", peak_memory_mb()},
                 {"peak_memory_mb_after_reading", memory_before}};
+    if (std::count(cloud.classification.begin(), cloud.classification.end(), std::uint8_t{2}) > 0) {
+        // The input's ground class as a check of the terrain (meaningful with
+        // --ignore-classification): share of its points found as ground, RMS of their height above the DTM.
+        std::size_t count = 0, found = 0;
+        double squares = 0;
+        for (std::size_t i = 0; i < cloud.size(); ++i) {
+            if (cloud.classification[i] != 2) continue;
+            ++count;
+            found += terrain.is_ground[i];
+            squares += static_cast<double>(terrain.height_above_ground[i]) * terrain.height_above_ground[i];
+        }
+        out["ground_check"] = {{"class2_points", count}, {"found_as_ground", static_cast<double>(found) / count},
+                               {"rms_height_m", std::sqrt(squares / count)}};
+    }
     if (!reference.empty())
         out["score"] = score_json(score_segmentation(reference, trees.tree_id, terrain.height_above_ground, min_height));
     if (list_trees) {

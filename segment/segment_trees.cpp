@@ -81,7 +81,7 @@ std::vector<std::uint8_t> vegetation_points(const PointCloud& cloud, const Terra
 }
 
 // Airborne or terrestrial from the density of the vegetation points over the occupied 1 m cells:
-// an airborne survey gives tens of points per square metre, a terrestrial scan thousands.
+// an airborne survey gives 1-100 points per square metre, a terrestrial scan hundreds to thousands.
 ScanMode choose_mode(const PointCloud& cloud, const std::vector<std::uint8_t>& vegetation, const SegmentOptions& options,
                      std::string& reason) {
     std::unordered_map<std::int64_t, std::uint32_t> cells;
@@ -484,8 +484,9 @@ std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cl
     return Stem{circle.centre, circle.radius, circle.inliers, std::move(on_circle)};
 }
 
-// Stems found in the slice, one per trunk: arcs of one trunk split by occlusion give circles
-// whose centres lie within each other; the one with more inliers stays.
+// Stems found in the slice that also have points under them down to the ground clearance, one
+// per trunk: arcs of one trunk split by occlusion give circles whose centres lie within each
+// other; the one with more inliers stays.
 std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
                              const SegmentOptions& options) {
     std::vector<int> slice;
@@ -493,9 +494,25 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
         const float h = terrain.height_above_ground[i];
         if (vegetation[i] && h >= options.stem_slice_low && h <= options.stem_slice_high) slice.push_back(static_cast<int>(i));
     }
+    // Points between the graph's floor and the slice, flattened: a stem continues down to the
+    // ground (within 1.5 radii: root flare), a branch or a drooping crown that crosses the slice
+    // does not.
+    std::vector<Eigen::Vector3f> below;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        if (vegetation[i] && terrain.height_above_ground[i] < options.stem_slice_low)
+            below.emplace_back(cloud.positions[i].x(), cloud.positions[i].y(), 0.0f);
+    if (below.empty()) return {};
+    const KdTree below_index(below);
+    std::vector<int> near;
+    std::vector<float> squared;
+    const auto reaches_ground = [&](const Stem& stem) {
+        below_index.radius_search(Eigen::Vector3f(stem.centre.x(), stem.centre.y(), 0.0f), 1.5f * stem.radius + 2.0f * options.circle_tolerance,
+                                  near, squared, static_cast<std::size_t>(options.min_stem_points));
+        return static_cast<int>(near.size()) >= options.min_stem_points;
+    };
     std::vector<Stem> stems;
     for (const auto& cluster : cluster_slice(cloud, slice, options.stem_cluster_distance))
-        if (auto stem = fit_stem(cloud, cluster, options)) stems.push_back(std::move(*stem));
+        if (auto stem = fit_stem(cloud, cluster, options); stem && reaches_ground(*stem)) stems.push_back(std::move(*stem));
     std::stable_sort(stems.begin(), stems.end(), [](const Stem& a, const Stem& b) { return a.inliers > b.inliers; });
     std::vector<Stem> kept;
     for (auto& stem : stems) {

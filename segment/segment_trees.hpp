@@ -3,18 +3,21 @@
 // Airborne scans see crowns from above: a pit-free canopy height model (highest point per cell
 // with each point drawn as a small disc, pits filled from their neighbours' median, Ben-Arie et
 // al. 2009), treetops as local maxima in a window that widens with height (Popescu & Wynne 2004,
-// §2.4) that also stand out from the saddles to higher tops (dynamics, Grimaud 1992), crowns grown from the tops over the CHM (Dalponte & Coomes 2016, §2.3: a cell joins a
-// neighbouring crown when it is high enough relative to that crown's top and near it); every
-// point above `min_tree_height` goes to the crown of its CHM cell, including points below the
-// crown surface.
+// §2.4) on a smoothed CHM, tops merged into a higher neighbour across shallow high passes (their
+// dynamics, Grimaud 1992), crowns grown from the remaining tops over the CHM (Dalponte & Coomes
+// 2016, §2.3: a cell joins a neighbouring crown when it is high enough relative to that crown's
+// top and mean and near it); every vegetation point goes to the crown of its CHM cell, points
+// below the crown surface included.
 //
 // Terrestrial (dense) scans see stems: the points of a slice above the DTM are clustered, and
-// clusters that fit circles are stems (Liang et al. 2012, §2.2); then one multi-source Dijkstra
-// over the whole plot's neighbour graph, from all stem bases at once (the multi-root variant of
-// the skeleton's shortest paths, Livny et al. 2010, §3), gives every point to the base it
-// reaches most cheaply. The graph is built on a voxel-thinned copy of the non-ground points
-// with no edge longer than `max_gap`, and every point takes the label of its voxel: points
-// no base reaches (understory apart from the trees, clutter beyond a gap) stay 0.
+// clusters that fit upright circles with points under them down to the ground are stems (Liang
+// et al. 2012, §2.2); then one multi-source Dijkstra over the whole plot's neighbour graph, from
+// all stem bases at once (the multi-root variant of the skeleton's shortest paths, Livny et al.
+// 2010, §3), gives every point to the base it reaches most cheaply, an edge costing
+// length^graph_beta. The graph is built on a voxel-thinned copy of the non-ground points with no
+// edge longer than `max_gap`, and every point takes the label of its voxel: points no base
+// reaches (understory apart from the trees, clutter beyond a gap) stay 0.
+// docs/segment.md has the figures and the settings for dense conifer stands.
 #pragma once
 
 #include "core/point_cloud.hpp"
@@ -40,8 +43,10 @@ struct SegmentOptions {
     ScanMode mode = ScanMode::Automatic;
     float min_tree_height = 2.0f;        // trees whose top is lower are not trees (metres above ground)
     // Automatic choice: terrestrial when the non-ground points are at least this dense over the
-    // tile's occupied footprint (points per square metre); airborne otherwise.
-    float terrestrial_density = 800.0f;
+    // tile's occupied footprint (points per square metre); airborne otherwise. Airborne surveys
+    // give 1-100 per m^2 (dense drone surveys more: pass the mode then), terrestrial plots
+    // hundreds to thousands.
+    float terrestrial_density = 200.0f;
 
     // Airborne (canopy height model and crowns).
     float chm_cell = 0.5f;               // CHM cell edge (metres)

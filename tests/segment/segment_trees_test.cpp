@@ -81,7 +81,9 @@ TEST(SegmentTrees, AirborneSeparatesTwoCrownsHighestFirst) {
     EXPECT_NEAR(result.trees[0].top.z() - result.trees[0].base.z(), 15.0f, 0.2f);
     EXPECT_NEAR(result.trees[1].top.x(), 12.5f, 0.2f);
     for (std::size_t i = 0; i < tile.truth.size(); ++i)
-        if (!tile.truth[i]) ASSERT_EQ(result.tree_id[i], 0) << "ground point " << i;
+        if (!tile.truth[i]) {
+            ASSERT_EQ(result.tree_id[i], 0) << "ground point " << i;
+        }
 }
 
 TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
@@ -103,12 +105,18 @@ TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
     // Crown points on the far side of each ball belong to their own tree.
     for (std::size_t i = 0; i < tile.truth.size(); ++i) {
         const Eigen::Vector3f& p = tile.cloud.positions[i];
-        if (p.z() > 6.0f && p.x() < -0.5f) ASSERT_EQ(result.tree_id[i], 1);
-        if (p.z() > 6.0f && p.x() > 3.5f) ASSERT_EQ(result.tree_id[i], 2);
+        if (p.z() > 6.0f && p.x() < -0.5f) {
+            ASSERT_EQ(result.tree_id[i], 1);
+        }
+        if (p.z() > 6.0f && p.x() > 3.5f) {
+            ASSERT_EQ(result.tree_id[i], 2);
+        }
     }
     // The bush is out of reach (more than max_gap from any tree), the ground is not a tree.
     for (std::size_t i = 0; i < tile.truth.size(); ++i)
-        if (!tile.truth[i]) ASSERT_EQ(result.tree_id[i], 0) << "point " << i;
+        if (!tile.truth[i]) {
+            ASSERT_EQ(result.tree_id[i], 0) << "point " << i;
+        }
     const SegmentationScore score = score_segmentation(tile.truth, result.tree_id, terrain.height_above_ground, 5.0f);
     EXPECT_EQ(score.f1, 1.0);
     EXPECT_GT(score.points_right, 0.85);
