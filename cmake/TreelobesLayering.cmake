@@ -19,11 +19,13 @@ set(TREELOBES_DEPENDS_classify core geometry render
 set(TREELOBES_DEPENDS_segment core geometry render)
 # forestry: measures and the per-tree pipeline of a tile, which runs the whole chain on each tree.
 set(TREELOBES_DEPENDS_forestry core geometry reconstruct lobes encode classify)
+# survey: many tiles (their list and shards, completion markers, memory estimate, retiling, merging).
+set(TREELOBES_DEPENDS_survey core encode)
 set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct lobes classify synth render
-    segment forestry)
+    segment forestry survey)
 # Build order of the stage folders (each one CMake library target treelobes_<stage>).
 set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct synth segment lobes classify
-    forestry apps)
+    forestry survey apps)
 
 # Fails with one message naming the file and the include when a source of `stage` (a folder of
 # `root`) includes "<folder>/..." that is neither the stage itself nor in its list. A folder with
