@@ -6,6 +6,7 @@
 #include "survey_fixture.hpp"
 
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <nlohmann/json.hpp>
 
 using namespace treelobes;
@@ -36,7 +37,12 @@ TEST(SurveyCluster, SlurmJobArrayMergesToTheBytesOfOneRun) {
     int logs = 0;
     for (const auto& entry : fs::directory_iterator(dir / "jobs")) logs += entry.path().filename().string().rfind("treelobes-batch-", 0) == 0;
     EXPECT_EQ(logs, 4);
-    EXPECT_EQ(shell("pgrep -f '" + (dir / "cluster").string() + "' >/dev/null"), 1) << "a daemon of the test cluster is still running";
+    // The daemons are gone: their pid files are removed or name no live process.
+    for (const fs::path& pid_file : {dir / "cluster" / "munge" / "munged.pid", dir / "cluster" / "slurmctld.pid", dir / "cluster" / "slurmd.pid"}) {
+        if (!fs::exists(pid_file)) continue;
+        const pid_t pid = static_cast<pid_t>(std::stol(file_bytes(pid_file)));
+        EXPECT_NE(kill(pid, 0), 0) << pid_file << ": process " << pid << " still runs";
+    }
 
     ASSERT_EQ(shell(cli() + " merge '" + (dir / "sharded").string() + "' --out '" + (dir / "sharded_merged").string() + "' >/dev/null"), 0);
     expect_same_merge(dir / "single_merged", dir / "sharded_merged");
