@@ -7,6 +7,7 @@
 #include "core/error.hpp"
 #include "core/version.hpp"
 #include "reconstruct/skeleton_eval.hpp"
+#include "reconstruct/visible_reference.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -24,6 +25,8 @@ struct EvalSkeletonOptions {
     std::string reference_kind = "auto";
     std::string skeleton_kind = "skeleton";
     std::string samples_out;
+    std::string visible_in;
+    std::size_t visible_points = 5;
     EvalOptions eval;
 };
 
@@ -39,6 +42,7 @@ nlohmann::json to_json(const EvalSkeletonOptions& o, const SkeletonGraph& ref, c
                         {"skeleton", o.skeleton},
                         {"reference", o.reference},
                         {"reference_kind", ref.kind},
+                        {"visible_in", o.visible_in.empty() ? nlohmann::json() : nlohmann::json(o.visible_in)},
                         {"sample_step", o.eval.sample_step},
                         {"skeleton_to_reference", stats_json(c.to_reference)},
                         {"reference_to_skeleton", stats_json(c.from_reference)},
@@ -62,7 +66,8 @@ void print_stats(const char* label, const DistanceStats& s) {
 }
 
 void print_human(const EvalSkeletonOptions& o, const SkeletonGraph& ref, const SkeletonComparison& c) {
-    std::printf("%s vs %s (%s)\n", o.skeleton.c_str(), o.reference.c_str(), ref.kind.c_str());
+    std::printf("%s vs %s (%s%s)\n", o.skeleton.c_str(), o.reference.c_str(), ref.kind.c_str(),
+                o.visible_in.empty() ? "" : ", the part the scan sees");
     print_stats("skeleton -> reference:", c.to_reference);
     print_stats("reference -> skeleton:", c.from_reference);
     std::printf("  length %.2f m", c.length);
@@ -93,7 +98,15 @@ void write_samples(const SkeletonComparison& c, const std::string& path) {
 
 int run_eval_skeleton(const EvalSkeletonOptions& o, const GlobalOptions& global) {
     const SkeletonGraph skeleton = read_skeleton_graph(o.skeleton, o.skeleton_kind);
-    const SkeletonGraph reference = read_skeleton_graph(o.reference, o.reference_kind);
+    SkeletonGraph reference = read_skeleton_graph(o.reference, o.reference_kind);
+    if (!o.visible_in.empty()) {
+        const PointCloud scan = read_point_cloud(o.visible_in);
+        const ExtraAttribute* internode = scan.extra("internode");
+        if (!internode) throw Error::input(o.visible_in, "--visible-in needs a scan with the `internode` attribute (a `treelobes synth` scan)");
+        // Leaf points count too: they carry the internode of the twig they grow on, whose place
+        // they show (a skeleton through a leafy twig is right).
+        reference = visible_reference(reference, internode->values, o.visible_points);
+    }
     const SkeletonComparison c = compare_skeletons(skeleton, reference, o.eval);
     if (!o.samples_out.empty()) write_samples(c, o.samples_out);
     if (global.json) std::cout << to_json(o, reference, c).dump(2) << "\n";
@@ -120,6 +133,11 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
         ->check(cli::PositiveNumber)->capture_default_str();
     sub->add_option("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
         ->check(cli::NonNegativeNumber)->capture_default_str();
+    sub->add_option("--visible-in", options->visible_in,
+                    "A synthetic scan of the reference (points labelled with `internode`): score against the part of the "
+                    "reference it sees, i.e. the internodes holding --visible-points of its points (bark or leaves) and their way to the root");
+    sub->add_option("--visible-points", options->visible_points, "Scan points an internode needs to count as seen")
+        ->check(CLI::Range(1, 1000000))->capture_default_str();
     sub->add_option("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
     sub->callback([options, &global, &job] { job = [options, &global] { return run_eval_skeleton(*options, global); }; });
 }

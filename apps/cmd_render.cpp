@@ -75,8 +75,8 @@ int run_render(const RenderOptions& options, const GlobalOptions& global) {
     for (const auto& item : items) bounds_of(item, lo, hi);
     if (!lo.allFinite() || (lo.array() > hi.array()).any()) throw Error::input(options.inputs.front(), "nothing to draw");
     const render::View view = render::View::side(lo, hi, options.azimuth, options.elevation);
-    const int width = std::max(64, static_cast<int>(options.size * std::max(0.3, std::hypot(hi.x() - lo.x(), hi.y() - lo.y()) /
-                                                                              std::max(1e-6, hi.z() - lo.z()))));
+    // Panels shaped like the subject seen from this view, so that it fills the frame.
+    const int width = std::max(64, static_cast<int>(options.size * std::max(0.3, view.aspect())));
     std::vector<render::Image> panels;
     for (const auto& item : items) panels.push_back(draw(item, view, std::min(width, 4096), options.size));
     render::write_png(render::side_by_side(panels), options.out);

@@ -95,6 +95,7 @@ json tree_options_json(const TileCliOptions& o) {
             {"gamma", t.reconstruct.allometry.gamma},
             {"fs", t.reconstruct.allometry.fs},
             {"alpha_factor", t.lobes.alpha.alpha_factor},
+            {"lobe_shape_points", t.lobes.max_shape_points},
             {"dbf6_resolution", t.dbf6.encode.resolution},
             {"dbf6_lods", t.dbf6.lods},
             {"breast_height", t.dbh.breast_height},
@@ -376,6 +377,9 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
 
 void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<TileCliOptions>();
+    // A tile has hundreds of trees: lobes from at most 2,000 grid-thinned points each (the single-tree
+    // `lobes` command takes 6,000), which keeps the alpha shapes, the slowest per-tree stage, affordable.
+    o->trees.lobes.max_shape_points = 2000;
     CLI::App* sub = app.add_subcommand(
         "tile", "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
                 "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
@@ -397,6 +401,8 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
         ->check(CLI::Range(10, 100000000))->capture_default_str();
     sub->add_option("--outlier-test", o->outlier_test, "Outlier test of the per-tree reconstruction: auto, global, local")
         ->check(CLI::IsMember({"auto", "global", "local"}))->capture_default_str();
+    sub->add_option("--lobe-shape-points", o->trees.lobes.max_shape_points, "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
+        ->check(CLI::Range(100, 10000000))->capture_default_str();
     sub->add_option("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")
         ->check(CLI::Range(1.0, 64.0))->capture_default_str();
     sub->add_option("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16))->capture_default_str();

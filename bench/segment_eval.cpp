@@ -92,7 +92,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
     const float v = std::stof(assignment.substr(equals + 1));
     const std::map<std::string, float*> fields = {
         {"chm_cell", &o.chm_cell},           {"point_radius", &o.point_radius},   {"pit_depth", &o.pit_depth},
-        {"window_base", &o.window_base},     {"window_per_metre", &o.window_per_metre}, {"max_window", &o.max_window},
+        {"window_base", &o.window_base},     {"window_per_metre", &o.window_per_metre}, {"max_window", &o.max_window}, {"min_top_prominence", &o.min_top_prominence}, {"top_prominence_ratio", &o.top_prominence_ratio}, {"merge_pass_ratio", &o.merge_pass_ratio}, {"chm_smoothing", &o.chm_smoothing}, {"max_stem_lean", &o.max_stem_lean}, {"graph_beta", &o.graph_beta},
         {"seed_ratio", &o.seed_ratio},       {"crown_ratio", &o.crown_ratio},     {"max_crown_radius", &o.max_crown_radius},
         {"min_tree_height", &o.min_tree_height}, {"max_gap", &o.max_gap},         {"graph_voxel", &o.graph_voxel},
         {"stem_slice_low", &o.stem_slice_low}, {"stem_slice_high", &o.stem_slice_high},

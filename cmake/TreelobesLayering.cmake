@@ -10,22 +10,19 @@ set(TREELOBES_DEPENDS_lsystem core)
 set(TREELOBES_DEPENDS_encode core)
 set(TREELOBES_DEPENDS_render core)
 set(TREELOBES_DEPENDS_reconstruct core geometry)
+set(TREELOBES_DEPENDS_segment core geometry render)
 set(TREELOBES_DEPENDS_synth core geometry config)
 # lobes and classify start from a first reconstruction of the tree: its entry points only.
 set(TREELOBES_DEPENDS_lobes core geometry config lsystem reconstruct/reconstruct_tree.hpp)
 set(TREELOBES_DEPENDS_classify core geometry render
     reconstruct/reconstruct_tree.hpp reconstruct/preprocess.hpp reconstruct/skeleton.hpp reconstruct/allometry.hpp)
-# segment: a tile into terrain and trees (render/ for the hillshade image only).
-set(TREELOBES_DEPENDS_segment core geometry render)
-# forestry: measures and the per-tree pipeline of a tile, which runs the whole chain on each tree.
-set(TREELOBES_DEPENDS_forestry core geometry reconstruct lobes encode classify)
+# forestry runs every tree of a tile through the single-tree stages: their entry points.
+set(TREELOBES_DEPENDS_forestry core geometry encode lobes classify reconstruct/reconstruct_tree.hpp)
 # survey: many tiles (their list and shards, completion markers, memory estimate, retiling, merging).
 set(TREELOBES_DEPENDS_survey core encode)
-set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct lobes classify synth render
-    segment forestry survey)
+set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct segment lobes classify forestry survey synth render)
 # Build order of the stage folders (each one CMake library target treelobes_<stage>).
-set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct synth segment lobes classify
-    forestry survey apps)
+set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct segment synth lobes classify forestry survey apps)
 
 # Fails with one message naming the file and the include when a source of `stage` (a folder of
 # `root`) includes "<folder>/..." that is neither the stage itself nor in its list. A folder with

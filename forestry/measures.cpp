@@ -2,8 +2,8 @@
 
 #include "core/error.hpp"
 #include "geometry/grid_thinning.hpp"
-#include "lobes/alpha_shape.hpp"
 #include "geometry/ransac_fit.hpp"
+#include "lobes/alpha_shape.hpp"
 
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_point.hpp>
@@ -72,6 +72,12 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
     m.rms = fit.rms;
     if (fit.inliers < options.min_inliers) return not_visible(m, "too few points on the fitted circle");
     if (fit.rms > options.max_relative_rms * fit.radius) return not_visible(m, "the breast-height points do not lie on a circle");
+    // A scanned stem is hollow: its points lie on the bark. Points filling the circle are
+    // foliage or undergrowth, on which RANSAC also finds some circle.
+    std::size_t interior = 0;
+    for (const auto& p : slice) interior += (p - fit.centre).norm() < options.hollow_fraction * fit.radius;
+    if (static_cast<double>(interior) > options.max_interior_share * static_cast<double>(fit.inliers))
+        return not_visible(m, "the breast-height points fill the circle (foliage or undergrowth, not a stem)");
     if (fit.coverage < options.min_coverage) return not_visible(m, "the stem is seen over less than a quarter of its circumference");
     m.quality = fit.coverage >= options.ok_coverage ? DbhQuality::Ok : DbhQuality::PartialArc;
     m.diameter = 2.0 * fit.radius;

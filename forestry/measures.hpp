@@ -30,6 +30,8 @@ struct DbhOptions {
     double ok_coverage = 0.6;       // fraction of 10-degree sectors around the centre holding inliers
     double min_coverage = 0.25;     // below: not_visible
     double max_relative_rms = 0.25; // rms / radius above this: not a stem (branch clutter, leaves)
+    double hollow_fraction = 0.6;   // points closer to the centre than this many radii are inside the stem...
+    double max_interior_share = 0.25; // ...and more of them than this share of the inliers: not a stem
 };
 
 struct DbhMeasure {
@@ -52,8 +54,8 @@ struct CrownOptions {
     double base_quantile = 0.05;       // crown base = this quantile of the crown points' HAG
     std::size_t min_points = 10;
     double alpha_factor = 2.0;         // crown volume: alpha shape at alpha = factor * alpha_min
-    double volume_cell = 0.1;          // metres: crown points thinned on this grid for the alpha shape
-    std::size_t max_volume_points = 8000;
+    double volume_cell = 0.25;         // metres: crown points thinned on this grid for the alpha shape
+    std::size_t max_volume_points = 3000;
 };
 
 struct CrownMeasure {

@@ -26,27 +26,50 @@ View View::side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azi
     return view;
 }
 
-Rasterizer::Rasterizer(int width, int height, const View& view, Rgba background)
-    : image_(width, height, background),
-      depth_(static_cast<std::size_t>(width) * height, std::numeric_limits<double>::infinity()) {
+namespace {
+
+struct ImageAxes {
+    Eigen::Vector3d forward, right, up;
+    double half_width = 1e-9, half_height = 1e-9;  // of the view's box on the image axes
+};
+
+ImageAxes image_axes(const View& view) {
     if (!view.forward.allFinite() || view.forward.norm() == 0) throw Error::usage("render: view direction is zero");
-    forward_ = view.forward.normalized();
+    ImageAxes axes;
+    axes.forward = view.forward.normalized();
     // Image axes: right = forward x up, up = right x forward (Gram-Schmidt against forward).
-    Eigen::Vector3d up = view.up - view.up.dot(forward_) * forward_;
-    if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY().dot(forward_) * forward_;
-    up_ = up.normalized();
-    right_ = forward_.cross(up_).normalized();
-    centre_ = 0.5 * (view.lo + view.hi);
-    // Extent of the box's corners on the image axes decides the scale.
-    double half_w = 1e-9, half_h = 1e-9;
+    Eigen::Vector3d up = view.up - view.up.dot(axes.forward) * axes.forward;
+    if (up.norm() < 1e-9) up = Eigen::Vector3d::UnitY() - Eigen::Vector3d::UnitY().dot(axes.forward) * axes.forward;
+    axes.up = up.normalized();
+    axes.right = axes.forward.cross(axes.up).normalized();
+    const Eigen::Vector3d centre = 0.5 * (view.lo + view.hi);
     for (int corner = 0; corner < 8; ++corner) {
         const Eigen::Vector3d p((corner & 1) ? view.hi.x() : view.lo.x(), (corner & 2) ? view.hi.y() : view.lo.y(),
                                 (corner & 4) ? view.hi.z() : view.lo.z());
-        half_w = std::max(half_w, std::abs((p - centre_).dot(right_)));
-        half_h = std::max(half_h, std::abs((p - centre_).dot(up_)));
+        axes.half_width = std::max(axes.half_width, std::abs((p - centre).dot(axes.right)));
+        axes.half_height = std::max(axes.half_height, std::abs((p - centre).dot(axes.up)));
     }
+    return axes;
+}
+
+}  // namespace
+
+double View::aspect() const {
+    const ImageAxes axes = image_axes(*this);
+    return axes.half_width / axes.half_height;
+}
+
+Rasterizer::Rasterizer(int width, int height, const View& view, Rgba background)
+    : image_(width, height, background),
+      depth_(static_cast<std::size_t>(width) * height, std::numeric_limits<double>::infinity()) {
+    const ImageAxes axes = image_axes(view);
+    forward_ = axes.forward;
+    up_ = axes.up;
+    right_ = axes.right;
+    centre_ = 0.5 * (view.lo + view.hi);
+    // Extent of the box's corners on the image axes decides the scale.
     const double usable = 1.0 - 2.0 * view.margin;
-    scale_ = std::min(width * usable / (2 * half_w), height * usable / (2 * half_h));
+    scale_ = std::min(width * usable / (2 * axes.half_width), height * usable / (2 * axes.half_height));
 }
 
 Eigen::Vector3d Rasterizer::project(const Eigen::Vector3d& world) const {

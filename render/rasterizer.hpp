@@ -26,6 +26,10 @@ struct View {
     // and `elevation_deg` above the horizon.
     static View side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azimuth_deg = 0,
                      double elevation_deg = 10);
+
+    // Width over height of the box [lo, hi] as this view sees it: the image shape in which the
+    // box fills the frame.
+    double aspect() const;
 };
 
 class Rasterizer {

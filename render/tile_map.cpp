@@ -57,7 +57,12 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
     auto column = [&](double x) { return m + static_cast<int>((x - lo.x()) / pixel); };
     auto row = [&](double y) { return height - 1 - m - static_cast<int>((y - lo.y()) / pixel); };  // north up
 
-    // Highest point per pixel decides its colour (the view from above).
+    // Highest point per pixel decides its colour (the view from above). A sparse (airborne) scan
+    // leaves most pixels empty, so each point covers a disc about as wide as the mean point
+    // spacing over the tile's footprint.
+    const double area = std::max(static_cast<double>(hi.x() - lo.x()) * (hi.y() - lo.y()), pixel * pixel);
+    const double spacing = std::sqrt(area / static_cast<double>(cloud.size()));
+    const int splat = std::min(12, static_cast<int>(std::ceil(0.75 * spacing / pixel)) - 1);
     std::vector<float> top(static_cast<std::size_t>(width) * height, -std::numeric_limits<float>::infinity());
     std::vector<std::size_t> owner(top.size(), cloud.size());
     float lowest = std::numeric_limits<float>::infinity(), highest = -lowest;
@@ -65,11 +70,17 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
         const float h = height_above_ground.empty() ? cloud.positions[i].z() : height_above_ground[i];
         lowest = std::min(lowest, h);
         highest = std::max(highest, h);
-        const std::size_t cell = static_cast<std::size_t>(row(cloud.positions[i].y())) * width + column(cloud.positions[i].x());
-        if (cloud.positions[i].z() > top[cell]) {
-            top[cell] = cloud.positions[i].z();
-            owner[cell] = i;
-        }
+        const int cx = column(cloud.positions[i].x()), cy = row(cloud.positions[i].y());
+        for (int dy = -splat; dy <= splat; ++dy)
+            for (int dx = -splat; dx <= splat; ++dx) {
+                const int x = cx + dx, y = cy + dy;
+                if (dx * dx + dy * dy > splat * splat || x < 0 || y < 0 || x >= width || y >= height) continue;
+                const std::size_t cell = static_cast<std::size_t>(y) * width + x;
+                if (cloud.positions[i].z() > top[cell]) {
+                    top[cell] = cloud.positions[i].z();
+                    owner[cell] = i;
+                }
+            }
     }
     const float span = std::max(highest - lowest, 1e-3f);
     Image image(width, height, {255, 255, 255, 255});
@@ -82,7 +93,7 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
         for (int c = 0; c < 3; ++c) colour[c] = static_cast<std::uint8_t>(colour[c] * light);
         image.set(static_cast<int>(cell % width), static_cast<int>(cell / width), colour);
     }
-    const int mark = std::clamp(width / 250, 2, 6), scale = std::clamp(width / 500, 1, 3);
+    const int mark = std::clamp(width / 160, 3, 8), scale = std::clamp(width / 250, 2, 5);
     for (const auto& stem : stems) {
         const int x = column(stem.position.x()), y = row(stem.position.y());
         draw_disc(image, x, y, mark + 1, {255, 255, 255, 255});

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Set-up (scripts/setup.sh), then the main job on the bundled synthetic sample (data/synthetic/):
-# describe the files, reconstruct two scanned trees (skeleton, allometric radii, branch mesh),
-# score the skeletons against their ground truth, build the lobe-based representation and a full
-# synthesized tree, compress the skeletons as DBF6, and draw previews. Outputs go to ./demo-out/.
+# `treelobes tile` on a forest tile (ground, trees, a model and measures per tree, a table and a
+# top-view picture), then the single-tree stages: reconstruct two scanned trees (skeleton,
+# allometric radii, branch mesh), score the skeletons against the part of their true skeletons
+# the scans see, build the lobe-based representation and a full synthesized tree, compress a
+# skeleton as DBF6, and draw a preview. Outputs go to ./demo-out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -17,13 +19,34 @@ step() { echo; echo "== $*"; }
 step "info: the sample's scans"
 "$BIN" info "$SAMPLE"/*.las "$SAMPLE/tile/tile.las"
 
+step "tile: a forest tile in, every tree out"
+# Exit 3 means the tile is done but some trees were not modelled (listed in failures.jsonl).
+status=0
+"$BIN" tile "$SAMPLE/tile/tile.las" --out "$OUT/tile" || status=$?
+((status == 0 || status == 3)) || exit "$status"
+echo
+echo "trees found (from $OUT/tile/trees.csv; heights in metres above the ground; an airborne scan"
+echo "does not see stems, so DBH is 'not_visible' rather than guessed):"
+awk -F, 'NR == 1 { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", "tree", "x", "y", "height", "DBH", "crown_d", "crown_m3", "wood_m3", "points"; next }
+         { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $1, $2, $3, $5, ($6 == "" ? $7 : $6 " m"), $9, $11, $12, $15 }' \
+    "$OUT/tile/trees.csv"
+echo "$(($(wc -l <"$OUT/tile/trees.csv") - 1)) trees modelled; the tile holds $(($(wc -l <"$SAMPLE/tile/truth.csv") - 1)) true trees ($SAMPLE/tile/truth.csv)"
+if [[ -f "$OUT/tile/failures.jsonl" ]]; then
+    echo "$(wc -l <"$OUT/tile/failures.jsonl") segments not modelled (too few points for a tree model): $OUT/tile/failures.jsonl"
+fi
+echo "picture: $OUT/tile/top_view.png (each tree in its colour, stems as dots with their ids)"
+echo "also: $OUT/tile/points.las (treeID, HeightAboveGround), trees.geojson, tile.forest, trees/ (per tree skeleton, mesh, .tlobe, .dbf6)"
+
 step "reconstruct: skeleton, radii and branch mesh of two scanned trees"
 "$BIN" reconstruct "$SAMPLE/lagerstroemia_2.las" --species lagerstroemia --out "$OUT/reconstruct"
 "$BIN" reconstruct "$SAMPLE/palm_1.las" --species palm --out "$OUT/reconstruct"
 
-step "eval: reconstructed skeletons against the true ones"
+step "eval: reconstructed skeletons against the part of the true ones their scans see"
+# The true skeletons hold every twig, also those hidden in leaves; --visible-in keeps the
+# internodes whose bark the scan hit (and their way to the root).
 for tree in lagerstroemia_2 palm_1; do
-    args=(eval skeleton --skeleton "$OUT/reconstruct/${tree}_skeleton.ply" --reference "$SAMPLE/${tree}_skeleton.ply")
+    args=(eval skeleton --skeleton "$OUT/reconstruct/${tree}_skeleton.ply" --reference "$SAMPLE/${tree}_skeleton.ply"
+          --visible-in "$SAMPLE/${tree}.las")
     "$BIN" "${args[@]}"
     "$BIN" --json "${args[@]}" > "$OUT/eval_${tree}.json"
 done

@@ -10,9 +10,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <numbers>
 #include <limits>
 #include <optional>
 #include <queue>
+#include <tuple>
 #include <unordered_map>
 
 namespace treelobes {
@@ -33,9 +36,13 @@ void validate(const SegmentOptions& o) {
     positive(o.chm_cell, "CHM cell");
     if (!(o.point_radius >= 0.0f) || !std::isfinite(o.point_radius)) throw Error::usage("segment: point radius must be >= 0");
     positive(o.pit_depth, "pit depth");
+    if (!(o.chm_smoothing >= 0.0f) || !std::isfinite(o.chm_smoothing)) throw Error::usage("segment: CHM smoothing must be >= 0");
     positive(o.window_base, "window base");
     if (!(o.window_per_metre >= 0.0f) || !std::isfinite(o.window_per_metre)) throw Error::usage("segment: window per metre must be >= 0");
     positive(o.max_window, "max window");
+    if (!(o.min_top_prominence >= 0.0f) || !std::isfinite(o.min_top_prominence)) throw Error::usage("segment: min top prominence must be >= 0");
+    share(o.top_prominence_ratio, "top prominence ratio");
+    share(o.merge_pass_ratio, "merge pass ratio");
     share(o.seed_ratio, "seed ratio");
     share(o.crown_ratio, "crown ratio");
     positive(o.max_crown_radius, "max crown radius");
@@ -48,9 +55,11 @@ void validate(const SegmentOptions& o) {
     positive(o.circle_tolerance, "circle tolerance");
     share(o.min_circle_inliers, "min circle inliers");
     share(o.min_arc_coverage, "min arc coverage");
+    if (!(o.max_stem_lean >= 0.0f && o.max_stem_lean < 90.0f)) throw Error::usage("segment: max stem lean must be in 0..90 degrees");
     positive(o.graph_voxel, "graph voxel");
     if (o.graph_neighbours < 2 || o.graph_neighbours > 64) throw Error::usage("segment: graph neighbours must be in 2..64");
     positive(o.max_gap, "max gap");
+    positive(o.graph_beta, "graph beta");
     if (!(o.ground_clearance >= 0.0f) || !std::isfinite(o.ground_clearance)) throw Error::usage("segment: ground clearance must be >= 0");
 }
 
@@ -163,6 +172,36 @@ void fill_pits(Raster& chm, float depth) {
     chm.values.swap(out);
 }
 
+// Gaussian smoothing (separable, kernel to 3 sigma) of the CHM the tops are searched on: the
+// leaf clumps of a broad crown make many small maxima that smoothing removes while the peaks of
+// separate crowns stay (Popescu & Wynne 2004, §2.3 smooth their CHM the same way).
+Raster smoothed(const Raster& chm, float sigma) {
+    if (sigma <= 0.0f) return chm;
+    const float s = sigma / chm.cell;
+    const int reach = std::max(1, static_cast<int>(std::ceil(3.0f * s)));
+    std::vector<float> kernel(static_cast<std::size_t>(2 * reach + 1));
+    for (int k = -reach; k <= reach; ++k) kernel[static_cast<std::size_t>(k + reach)] = std::exp(-0.5f * k * k / (s * s));
+    const auto pass = [&](const std::vector<float>& in, bool along_rows) {
+        std::vector<float> out(in.size());
+        for (int r = 0; r < chm.rows; ++r)
+            for (int c = 0; c < chm.columns; ++c) {
+                double sum = 0, weights = 0;
+                for (int k = -reach; k <= reach; ++k) {
+                    const int cc = along_rows ? c + k : c, rr = along_rows ? r : r + k;
+                    if (cc < 0 || rr < 0 || cc >= chm.columns || rr >= chm.rows) continue;
+                    const double w = kernel[static_cast<std::size_t>(k + reach)];
+                    sum += w * in[chm.index(cc, rr)];
+                    weights += w;
+                }
+                out[chm.index(c, r)] = static_cast<float>(sum / weights);
+            }
+        return out;
+    };
+    Raster out = chm;
+    out.values = pass(pass(chm.values, true), false);
+    return out;
+}
+
 // Cells higher than every other cell within a window whose diameter grows with their height
 // (Popescu & Wynne 2004, §2.4). Of equal heights the first cell in row-major order wins.
 std::vector<std::size_t> find_treetops(const Raster& chm, const SegmentOptions& options) {
@@ -195,57 +234,124 @@ std::vector<std::size_t> find_treetops(const Raster& chm, const SegmentOptions& 
     return tops;
 }
 
-// Crowns grown from the tops over the CHM, highest candidate cell first (a watershed from the
-// tops, Li et al. 2012, §2.2, with Dalponte & Coomes 2016's admission rules, §2.3): a cell
-// joins the neighbouring crown that reaches it when it is above min_tree_height, above
-// seed_ratio x the crown's top, above crown_ratio x the crown's mean height, not higher than the
-// top, and within max_crown_radius of it. Returns the crown index + 1 per cell (0 = none).
-std::vector<std::int32_t> grow_crowns(const Raster& chm, const std::vector<std::size_t>& tops, const SegmentOptions& options) {
-    std::vector<std::int32_t> crown(chm.values.size(), 0);
-    std::vector<double> sum(tops.size(), 0.0);
-    std::vector<std::uint32_t> count(tops.size(), 0);
+// Regions flooded from the tops over the CHM, highest candidate cell first (a watershed from
+// markers, Li et al. 2012, §2.2 ordering): a neighbouring cell joins the region that reaches it
+// first when `admit(cell, region)` allows. Returns the region index + 1 per cell (0 = none).
+template <typename Admit>
+std::vector<std::int32_t> flood_from_tops(const Raster& chm, const std::vector<std::size_t>& tops, Admit admit) {
+    std::vector<std::int32_t> region(chm.values.size(), 0);
     struct Candidate {
         float height;
         std::size_t cell;
-        std::int32_t crown;
-        bool operator<(const Candidate& o) const {  // max-heap: highest, then lowest cell, then lowest crown
+        std::int32_t region;
+        bool operator<(const Candidate& o) const {  // max-heap: highest, then lowest cell, then lowest region
             if (height != o.height) return height < o.height;
             if (cell != o.cell) return cell > o.cell;
-            return crown > o.crown;
+            return region > o.region;
         }
     };
     std::priority_queue<Candidate> front;
     for (std::size_t t = 0; t < tops.size(); ++t) front.push({chm.values[tops[t]], tops[t], static_cast<std::int32_t>(t + 1)});
-    const float max_squared = options.max_crown_radius * options.max_crown_radius;
     while (!front.empty()) {
         const Candidate next = front.top();
         front.pop();
-        if (crown[next.cell]) continue;
-        const std::size_t t = static_cast<std::size_t>(next.crown - 1);
-        const float top = chm.values[tops[t]];
-        const bool is_top = next.cell == tops[t];
-        if (!is_top) {
-            const int c = static_cast<int>(next.cell % chm.columns), r = static_cast<int>(next.cell / chm.columns);
-            const int tc = static_cast<int>(tops[t] % chm.columns), tr = static_cast<int>(tops[t] / chm.columns);
-            const float distance_squared = chm.cell * chm.cell * static_cast<float>((c - tc) * (c - tc) + (r - tr) * (r - tr));
-            const double mean = sum[t] / count[t];
-            if (next.height < options.min_tree_height || next.height < options.seed_ratio * top ||
-                next.height < options.crown_ratio * mean || next.height > top || distance_squared > max_squared)
-                continue;
-        }
-        crown[next.cell] = next.crown;
-        sum[t] += next.height;
-        ++count[t];
+        if (region[next.cell]) continue;
+        const auto t = static_cast<std::size_t>(next.region - 1);
+        if (next.cell != tops[t] && !admit(next.cell, t)) continue;
+        region[next.cell] = next.region;
         const int c = static_cast<int>(next.cell % chm.columns), r = static_cast<int>(next.cell / chm.columns);
         for (int dr = -1; dr <= 1; ++dr)
             for (int dc = -1; dc <= 1; ++dc) {
                 const int rr = r + dr, cc = c + dc;
                 if ((dr == 0 && dc == 0) || rr < 0 || cc < 0 || rr >= chm.rows || cc >= chm.columns) continue;
                 const std::size_t there = chm.index(cc, rr);
-                if (!crown[there]) front.push({chm.values[there], there, next.crown});
+                if (!region[there]) front.push({chm.values[there], there, next.region});
             }
     }
-    return crown;
+    return region;
+}
+
+float cell_distance(const Raster& chm, std::size_t a, std::size_t b) {
+    const int ac = static_cast<int>(a % chm.columns), ar = static_cast<int>(a / chm.columns);
+    const int bc = static_cast<int>(b % chm.columns), br = static_cast<int>(b / chm.columns);
+    return chm.cell * std::hypot(static_cast<float>(ac - bc), static_cast<float>(ar - br));
+}
+
+// Keeps the tops that stand out. Branch clusters of one broad crown make local maxima separated
+// by shallow saddles from a nearby higher top. The watershed basins of all tops are merged
+// across their highest passes, highest pass first (union-find, as in computing dynamics,
+// Grimaud 1992, §3): the group with the lower peak joins when its peak rises less than
+// max(min_top_prominence, top_prominence_ratio x its height) above the pass and the pass is
+// high in the other group's crown (at least merge_pass_ratio x its peak: a small tree touching
+// a tall neighbour's lower crown is still a tree). The peaks of the merged groups are the tops
+// that remain.
+std::vector<std::size_t> prominent_tops(const Raster& chm, const std::vector<std::size_t>& tops, const SegmentOptions& options) {
+    const std::vector<std::int32_t> basin =
+        flood_from_tops(chm, tops, [&](std::size_t cell, std::size_t) { return chm.values[cell] >= options.min_tree_height; });
+    // Highest pass between every pair of touching basins.
+    std::map<std::pair<std::int32_t, std::int32_t>, float> passes;
+    for (int r = 0; r < chm.rows; ++r)
+        for (int c = 0; c < chm.columns; ++c) {
+            const std::size_t here = chm.index(c, r);
+            if (!basin[here]) continue;
+            for (const auto& [dc, dr] : {std::pair{1, 0}, std::pair{0, 1}, std::pair{1, 1}, std::pair{-1, 1}}) {
+                const int cc = c + dc, rr = r + dr;
+                if (cc < 0 || cc >= chm.columns || rr >= chm.rows) continue;
+                const std::size_t there = chm.index(cc, rr);
+                if (!basin[there] || basin[there] == basin[here]) continue;
+                const auto key = std::minmax(basin[here], basin[there]);
+                const float pass = std::min(chm.values[here], chm.values[there]);
+                auto [it, added] = passes.emplace(key, pass);
+                if (!added) it->second = std::max(it->second, pass);
+            }
+        }
+    std::vector<std::tuple<float, std::int32_t, std::int32_t>> order;
+    for (const auto& [key, pass] : passes) order.emplace_back(pass, key.first, key.second);
+    std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
+        return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : a < b;
+    });
+    UnionFind groups(tops.size());
+    std::vector<std::size_t> peak(tops.size());  // per group root: index into tops of its highest top
+    for (std::size_t t = 0; t < tops.size(); ++t) peak[t] = t;
+    for (const auto& [pass, a, b] : order) {
+        const int ra = groups.find(a - 1), rb = groups.find(b - 1);
+        if (ra == rb) continue;
+        const std::size_t pa = peak[static_cast<std::size_t>(ra)], pb = peak[static_cast<std::size_t>(rb)];
+        // tops are sorted highest first, so the smaller index is the higher peak.
+        const std::size_t high = std::min(pa, pb), low = std::max(pa, pb);
+        const float rise = chm.values[tops[low]] - pass;
+        const bool shallow = rise < std::max(options.min_top_prominence, options.top_prominence_ratio * chm.values[tops[low]]);
+        if (!shallow || pass < options.merge_pass_ratio * chm.values[tops[high]]) continue;
+        groups.unite(ra, rb);
+        peak[static_cast<std::size_t>(groups.find(ra))] = high;
+    }
+    std::vector<std::size_t> kept;
+    for (std::size_t t = 0; t < tops.size(); ++t)
+        if (groups.find(static_cast<int>(t)) == static_cast<int>(t)) kept.push_back(tops[peak[t]]);
+    std::stable_sort(kept.begin(), kept.end(), [&](std::size_t a, std::size_t b) { return chm.values[a] > chm.values[b]; });
+    return kept;
+}
+
+// Crowns grown from the tops over the CHM (Dalponte & Coomes 2016, §2.3 admission rules): a cell
+// joins the neighbouring crown that reaches it when it is above min_tree_height, above
+// seed_ratio x the crown's top, above crown_ratio x the crown's mean height, not higher than the
+// top, and within max_crown_radius of it. Returns the crown index + 1 per cell (0 = none).
+std::vector<std::int32_t> grow_crowns(const Raster& chm, const std::vector<std::size_t>& tops, const SegmentOptions& options) {
+    std::vector<double> sum(tops.size(), 0.0);
+    std::vector<std::uint32_t> count(tops.size(), 0);
+    for (std::size_t t = 0; t < tops.size(); ++t) {
+        sum[t] = chm.values[tops[t]];
+        count[t] = 1;
+    }
+    return flood_from_tops(chm, tops, [&](std::size_t cell, std::size_t t) {
+        const float h = chm.values[cell], top = chm.values[tops[t]];
+        if (h < options.min_tree_height || h < options.seed_ratio * top || h < options.crown_ratio * sum[t] / count[t] || h > top ||
+            cell_distance(chm, cell, tops[t]) > options.max_crown_radius)
+            return false;
+        sum[t] += h;
+        ++count[t];
+        return true;
+    });
 }
 
 // Per-point labels -> trees: drops labels without points or lower than min_tree_height,
@@ -284,7 +390,8 @@ void segment_airborne(const PointCloud& cloud, const Terrain& terrain, const std
                       const SegmentOptions& options, TreeSegmentation& result) {
     Raster chm = highest_points_raster(cloud, terrain, vegetation, options);
     fill_pits(chm, options.pit_depth);
-    const std::vector<std::size_t> tops = find_treetops(chm, options);
+    const Raster smooth = smoothed(chm, options.chm_smoothing);
+    const std::vector<std::size_t> tops = prominent_tops(smooth, find_treetops(smooth, options), options);
     const std::vector<std::int32_t> crown = grow_crowns(chm, tops, options);
     for (std::size_t i = 0; i < cloud.size(); ++i)
         if (vegetation[i]) result.tree_id[i] = crown[chm.index(chm.column_of(cloud.positions[i].x()), chm.row_of(cloud.positions[i].y()))];
@@ -326,6 +433,30 @@ std::vector<std::vector<int>> cluster_slice(const PointCloud& cloud, const std::
     return clusters;
 }
 
+// A stem stands upright: the centroids of the lower and upper halves of its slice points lie
+// above each other within `max_lean_degrees`. A low branch crossing the slice aslant can fit a
+// circle arc too, but its halves are offset by its horizontal run.
+bool upright(const PointCloud& cloud, const std::vector<int>& points, float max_lean_degrees) {
+    float low = std::numeric_limits<float>::infinity(), high = -low;
+    for (int i : points) {
+        low = std::min(low, cloud.positions[static_cast<std::size_t>(i)].z());
+        high = std::max(high, cloud.positions[static_cast<std::size_t>(i)].z());
+    }
+    const float middle = 0.5f * (low + high);
+    Eigen::Vector3d sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    std::size_t count[2] = {0, 0};
+    for (int i : points) {
+        const Eigen::Vector3f& p = cloud.positions[static_cast<std::size_t>(i)];
+        const int half = p.z() >= middle;
+        sum[half] += p.cast<double>();
+        ++count[half];
+    }
+    if (!count[0] || !count[1]) return false;
+    const Eigen::Vector3d step = sum[1] / count[1] - sum[0] / count[0];
+    const double tangent = std::tan(static_cast<double>(max_lean_degrees) * std::numbers::pi / 180.0);
+    return step.z() > 0 && step.head<2>().norm() <= tangent * step.z();
+}
+
 // A slice cluster is a stem when it spans most of the slice height and a circle of a plausible
 // radius holds enough of its points around enough of its circumference (Liang et al. 2012, §2.2).
 std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cluster, const SegmentOptions& options) {
@@ -349,6 +480,7 @@ std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cl
     std::vector<int> on_circle;
     for (std::size_t k = 0; k < cluster.size(); ++k)
         if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circle.push_back(cluster[k]);
+    if (!upright(cloud, on_circle, options.max_stem_lean)) return std::nullopt;
     return Stem{circle.centre, circle.radius, circle.inliers, std::move(on_circle)};
 }
 
@@ -435,8 +567,9 @@ void segment_terrestrial(const PointCloud& cloud, const Terrain& terrain, const 
     graph_options.neighbours = std::min(options.graph_neighbours, std::max(2, static_cast<int>(voxels.centres.size()) - 1));
     graph_options.max_edge_length = options.max_gap;
     graph_options.join_components = false;  // a gap wider than max_gap separates: what lies beyond stays 0
+    graph_options.beta = options.graph_beta;
     const NeighbourGraph graph = build_neighbour_graph(voxels.centres, graph_options);
-    const ShortestPaths paths = shortest_paths(graph, sources, EdgeCost::Length);
+    const ShortestPaths paths = shortest_paths(graph, sources, EdgeCost::Weight);
 
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const int v = voxels.voxel_of_point[i];

@@ -3,7 +3,7 @@
 // Airborne scans see crowns from above: a pit-free canopy height model (highest point per cell
 // with each point drawn as a small disc, pits filled from their neighbours' median, Ben-Arie et
 // al. 2009), treetops as local maxima in a window that widens with height (Popescu & Wynne 2004,
-// §2.4), crowns grown from the tops over the CHM (Dalponte & Coomes 2016, §2.3: a cell joins a
+// §2.4) that also stand out from the saddles to higher tops (dynamics, Grimaud 1992), crowns grown from the tops over the CHM (Dalponte & Coomes 2016, §2.3: a cell joins a
 // neighbouring crown when it is high enough relative to that crown's top and near it); every
 // point above `min_tree_height` goes to the crown of its CHM cell, including points below the
 // crown surface.
@@ -47,12 +47,21 @@ struct SegmentOptions {
     float chm_cell = 0.5f;               // CHM cell edge (metres)
     float point_radius = 0.15f;          // each point drawn as a disc of this radius (pit-free CHM)
     float pit_depth = 1.0f;              // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
+    float chm_smoothing = 0.5f;          // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
     float window_base = 2.0f;            // treetop window diameter at 0 m height (metres) ...
     float window_per_metre = 0.1f;       // ... plus this much per metre of height (Popescu & Wynne 2004)
-    float max_window = 8.0f;             // cap of the treetop window diameter (metres)
+    float max_window = 20.0f;            // cap of the treetop window diameter (metres)
+    // A top is part of a higher neighbour's crown when it rises less than
+    // max(min_top_prominence, top_prominence_ratio x its height) above the highest pass between
+    // them (its dynamics, Grimaud 1992) and that pass is at least merge_pass_ratio x the higher top.
+    // The defaults suit broad crowns (the synthetic species library); for dense conifer stands
+    // such as lidR's MixedConifer set min_top_prominence = 0 and chm_smoothing = 0 (docs/segment.md).
+    float min_top_prominence = 3.0f;     // metres
+    float top_prominence_ratio = 0.0f;
+    float merge_pass_ratio = 0.5f;
     float seed_ratio = 0.45f;            // a crown cell must be higher than this share of its top (Dalponte 2016: th_seed)
     float crown_ratio = 0.55f;           // ... and higher than this share of the crown's mean height (th_cr)
-    float max_crown_radius = 8.0f;       // no crown cell farther than this from its top (metres)
+    float max_crown_radius = 15.0f;      // no crown cell farther than this from its top (metres)
 
     // Terrestrial (stems and plot-wide shortest paths).
     float stem_slice_low = 1.0f;         // stem slice, metres above ground: from ...
@@ -64,8 +73,10 @@ struct SegmentOptions {
     float circle_tolerance = 0.03f;      // circle inlier band (metres)
     float min_circle_inliers = 0.5f;     // share of the cluster's points on the circle
     float min_arc_coverage = 0.2f;       // share of the circle's 10-degree sectors that hold inliers
+    float max_stem_lean = 30.0f;         // degrees from vertical between the lower and upper half of a stem's slice points
     float graph_voxel = 0.1f;            // voxel edge of the thinned cloud the plot graph is built on (metres)
     int graph_neighbours = 10;           // k of the kNN graph
+    float graph_beta = 2.0f;             // an edge costs length^beta: > 1 makes jumps across the sparse contact of two crowns dear
     float max_gap = 0.5f;                // longest graph edge (metres): points beyond wider gaps stay 0
     float ground_clearance = 0.3f;       // points lower than this above the DTM stay out of the graph (metres)
 };

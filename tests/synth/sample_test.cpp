@@ -49,7 +49,7 @@ TEST(SynthSample, SingleTreeLabelsMatchTheirTruth) {
     EXPECT_GE(trees, 3);
 }
 
-TEST(SynthSample, TileTruthSkeletonsAndLabelsAgree) {
+TEST(SynthSample, TileTruthAndLabelsAgree) {
     std::istringstream csv(read_file(sample() / "tile" / "truth.csv"));
     std::string line;
     std::getline(csv, line);
@@ -57,9 +57,8 @@ TEST(SynthSample, TileTruthSkeletonsAndLabelsAgree) {
     while (std::getline(csv, line)) {
         const int id = std::stoi(line.substr(0, line.find(',')));
         ids.insert(id);
-        EXPECT_TRUE(std::filesystem::exists(sample() / "tile" / "skeletons" / ("tree_" + std::to_string(id) + ".ply"))) << id;
     }
-    ASSERT_GE(ids.size(), 5u);
+    ASSERT_GE(ids.size(), 24u);  // dozens of trees: the demo's tile
     const PointCloud cloud = read_las(sample() / "tile" / "tile.las");
     std::set<int> seen;
     for (double v : cloud.extra("treeID")->values) seen.insert(static_cast<int>(v));

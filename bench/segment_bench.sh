@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# Terrain + tree segmentation figures (docs/segment.md), from bench/segment_eval (the library
+# through a small program: terrain, segmentation, scoring against per-point reference labels):
+#   1. synthetic tiles with truth (`treelobes synth tile`: mixed species of the library, 20-degree
+#      slope, 1 m roughness, understory): detection F1 of trees taller than 5 m and the share of
+#      points assigned to the right tree, ALS (open and crowded stands) and TLS, with the input's
+#      ground class and with the ground filtered afresh (--ignore-classification);
+#   2. lidR/MixedConifer.las against lidR's treeID (defaults and the conifer setting);
+#   3. treels/pine_plot.las: stems found, with their positions and diameters;
+#   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
+#      2 x 2 and 4 x 4 copies side by side) and the TLS tiles.
+# Matching rule: a true tree and a found tree match when each holds at least half of the other's
+# points (segment/segmentation_score.hpp).
+# Usage: bench/segment_bench.sh [WORK_DIR]   (default /tmp/treelobes_segment_bench; generated
+# tiles are kept there and reused). Environment: TREELOBES_BIN (default build/bin/treelobes),
+# SEGMENT_EVAL (default build/bin/segment_eval), TREELOBES_REAL_DATA (default ../shared/data).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BIN=${TREELOBES_BIN:-build/bin/treelobes}
+EVAL=${SEGMENT_EVAL:-build/bin/segment_eval}
+DATA=${TREELOBES_REAL_DATA:-../shared/data}
+WORK=${1:-/tmp/treelobes_segment_bench}
+for tool in "$BIN" "$EVAL"; do
+  [[ -x "$tool" ]] || { echo "segment_bench: $tool not found (cmake --build build --target treelobes segment_eval)" >&2; exit 1; }
+done
+[[ -d "$DATA" ]] || { echo "segment_bench: real data folder $DATA not found (set TREELOBES_REAL_DATA)" >&2; exit 1; }
+mkdir -p "$WORK"
+
+COMMON=(--slope 20 --roughness 1 --spacing 1.0)
+# tile NAME SEED ARGS...: generates $WORK/NAME/tile.las once.
+tile() {
+  local name=$1 seed=$2
+  shift 2
+  [[ -f "$WORK/$name/tile.las" ]] && return 0
+  echo "generating $name (synth tile --seed $seed $*)" >&2
+  "$BIN" --log-level error synth tile --out "$WORK/$name" --seed "$seed" "${COMMON[@]}" "$@" >/dev/null
+}
+for s in 11 12 13 14; do tile "als_open_$s" "$s" --trees 25 --size 100 --scanner als; done
+for s in 1 2 3 4; do tile "als_crowded_$s" "$s" --trees 30 --size 80 --scanner als; done
+for s in 1 2 3; do tile "tls_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
+
+# row LABEL ARGS...: one table row from one segment_eval run.
+row() {
+  local label=$1 result
+  shift
+  result=$("$EVAL" "$@")
+  python3 - "$label" "$result" <<'PY'
+import json, sys
+d = json.loads(sys.argv[2])
+s = d.get("score")
+if s:
+    score = f"{s['reference_trees']:5d} {s['found_trees']:5d} {s['matched']:5d} {s['f1']:6.3f} {100 * s['points_right']:6.1f}"
+else:
+    score = "    -     -     -      -      -"
+print(f"{sys.argv[1]:<34} {d['ground_source']:<10} {d['mode']:<4} {score} {d['seconds']['total']:7.2f} {d['peak_memory_mb']:7.0f}")
+PY
+}
+header() { printf '%-34s %-10s %-4s %5s %5s %5s %6s %6s %7s %7s\n' "$1" ground mode true found match F1 right% seconds peak_MB; }
+
+echo "== synthetic tiles (trees > 5 m; right% = points of those trees in their matched tree)"
+header "tile"
+for s in 11 12 13 14; do row "ALS open, seed $s" "$WORK/als_open_$s/tile.las" --reference treeID; done
+for s in 11 12 13 14; do row "ALS open, seed $s, ground filtered" "$WORK/als_open_$s/tile.las" --reference treeID --ignore-classification; done
+for s in 1 2 3 4; do row "ALS crowded, seed $s" "$WORK/als_crowded_$s/tile.las" --reference treeID; done
+for s in 1 2 3; do row "TLS, seed $s" "$WORK/tls_$s/tile.las" --reference treeID; done
+for s in 1 2 3; do row "TLS, seed $s, ground filtered" "$WORK/tls_$s/tile.las" --reference treeID --ignore-classification; done
+
+echo
+echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
+header "setting"
+CONIFER=(--set min_top_prominence=0 --set chm_smoothing=0)
+row "defaults" "$DATA/lidr/MixedConifer.las" --reference treeID
+row "conifer (no crown merging/smoothing)" "$DATA/lidr/MixedConifer.las" --reference treeID "${CONIFER[@]}"
+echo "matching table (conifer setting):"
+python3 - "$("$EVAL" "$DATA/lidr/MixedConifer.las" --reference treeID "${CONIFER[@]}")" <<'PY'
+import json, sys
+d = json.loads(sys.argv[1])
+print("| height (lidR tree) | lidR trees | found | matched |")
+print("|---|---|---|---|")
+for r in d["score"]["by_height"]:
+    print(f"| {r['height']} | {r['reference']} | {r['found']} | {r['matched']} |")
+PY
+
+echo
+echo "== TreeLS pine_plot.las: stems"
+python3 - "$("$EVAL" "$DATA/treels/pine_plot.las" --trees)" <<'PY'
+import json, sys
+d = json.loads(sys.argv[1])
+print(f"{d['trees']} trees ({d['mode_reason']}; ground {d['ground_source']}), {d['seconds']['total']:.2f} s")
+print("| id | x | y | height m | stem diameter at 1-2 m, cm | points |")
+print("|---|---|---|---|---|---|")
+for t in d["tree_list"]:
+    print(f"| {t['id']} | {t['x']:.2f} | {t['y']:.2f} | {t['height']:.1f} | {200 * t['stem_radius']:.1f} | {t['points']} |")
+PY
+
+echo
+echo "== scaling (ALS open seed 11 and its 2 x 2 and 4 x 4 copies; TLS tiles as generated)"
+printf '%-34s %9s %9s %9s %9s %8s\n' input points terrain_s segment_s total_s peak_MB
+scale() {
+  local label=$1 result
+  shift
+  result=$("$EVAL" "$@")
+  python3 - "$label" "$result" <<'PY'
+import json, sys
+d = json.loads(sys.argv[2])
+t = d["seconds"]
+print(f"{sys.argv[1]:<34} {d['points']:9d} {t['terrain']:9.2f} {t['segment']:9.2f} {t['total']:9.2f} {d['peak_memory_mb']:8.0f}")
+PY
+}
+scale "ALS x1" "$WORK/als_open_11/tile.las"
+scale "ALS x4 (2 x 2 copies)" "$WORK/als_open_11/tile.las" --replicate 2
+scale "ALS x16 (4 x 4 copies)" "$WORK/als_open_11/tile.las" --replicate 4
+for s in 1 2 3; do scale "TLS seed $s" "$WORK/tls_$s/tile.las"; done
