@@ -46,6 +46,9 @@ int run(int argc, char** argv) {
     cli::add_export_command(app, global, job);
     cli::add_rebuild_command(app, global, job);
     cli::add_tile_command(app, global, job);
+    cli::add_batch_command(app, global, job);
+    cli::add_merge_command(app, global, job);
+    cli::add_retile_command(app, global, job);
 
     try {
         app.parse(argc, argv);

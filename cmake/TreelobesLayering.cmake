@@ -20,9 +20,11 @@ set(TREELOBES_DEPENDS_classify core geometry render
 set(TREELOBES_DEPENDS_export core geometry encode lobes)
 # forestry runs every tree of a tile through the single-tree stages: their entry points.
 set(TREELOBES_DEPENDS_forestry core geometry encode lobes classify reconstruct/reconstruct_tree.hpp)
-set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct segment lobes classify forestry synth render export)
+# survey: many tiles (their list and shards, completion markers, memory estimate, retiling, merging).
+set(TREELOBES_DEPENDS_survey core encode)
+set(TREELOBES_DEPENDS_apps core geometry config lsystem encode reconstruct segment lobes classify forestry survey synth render export)
 # Build order of the stage folders (each one CMake library target treelobes_<stage>).
-set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct segment synth lobes classify forestry export apps)
+set(TREELOBES_STAGES core geometry config lsystem encode render reconstruct segment synth lobes classify forestry survey export apps)
 
 # Fails with one message naming the file and the include when a source of `stage` (a folder of
 # `root`) includes "<folder>/..." that is neither the stage itself nor in its list. A folder with

@@ -14,6 +14,7 @@ PACKAGES=(
   libembree-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
   libpng-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev libxgboost-dev
   libbz2-dev liblzma-dev libzstd-dev libbrotli-dev
+  parallel slurm-wlm munge
 )
 
 # clang with its sanitizer runtimes and libFuzzer: only the hardening builds use them.

@@ -1,0 +1,216 @@
+// `treelobes batch LIST|DIR|GLOB --out DIR [--shard i/n] [tile options]`: the tile pipeline over
+// many tiles, one output folder per tile, in a stable order (sorted paths; shard i of n takes
+// every n-th), so that Slurm array tasks or GNU parallel jobs split a survey without talking to
+// each other (docs/survey.md). Each tile runs in this process through the `tile` subcommand
+// itself, with its own error boundary: a bad tile is listed in failures.jsonl and the batch goes
+// on. A tile's folder is finished when its completion marker exists (written last, atomically);
+// a re-run skips finished tiles and redoes partial ones from scratch.
+#include "apps/command.hpp"
+#include "apps/summary_values.hpp"
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/version.hpp"
+#include "survey/completion.hpp"
+#include "survey/memory_estimate.hpp"
+#include "survey/tile_list.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <new>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace treelobes::cli {
+
+namespace {
+
+using nlohmann::json;
+
+struct BatchCliOptions {
+    std::string source;
+    std::string out;
+    std::string shard;
+    std::string max_memory;
+    bool overwrite = false;
+    std::vector<std::string> tile_arguments;  // passed on to every `tile` run
+};
+
+// Parses `tile <input> --out <dir> <tile arguments>` the way the CLI does and returns its job.
+// The tile's global options: this process's threads, and its summary as JSON (swallowed below)
+// instead of the human lines, so the batch keeps one display.
+Job tile_job(CLI::App& app, const GlobalOptions& tile_global, const fs::path& input, const fs::path& dir,
+             const std::vector<std::string>& tile_arguments) {
+    Job job;
+    add_tile_command(app, tile_global, job);
+    std::vector<std::string> args{"tile", input.string(), "--out", dir.string()};
+    args.insert(args.end(), tile_arguments.begin(), tile_arguments.end());
+    std::reverse(args.begin(), args.end());  // CLI11 takes the arguments last first
+    try {
+        app.parse(args);
+    } catch (const CLI::ParseError& e) {
+        throw Error::usage(std::string("tile options of the batch: ") + e.what());
+    }
+    return job;
+}
+
+// Runs one tile in this process with its stdout swallowed and info logs quiet; returns its exit
+// code. Errors propagate to the caller's boundary.
+int run_one_tile(const fs::path& input, const fs::path& dir, const std::vector<std::string>& tile_arguments, const GlobalOptions& global) {
+    GlobalOptions tile_global = global;
+    tile_global.json = true;
+    CLI::App app;
+    const Job job = tile_job(app, tile_global, input, dir, tile_arguments);
+    std::ostringstream swallowed;
+    std::streambuf* const stdout_buffer = std::cout.rdbuf(swallowed.rdbuf());
+    const LogLevel level = log_level();
+    if (level > LogLevel::Warn) set_log_level(LogLevel::Warn);
+    struct Restore {
+        std::streambuf* buffer;
+        LogLevel level;
+        ~Restore() {
+            std::cout.rdbuf(buffer);
+            set_log_level(level);
+        }
+    } restore{stdout_buffer, level};
+    return job();
+}
+
+// The key a finished tile's marker holds: what made its outputs.
+std::string completion_key(const fs::path& input, const std::vector<std::string>& tile_arguments) {
+    json key = {{"input", fs::absolute(input).lexically_normal().string()}, {"tile_arguments", tile_arguments}, {"treelobes", kVersion}};
+    return key.dump();
+}
+
+std::string failures_name(const BatchCliOptions& o, const survey::Shard& shard) {
+    if (o.shard.empty()) return "failures.jsonl";
+    return "failures.shard" + std::to_string(shard.index) + "of" + std::to_string(shard.count) + ".jsonl";
+}
+
+void write_failures(const fs::path& path, const std::vector<json>& failures) {
+    if (failures.empty()) {
+        std::error_code ec;
+        fs::remove(path, ec);  // the failures of an earlier run no longer hold
+        return;
+    }
+    std::string lines;
+    for (const json& failure : failures) lines += failure.dump() + "\n";
+    write_file_atomically(path, lines);
+}
+
+struct TileResult {
+    int exit_code = 0;
+    std::string reason;  // of a failed tile
+};
+
+// One tile inside its error boundary: refused when its header says it would not fit, else run.
+TileResult process_tile(const fs::path& input, const fs::path& dir, const BatchCliOptions& o, double budget, const GlobalOptions& global) {
+    try {
+        if (const auto refusal = survey::refuse_if_too_big(input, budget)) return {static_cast<int>(ExitCode::InvalidInput), *refusal};
+        return {run_one_tile(input, dir, o.tile_arguments, global), {}};
+    } catch (const Error& e) {
+        return {static_cast<int>(e.code()), e.what()};
+    } catch (const std::bad_alloc&) {
+        return {static_cast<int>(ExitCode::Internal), "out of memory: retile with a smaller --size or lower --max-memory"};
+    } catch (const std::exception& e) {
+        return {static_cast<int>(ExitCode::Internal), std::string("internal error: ") + e.what()};
+    }
+}
+
+int run_batch(BatchCliOptions& o, const GlobalOptions& global) {
+    const survey::Shard shard = o.shard.empty() ? survey::Shard{} : survey::parse_shard(o.shard);
+    const double budget = o.max_memory.empty() ? survey::default_memory_budget_bytes() : survey::parse_memory_size(o.max_memory);
+    const std::vector<fs::path> all = survey::list_tiles(o.source);
+    const std::vector<fs::path> tiles = survey::shard_tiles(all, shard);
+    {
+        CLI::App check;  // tile options are checked once, before any tile runs
+        tile_job(check, global, all.front(), fs::path(o.out) / survey::tile_name(all.front()), o.tile_arguments);
+    }
+    std::error_code ec;
+    fs::create_directories(o.out, ec);
+    if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
+    const fs::path failures_path = fs::path(o.out) / failures_name(o, shard);
+
+    std::size_t done = 0, skipped = 0, with_tree_failures = 0;
+    std::vector<json> failures;
+    Progress progress("tiles", tiles.size());
+    for (const fs::path& input : tiles) {
+        const std::string name = survey::tile_name(input);
+        const fs::path dir = fs::path(o.out) / name;
+        const std::string key = completion_key(input, o.tile_arguments);
+        if (!o.overwrite && survey::is_complete(dir, key)) {
+            ++skipped;
+            progress.advance();
+            continue;
+        }
+        fs::remove_all(dir, ec);  // a partial folder (killed, failed, other options) is redone from scratch
+        const TileResult result = process_tile(input, dir, o, budget, global);
+        if (result.exit_code == 0 || result.exit_code == static_cast<int>(ExitCode::PartialFailure)) {
+            survey::mark_complete(dir, key, result.exit_code);
+            ++done;
+            if (result.exit_code != 0) ++with_tree_failures;
+        } else {
+            failures.push_back({{"tile", name}, {"input", input.string()}, {"reason", result.reason}, {"exit_code", result.exit_code}});
+            write_failures(failures_path, failures);
+            log_warn(name + ": " + result.reason);
+        }
+        progress.advance();
+    }
+    progress.finish();
+    write_failures(failures_path, failures);
+
+    const json summary = {{"treelobes", kVersion},
+                          {"command", "batch"},
+                          {"source", o.source},
+                          {"out", o.out},
+                          {"shard", o.shard.empty() ? json(nullptr) : json(o.shard)},
+                          {"tiles_total", all.size()},
+                          {"tiles", tiles.size()},
+                          {"tiles_done", done},
+                          {"tiles_skipped", skipped},
+                          {"tiles_failed", failures.size()},
+                          {"tiles_with_tree_failures", with_tree_failures},
+                          {"failures", failures.empty() ? json(nullptr) : json(failures_path.string())},
+                          {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
+    if (global.json) {
+        std::cout << summary.dump(2) << "\n";
+    } else {
+        std::printf("batch %s: %zu of %zu tiles%s: %zu done, %zu finished earlier (skipped), %zu failed%s\n", o.source.c_str(), tiles.size(),
+                    all.size(), o.shard.empty() ? "" : (" (shard " + o.shard + ")").c_str(), done, skipped, failures.size(),
+                    failures.empty() ? "" : (" (" + failures_path.string() + ")").c_str());
+    }
+    return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
+}
+
+}  // namespace
+
+void add_batch_command(CLI::App& app, const GlobalOptions& global, Job& job) {
+    auto o = std::make_shared<BatchCliOptions>();
+    CLI::App* sub = app.add_subcommand(
+        "batch", "The tile pipeline over many tiles: one folder per tile, resumable, shardable for Slurm arrays and GNU parallel "
+                 "(docs/survey.md). Options after the source that batch does not know are passed to every `tile` run");
+    sub->add_option("source", o->source, "The tiles: a folder, a quoted pattern (\"tiles/*.las\") or a list file (one path per line)")
+        ->required();
+    sub->add_option("--out", o->out, "Output folder: one subfolder per tile, named after the tile's file")->required();
+    sub->add_option("--shard", o->shard, "Run only shard i of n (0 <= i < n): every n-th tile of the sorted list, starting at i");
+    sub->add_option("--max-memory", o->max_memory,
+                    "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM)");
+    sub->add_flag("--overwrite", o->overwrite, "Redo tiles that an earlier run finished");
+    sub->allow_extras();
+    sub->fallthrough(false);  // unknown options are the tile's, not the main command's
+    sub->callback([o, sub, &global, &job] {
+        o->tile_arguments = sub->remaining();
+        for (const std::string& argument : o->tile_arguments)
+            if (argument == "--json" || argument.rfind("--threads", 0) == 0 || argument.rfind("--log-level", 0) == 0)
+                throw CLI::ValidationError(argument, "a global flag goes before the subcommand: treelobes " + argument + " batch ...");
+        job = [o, &global] { return run_batch(*o, global); };
+    });
+}
+
+}  // namespace treelobes::cli

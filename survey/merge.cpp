@@ -1,0 +1,232 @@
+#include "survey/merge.hpp"
+
+#include "core/error.hpp"
+#include "core/log.hpp"
+#include "core/version.hpp"
+#include "encode/forest_file.hpp"
+#include "survey/completion.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace treelobes::survey {
+
+namespace {
+
+std::string read_text(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error::input(path.string(), "cannot open file");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+json read_json(const fs::path& path) {
+    const json value = json::parse(read_text(path), nullptr, false);
+    if (value.is_discarded() || !value.is_object()) throw Error::input(path.string(), "not a JSON object");
+    return value;
+}
+
+bool is_tile_folder(const fs::path& dir) { return fs::is_regular_file(dir / "summary.json") && fs::is_regular_file(dir / "trees.csv"); }
+
+std::string tile_of(const fs::path& dir) { return dir.filename().string(); }
+
+long tree_id_of_name(const std::string& name, const std::string& context) {
+    long id = 0;
+    if (std::sscanf(name.c_str(), "tree_%ld", &id) != 1) throw Error::input(context, "forest tree '" + name + "' is not named tree_<id>");
+    return id;
+}
+
+// The forest's tree options as the tile summary records them (options.trees).
+encode::TreeFileOptions forest_options(const json& summary, const std::string& context) {
+    encode::TreeFileOptions options;
+    try {
+        options.encode.resolution = summary.at("options").at("trees").at("dbf6_resolution").get<double>();
+        options.lods = summary.at("options").at("trees").at("dbf6_lods").get<int>();
+    } catch (const json::exception&) {
+        throw Error::input(context, "summary.json without options.trees.dbf6_resolution / dbf6_lods (not a `treelobes tile` output)");
+    }
+    return options;
+}
+
+// Adds every number of `from` into `into`, recursing into objects (strings and the like are skipped).
+void add_counts(json& into, const json& from) {
+    for (const auto& [key, value] : from.items()) {
+        if (value.is_number_integer()) into[key] = into.value(key, 0L) + value.get<long>();
+        else if (value.is_object()) {
+            json& child = into[key];
+            if (!child.is_object()) child = json::object();
+            add_counts(child, value);
+        }
+    }
+}
+
+struct CsvRows {
+    std::string header;
+    std::map<std::string, std::string> rows;  // by global id
+};
+
+void add_csv(CsvRows& all, const fs::path& tile_dir) {
+    const std::string tile = tile_of(tile_dir);
+    std::istringstream in(read_text(tile_dir / "trees.csv"));
+    std::string header;
+    std::getline(in, header);
+    if (all.header.empty()) all.header = header;
+    else if (header != all.header) throw Error::input((tile_dir / "trees.csv").string(), "its columns differ from the other tiles'");
+    for (std::string line; std::getline(in, line);) {
+        if (line.empty()) continue;
+        const std::string global = global_tree_id(tile, std::stol(line.substr(0, line.find(','))));
+        all.rows[global] = global + "," + tile + "," + line + "\n";
+    }
+}
+
+void add_features(std::map<std::string, json>& features, std::string& crs, const fs::path& tile_dir) {
+    const std::string tile = tile_of(tile_dir);
+    const json collection = read_json(tile_dir / "trees.geojson");
+    const std::string tile_crs = collection.value("crs_wkt", std::string());
+    if (!tile_crs.empty()) {
+        if (!crs.empty() && crs != tile_crs) throw Error::input((tile_dir / "trees.geojson").string(), "its CRS differs from the other tiles'");
+        crs = tile_crs;
+    }
+    for (json feature : collection.at("features")) {
+        const std::string global = global_tree_id(tile, feature.at("properties").at("tree_id").get<long>());
+        feature["properties"]["global_id"] = global;
+        feature["properties"]["tile"] = tile;
+        features[global] = std::move(feature);
+    }
+}
+
+// The tile's forest trees, placed as `treelobes tile` places them (root at the position).
+void add_forest_trees(std::map<std::string, encode::ForestTree>& trees, const fs::path& tile_dir) {
+    const std::string tile = tile_of(tile_dir);
+    const fs::path path = tile_dir / "tile.forest";
+    encode::ForestReader reader(path);
+    for (std::size_t i = 0; i < reader.size(); ++i) {
+        const std::string global = global_tree_id(tile, tree_id_of_name(reader.entry(i).name, path.string()));
+        encode::ForestTree placed;
+        placed.skeleton = reader.decode(i, 0);
+        const Eigen::Vector3d root = placed.skeleton.origin + placed.skeleton.nodes.at(0).position.cast<double>();
+        placed.skeleton.origin = -placed.skeleton.nodes[0].position.cast<double>();
+        placed.position = root;
+        placed.name = global;
+        trees[global] = std::move(placed);
+    }
+}
+
+std::string failure_lines(const std::vector<fs::path>& lists) {
+    std::set<std::string> lines;
+    for (const fs::path& list : lists) {
+        std::istringstream in(read_text(list));
+        for (std::string line; std::getline(in, line);)
+            if (!line.empty()) lines.insert(line);
+    }
+    std::string text;
+    for (const std::string& line : lines) text += line + "\n";
+    return text;
+}
+
+}  // namespace
+
+std::string global_tree_id(const std::string& tile, long tree_id) {
+    char id[32];
+    std::snprintf(id, sizeof id, "%06ld", tree_id);
+    return tile + "/" + id;
+}
+
+TileFolders find_tile_folders(const std::vector<fs::path>& dirs) {
+    TileFolders found;
+    std::map<std::string, fs::path> by_name;
+    const auto add = [&](const fs::path& dir) {
+        const auto [it, fresh] = by_name.emplace(tile_of(dir), dir);
+        if (!fresh) throw Error::input(dir.string(), "tile '" + it->first + "' is also in " + it->second.string() + ": merge each tile once");
+    };
+    std::set<std::string> incomplete;
+    for (const fs::path& dir : dirs) {
+        if (!fs::is_directory(dir)) throw Error::input(dir.string(), "no such folder");
+        if (is_tile_folder(dir)) {
+            add(dir);
+            continue;
+        }
+        for (const auto& entry : fs::directory_iterator(dir)) {
+            if (entry.is_regular_file() && entry.path().filename().string().rfind("failures", 0) == 0 && entry.path().extension() == ".jsonl")
+                found.failure_lists.push_back(entry.path());
+            if (!entry.is_directory()) continue;
+            if (fs::is_regular_file(entry.path() / kCompletionMarker) && is_tile_folder(entry.path())) add(entry.path());
+            else incomplete.insert(tile_of(entry.path()));
+        }
+    }
+    for (const auto& [name, dir] : by_name) {
+        found.complete.push_back(dir);
+        incomplete.erase(name);  // finished in another batch folder
+    }
+    found.incomplete.assign(incomplete.begin(), incomplete.end());
+    std::sort(found.failure_lists.begin(), found.failure_lists.end());
+    return found;
+}
+
+MergedSurvey merge_tiles(const TileFolders& folders) {
+    if (folders.complete.empty()) throw Error::input("merge", "no finished tiles in the given folders");
+    MergedSurvey merged;
+    CsvRows csv;
+    std::map<std::string, json> features;
+    std::map<std::string, encode::ForestTree> forest_trees;
+    std::string crs;
+    json counts = json::object();
+    json tiles = json::array();
+    json options;
+    std::optional<encode::TreeFileOptions> dbf6;
+    for (const fs::path& dir : folders.complete) {  // sorted by tile name
+        const json summary = read_json(dir / "summary.json");
+        const encode::TreeFileOptions tile_dbf6 = forest_options(summary, (dir / "summary.json").string());
+        if (dbf6 && (tile_dbf6.encode.resolution != dbf6->encode.resolution || tile_dbf6.lods != dbf6->lods))
+            throw Error::input((dir / "summary.json").string(), "made with other DBF6 options (--resolution, --lods) than the other tiles");
+        dbf6 = tile_dbf6;
+        if (options.is_null()) options = summary.at("options");
+        else if (options != summary.at("options")) log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
+        json tile_counts = summary.at("counts");
+        tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
+        add_counts(counts, tile_counts);
+        tiles.push_back({{"name", tile_of(dir)}, {"trees", tile_counts.value("trees", 0)}, {"trees_failed", tile_counts.value("trees_failed", 0)}});
+        add_csv(csv, dir);
+        add_features(features, crs, dir);
+        add_forest_trees(forest_trees, dir);
+    }
+    merged.tiles = folders.complete.size();
+    merged.trees = csv.rows.size();
+    merged.trees_csv = "global_id,tile," + csv.header + "\n";
+    for (const auto& [id, row] : csv.rows) merged.trees_csv += row;
+    json collection = {{"type", "FeatureCollection"}, {"features", json::array()}};
+    for (auto& [id, feature] : features) collection["features"].push_back(std::move(feature));
+    if (!crs.empty()) collection["crs_wkt"] = crs;
+    merged.trees_geojson = collection.dump(1) + "\n";
+    std::vector<encode::ForestTree> ordered;
+    ordered.reserve(forest_trees.size());
+    for (auto& [id, tree] : forest_trees) ordered.push_back(std::move(tree));
+    merged.forest = encode::write_forest_bytes(ordered, *dbf6);
+    merged.failures_jsonl = failure_lines(folders.failure_lists);
+    const json summary = {{"treelobes", kVersion},
+                          {"command", "merge"},
+                          {"counts", counts},
+                          {"tiles", tiles},
+                          {"tiles_merged", merged.tiles},
+                          {"tiles_incomplete", folders.incomplete},
+                          {"tiles_failed", std::count(merged.failures_jsonl.begin(), merged.failures_jsonl.end(), '\n')},
+                          {"trees", merged.trees},
+                          {"forest_trees", ordered.size()},
+                          {"crs", crs.empty() ? json(nullptr) : json(crs)},
+                          {"options", options}};
+    merged.summary_json = summary.dump(2) + "\n";
+    return merged;
+}
+
+}  // namespace treelobes::survey
