@@ -14,11 +14,11 @@
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
+#include "geometry/branch_mesh.hpp"
 #include "lsystem/foliage.hpp"
 #include "lsystem/lsystem.hpp"
 #include "lsystem/multires_chain.hpp"
 #include "lsystem/tree_string.hpp"
-#include "reconstruct/branch_mesh.hpp"
 #include "render/foliage_textures.hpp"
 
 #include <nlohmann/json.hpp>

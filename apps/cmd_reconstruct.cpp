@@ -12,7 +12,7 @@
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
-#include "reconstruct/branch_mesh.hpp"
+#include "geometry/branch_mesh.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
 
 #include <nlohmann/json.hpp>

@@ -6,10 +6,10 @@
 
 #include "config/species_library.hpp"
 #include "config/species_profile.hpp"
+#include "core/random.hpp"
 #include "core/tree_graph.hpp"
 #include "encode/forest_file.hpp"
 #include "synth/grow.hpp"
-#include "synth/random.hpp"
 
 #include <cmath>
 #include <string>
@@ -39,7 +39,7 @@ inline std::vector<NamedTree> table5_trees() {
 // trees averages 1,792), which gives ~1,700 internodes per tree.
 inline std::vector<encode::ForestTree> forest_trees(int count, std::uint64_t seed = 2019) {
     const std::vector<SpeciesProfile> species = load_species_profiles(default_species_file());
-    synth::Rng rng(seed);
+    Rng rng(seed);
     const double side = 20.0 * std::sqrt(count / 100.0);
     std::vector<encode::ForestTree> forest;
     for (int i = 0; i < count; ++i) {
@@ -50,7 +50,7 @@ inline std::vector<encode::ForestTree> forest_trees(int count, std::uint64_t see
         const auto& h = profile.variation.height_m;
         options.height_m = h.min + (h.max - h.min) * rng.uniform(0.0, 0.6);
         encode::ForestTree tree;
-        tree.skeleton = synth::grow(profile, synth::stream_seed(seed, static_cast<std::uint64_t>(i)), options).skeleton;
+        tree.skeleton = synth::grow(profile, stream_seed(seed, static_cast<std::uint64_t>(i)), options).skeleton;
         tree.skeleton.origin.setZero();
         tree.position = {rng.uniform(0.0, side), rng.uniform(0.0, side), 0.0};
         tree.azimuth = static_cast<float>(rng.uniform(0.0, 2.0 * M_PI));

@@ -3,7 +3,7 @@
 #include "classify/splits.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "synth/random.hpp"
+#include "core/random.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -63,7 +63,7 @@ std::vector<Eigen::Vector2d> planting_layout(const std::vector<int>& labels, int
     }
     std::vector<std::size_t> order(labels.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    synth::Rng rng(synth::stream_seed(seed, 0x1a7047));
+    Rng rng(stream_seed(seed, 0x1a7047));
     for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.below(i)]);
     const auto side = static_cast<std::size_t>(std::ceil(std::sqrt(static_cast<double>(labels.size()))));
     for (std::size_t k = 0; k < order.size(); ++k)
@@ -298,7 +298,7 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
     std::vector<std::vector<std::size_t>> train(splits), test(splits);
     std::vector<std::uint64_t> seeds(splits);
     for (std::size_t s = 0; s < splits; ++s) {
-        seeds[s] = synth::stream_seed(options.seed, static_cast<std::uint64_t>(s));
+        seeds[s] = stream_seed(options.seed, static_cast<std::uint64_t>(s));
         stratified_split(set.labels, classes, options.train_fraction, seeds[s], true, train[s], test[s]);
     }
     for (auto r : train.front()) ++train_counts[set.labels[r]];
@@ -345,7 +345,7 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
         for (std::size_t g = 0; g < groups.size(); ++g) {
             std::vector<std::size_t> train, test;
             for (std::size_t r = 0; r < set.labels.size(); ++r) (set.groups[r] == groups[g] ? test : train).push_back(r);
-            const std::uint64_t seed = synth::stream_seed(options.seed, 1000000 + g);
+            const std::uint64_t seed = stream_seed(options.seed, 1000000 + g);
             for (std::size_t k = 0; k < classifiers.size(); ++k)
                 score_experiment(set, test, run_experiment(set, classifiers[k].run, train, test, seed), options, site_acc[k]);
             site_progress.advance();
@@ -386,7 +386,7 @@ EvaluationReport evaluate_train_test(const LabelledSet& set, const std::vector<N
     for (auto r : train) ++train_counts[set.labels[r]];
     for (const auto& classifier : classifiers) {
         ScoreAccumulator acc(classes, set.labels.size());
-        score_experiment(set, test, run_experiment(set, classifier.run, train, test, synth::stream_seed(options.seed, 0)), options, acc);
+        score_experiment(set, test, run_experiment(set, classifier.run, train, test, stream_seed(options.seed, 0)), options, acc);
         ClassifierReport r;
         r.name = classifier.name;
         r.random_splits = acc.scores(set.labels, train_counts);

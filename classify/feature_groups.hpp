@@ -3,7 +3,7 @@
 #pragma once
 
 #include "classify/features.hpp"
-#include "reconstruct/kd_tree.hpp"
+#include "geometry/kd_tree.hpp"
 
 #include <Eigen/Core>
 

@@ -3,7 +3,7 @@
 // alpha complex of squared radius alpha when its circumsphere's squared radius is at most alpha
 // (the interior cells of CGAL::Alpha_shape_3 at that alpha); all finite cells make the convex hull.
 #include "classify/feature_groups.hpp"
-#include "core/grid_thinning.hpp"
+#include "geometry/grid_thinning.hpp"
 
 #include <CGAL/Delaunay_triangulation_3.h>
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>

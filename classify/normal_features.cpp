@@ -4,7 +4,7 @@
 // lambda_min / sum lambda as in pcl::solvePlaneParameters). Neighbours come from the frame's kNN
 // table (one query shared with the cleaning and the skeleton, see TreeFrame).
 #include "classify/feature_groups.hpp"
-#include "reconstruct/kd_tree.hpp"
+#include "geometry/kd_tree.hpp"
 
 #include <pcl/common/eigen.h>
 #include <tbb/parallel_for.h>

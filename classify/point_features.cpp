@@ -2,8 +2,8 @@
 // vertical distribution, radial crown profile, horizontal shape, structure (occupancy,
 // inhomogeneity, box counting). See docs/features.md for the list.
 #include "classify/feature_groups.hpp"
-#include "reconstruct/ransac_fit.hpp"
-#include "reconstruct/union_find.hpp"
+#include "geometry/ransac_fit.hpp"
+#include "geometry/union_find.hpp"
 
 #include <Eigen/Dense>
 

@@ -1,6 +1,6 @@
 #include "classify/splits.hpp"
 
-#include "synth/random.hpp"
+#include "core/random.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,7 @@ void stratified_split(const std::vector<int>& labels, int classes, double fracti
     second.clear();
     std::vector<std::vector<std::size_t>> by_class(classes);
     for (std::size_t i = 0; i < labels.size(); ++i) by_class[labels[i]].push_back(i);
-    synth::Rng rng(synth::stream_seed(seed, 0x5b1175));
+    Rng rng(stream_seed(seed, 0x5b1175));
     for (auto& members : by_class) {
         for (std::size_t i = members.size(); i > 1; --i) std::swap(members[i - 1], members[rng.below(i)]);  // Fisher-Yates
         const std::size_t n = members.size();
@@ -30,7 +30,7 @@ void stratified_split(const std::vector<int>& labels, int classes, double fracti
 std::vector<int> stratified_folds(const std::vector<int>& labels, int classes, int folds, std::uint64_t seed) {
     std::vector<std::vector<std::size_t>> by_class(classes);
     for (std::size_t i = 0; i < labels.size(); ++i) by_class[labels[i]].push_back(i);
-    synth::Rng rng(synth::stream_seed(seed, 0xf01d5));
+    Rng rng(stream_seed(seed, 0xf01d5));
     std::vector<int> fold(labels.size(), 0);
     int next = 0;  // continue dealing across classes so small classes do not all start in fold 0
     for (auto& members : by_class) {

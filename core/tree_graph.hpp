@@ -80,4 +80,11 @@ public:
     void validate(const std::string& context) const;
 };
 
+// Keeps the flagged nodes (keep[0] must be true); new_index[old] is the new index of a kept node
+// or of its nearest kept ancestor. New nodes are numbered in the input's pre-order.
+TreeGraph keep_nodes(const TreeGraph& tree, const std::vector<bool>& keep, std::vector<int>& new_index);
+// Chains between branching points: each starts at the root or a fork, follows single-child
+// nodes and ends at a tip or the next fork (both ends included).
+std::vector<std::vector<int>> tree_chains(const TreeGraph& tree);
+
 }  // namespace treelobes

@@ -1,10 +1,9 @@
 #include "lobes/lobe_tree.hpp"
 
 #include "core/error.hpp"
-#include "core/grid_thinning.hpp"
+#include "geometry/grid_thinning.hpp"
+#include "geometry/kd_tree.hpp"
 #include "lobes/lobe_split.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/skeleton.hpp"
 
 #include <tbb/parallel_for.h>
 

@@ -1,7 +1,7 @@
 #include "lobes/patch_library.hpp"
 
 #include "core/error.hpp"
-#include "lsystem/random.hpp"
+#include "core/random.hpp"
 
 #include <Eigen/Geometry>
 
@@ -19,8 +19,6 @@ namespace {
 constexpr int kMaxChainsPerBranchlet = 60;   // thick chains first (breadth-first); bounds the library
 constexpr float kLeafyThickness = 0.02f;     // leaves grow on twigs thinner than this (metres)
 constexpr float kChildThicknessRatio = 0.6f; // t' = ratio * #InitThickness * t at the fork
-
-using lsystem::Random;
 
 float radians(double degrees) { return static_cast<float>(degrees * std::numbers::pi / 180.0); }
 
@@ -93,7 +91,7 @@ std::vector<PatchSegment> simplify_axis(const std::vector<PatchSegment>& segment
 }
 
 // Seed(t, v): one chain of #ChainPts segments with its leaves and new seeds (docking points).
-Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLibraryOptions& o, Random& rng,
+Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLibraryOptions& o, Rng& rng,
                  std::vector<Seed>& new_seeds) {
     const PatchProfile& pp = profile.patch;
     const LeafProfile& leaf = profile.growth.leaves;
@@ -180,7 +178,7 @@ PatchLibrary build_patch_library(const SpeciesProfile& profile, const PatchLibra
     library.leaf_cluster = profile.growth.leaves.cluster;
     library.branchlets = o.branchlets;
     for (int k = 0; k < o.branchlets; ++k) {
-        Random rng(o.seed * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(k) + 1);
+        Rng rng(o.seed * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(k) + 1);
         // Thickness log-spaced over the branchlets; elevation by a golden-ratio sequence from
         // slightly drooping (-15 deg) to vertical, so thickness and orientation vary independently.
         const double f = o.branchlets > 1 ? static_cast<double>(k) / (o.branchlets - 1) : 0.0;

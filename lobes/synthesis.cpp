@@ -1,7 +1,7 @@
 #include "lobes/synthesis.hpp"
 
 #include "core/error.hpp"
-#include "reconstruct/skeleton.hpp"
+#include "core/tree_graph.hpp"
 
 #include <Eigen/Geometry>
 #include <tbb/parallel_for.h>

@@ -9,7 +9,7 @@
 // lobes leave unspent goes to the lobes that spent theirs. Where a species' patches carry more
 // leaf than twig triangles, the leaves are thinned to the twig triangles (leaf_share, enlarged
 // to keep the area), so the budget buys more patches. synthesized_mesh() turns the main skeleton into generalized cylinders
-// (reconstruct/branch_mesh.hpp) and the placed patches into twig prisms and leaf blades.
+// (geometry/branch_mesh.hpp) and the placed patches into twig prisms and leaf blades.
 //
 // LOD (fraction f in (0, 1]): the elements are ordered once -
 //   - skeleton edges by thickness (thickest first; with allometric diameters a prefix is
@@ -22,10 +22,10 @@
 
 #include "config/species_profile.hpp"
 #include "core/triangle_mesh.hpp"
+#include "geometry/branch_mesh.hpp"
 #include "lobes/lobe_tree.hpp"
 #include "lobes/patch_library.hpp"
 #include "lobes/texturing.hpp"
-#include "reconstruct/branch_mesh.hpp"
 
 #include <string>
 #include <utility>

@@ -1,8 +1,8 @@
 #include "lobes/texturing.hpp"
 
 #include "core/error.hpp"
-#include "lsystem/random.hpp"
-#include "reconstruct/kd_tree.hpp"
+#include "core/random.hpp"
+#include "geometry/kd_tree.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -194,7 +194,7 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
     int filled_count = 0;
     const int fill_total = std::max(1, static_cast<int>(std::count(target.begin(), target.end(), 1)));
     texture.target_cells = static_cast<std::size_t>(fill_total);
-    lsystem::Random rng(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17);
+    Rng rng(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17);
 
     std::vector<std::vector<Sample>> samples(library.patches.size()), fit_samples(library.patches.size());
     for (std::size_t i = 0; i < library.patches.size(); ++i) {

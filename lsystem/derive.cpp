@@ -22,7 +22,7 @@ public:
     }
 
     // Rewrites `in` into `out` (cleared first). Throws when out would exceed max_modules.
-    void rewrite(const ModuleString& in, ModuleString& out, int step, int steps, Random& random, std::size_t max_modules) {
+    void rewrite(const ModuleString& in, ModuleString& out, int step, int steps, Rng& random, std::size_t max_modules) {
         out.clear();
         if (needs_brackets_) match_brackets(in);
         context_.step = step;
@@ -45,7 +45,7 @@ private:
     }
 
     // The rule to apply to module i, or -1 (copy the module).
-    int select(const ModuleString& in, std::size_t i, Random& random) {
+    int select(const ModuleString& in, std::size_t i, Rng& random) {
         if (!has_rules(in.symbol(i))) return -1;
         const auto& candidates = by_symbol_[static_cast<std::size_t>(in.symbol(i))];
         for (std::size_t k = 0; k < candidates.size(); ++k) {
@@ -59,7 +59,7 @@ private:
 
     // All stochastic rules from position `first` on that match compete, weighted by probability.
     int draw_stochastic(const ModuleString& in, std::size_t i, const std::vector<int>& candidates, std::size_t first,
-                        Random& random) {
+                        Rng& random) {
         group_.clear();
         double total = 0.0;
         for (std::size_t k = first; k < candidates.size(); ++k) {
@@ -238,7 +238,7 @@ ModuleString derive(const LSystem& system, const DeriveOptions& options) {
                            std::to_string(kMaxDerivationLength));
     if (system.axiom.size() > options.max_modules)
         throw Error::input(system.source, "the axiom has more than " + std::to_string(options.max_modules) + " modules");
-    Random random(options.seed.value_or(system.seed));
+    Rng random(options.seed.value_or(system.seed));
     Rewriter rewriter(system, system.productions);
     ModuleString current = system.axiom, next(system.alphabet);
     std::size_t work = 0;
@@ -260,7 +260,7 @@ ModuleString apply_homomorphism(const LSystem& system, const ModuleString& strin
     if (system.homomorphism.empty()) return string;
     const int steps = options.steps.value_or(system.derivation_length.value_or(0));
     // An independent stream: adding a stochastic homomorphism does not change the derivation.
-    Random random(options.seed.value_or(system.seed) ^ 0x6a09e667f3bcc909ULL);
+    Rng random(options.seed.value_or(system.seed) ^ 0x6a09e667f3bcc909ULL);
     Rewriter rewriter(system, system.homomorphism);
     ModuleString out(system.alphabet);
     rewriter.rewrite(string, out, steps, steps, random, options.max_modules);

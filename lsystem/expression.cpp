@@ -282,8 +282,8 @@ double Expression::evaluate(const EvalContext& context) const {
         stack = large.data();
     }
     int top = -1;
-    auto random = [&]() -> Random& {
-        static thread_local Random fallback(0);  // only for constant folding, which has no random calls
+    auto random = [&]() -> Rng& {
+        static thread_local Rng fallback(0);  // only for constant folding, which has no random calls
         return context.random ? *context.random : fallback;
     };
     for (const Instruction& ins : code_) {

@@ -11,7 +11,7 @@
 // Comparisons and logic give 1 or 0; a condition holds when it is non-zero.
 #pragma once
 
-#include "lsystem/random.hpp"
+#include "core/random.hpp"
 #include "lsystem/text_cursor.hpp"
 
 #include <span>
@@ -48,7 +48,7 @@ struct EvalContext {
     std::span<const double> params;
     double step = 0;
     double steps = 0;
-    Random* random = nullptr;
+    Rng* random = nullptr;
 };
 
 class Expression {

@@ -25,6 +25,7 @@
 #pragma once
 
 #include "core/tree_graph.hpp"
+#include "geometry/cylinder_fit.hpp"
 
 #include <Eigen/Core>
 
@@ -46,22 +47,6 @@ struct CylinderAxesOptions {
     float max_tilt = 30.0f;    // degrees between the fitted axis and the skeleton's direction
     float max_shift = 1.5f;    // x radius: nodes that would move farther stay where they are
 };
-
-struct CylinderFit {
-    bool converged = false;
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();      // on the axis, level with the points' centroid
-    Eigen::Vector3d direction = Eigen::Vector3d::UnitZ(); // unit
-    double radius = 0;
-    double rms = 0;       // RMS of |distance to the axis - radius| (metres)
-    double arc = 0;       // degrees around the axis covered by points (360 minus the widest empty gap)
-};
-
-// Least-squares cylinder (Levenberg-Marquardt over axis position, direction and radius) through
-// `points`, started from the axis through `point` along `direction` with radius `radius`. Points
-// farther than 3 RMS from the first fit's surface are dropped and the fit repeated once.
-// converged = false with fewer than 6 points or when the iteration fails.
-CylinderFit fit_cylinder(std::span<const Eigen::Vector3d> points, const Eigen::Vector3d& point, const Eigen::Vector3d& direction,
-                         double radius);
 
 // Moves the non-fixed nodes of `tree` across onto trusted cylinder fits (see above); a window
 // of a dense scan is thinned evenly to at most 80 points before fitting.

@@ -2,8 +2,9 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/point_scatter.hpp"
+#include "geometry/ransac_fit.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>

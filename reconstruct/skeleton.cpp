@@ -2,10 +2,10 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/ransac_fit.hpp"
-#include "reconstruct/shortest_paths.hpp"
-#include "reconstruct/union_find.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/ransac_fit.hpp"
+#include "geometry/shortest_paths.hpp"
+#include "geometry/union_find.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -696,33 +696,6 @@ TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old,
 }
 
 }  // namespace
-
-TreeGraph keep_nodes(const TreeGraph& tree, const std::vector<bool>& keep, std::vector<int>& new_index) {
-    if (tree.empty() || !keep[0]) throw Error(ExitCode::Internal, "keep_nodes: the root must be kept");
-    TreeGraph out;
-    out.origin = tree.origin;
-    new_index.assign(tree.size(), -1);
-    for (int u : tree.preorder()) {
-        const int parent = tree.nodes[u].parent;
-        if (keep[u]) new_index[u] = out.add_node(tree.nodes[u].position, tree.nodes[u].radius, parent < 0 ? -1 : new_index[parent]);
-        else new_index[u] = new_index[parent];
-    }
-    return out;
-}
-
-std::vector<std::vector<int>> tree_chains(const TreeGraph& tree) {
-    std::vector<std::vector<int>> chains;
-    for (int start : tree.preorder()) {
-        const auto& kids = tree.nodes[start].children;
-        if (start != 0 && kids.size() < 2) continue;
-        for (int child : kids) {
-            std::vector<int> chain{start, child};
-            while (tree.nodes[chain.back()].children.size() == 1) chain.push_back(tree.nodes[chain.back()].children.front());
-            chains.push_back(std::move(chain));
-        }
-    }
-    return chains;
-}
 
 SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, const SkeletonOptions& o, const std::string& name,
                                     const KdTree* given_index, const KnnTable* given_near) {

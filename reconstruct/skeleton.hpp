@@ -1,6 +1,6 @@
 // Skeleton extraction from a single-tree point cloud (seed 001 §4.1, after Xu et al. 2007 and
 // Livny et al. 2010):
-//   1. neighbour graph with edge weights ||u-v||^beta (reconstruct/neighbour_graph.hpp); a
+//   1. neighbour graph with edge weights ||u-v||^beta (geometry/neighbour_graph.hpp); a
 //      piece cut off by an occlusion gap is bridged where its own axis leads, not sideways to
 //      the nearest bark (the straight join the skeleton draws across the gap follows the bridge);
 //   2. stem foot (reconstruct/tree_base.hpp) and two multi-source Dijkstra runs from its
@@ -91,13 +91,5 @@ inline int skeleton_table_width(const SkeletonOptions& options) { return options
 
 // The skeleton of a cloud as it is (no cleaning); the tree takes the cloud's origin.
 TreeGraph extract_skeleton(const PointCloud& cloud, const SkeletonOptions& options = {});
-
-// Tree helpers shared with the other stages of reconstruct/.
-// Keeps the flagged nodes (keep[0] must be true); new_index[old] is the new index of a kept node
-// or of its nearest kept ancestor. New nodes are numbered in the input's pre-order.
-TreeGraph keep_nodes(const TreeGraph& tree, const std::vector<bool>& keep, std::vector<int>& new_index);
-// Chains between branching points: each starts at the root or a fork, follows single-child
-// nodes and ends at a tip or the next fork (both ends included).
-std::vector<std::vector<int>> tree_chains(const TreeGraph& tree);
 
 }  // namespace treelobes

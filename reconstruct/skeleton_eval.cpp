@@ -6,8 +6,8 @@
 #include "core/georef_sidecar.hpp"
 #include "core/ply_format.hpp"
 #include "core/skeleton_io.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/union_find.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/union_find.hpp"
 
 #include <algorithm>
 #include <charconv>

@@ -1,8 +1,8 @@
 #include "reconstruct/tree_base.hpp"
 
 #include "core/error.hpp"
-#include "reconstruct/ransac_fit.hpp"
-#include "reconstruct/union_find.hpp"
+#include "geometry/ransac_fit.hpp"
+#include "geometry/union_find.hpp"
 
 #include <algorithm>
 #include <cmath>

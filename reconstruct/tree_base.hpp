@@ -5,7 +5,7 @@
 // placed below the lowest piece and flagged, so callers can fall back on allometry.
 #pragma once
 
-#include "reconstruct/neighbour_graph.hpp"
+#include "geometry/neighbour_graph.hpp"
 
 #include <Eigen/Core>
 

@@ -1,6 +1,6 @@
 #include "reconstruct/tree_quality.hpp"
 
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/ransac_fit.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>

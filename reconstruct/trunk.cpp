@@ -1,7 +1,7 @@
 #include "reconstruct/trunk.hpp"
 
 #include "core/error.hpp"
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/ransac_fit.hpp"
 
 #include <Eigen/Geometry>
 

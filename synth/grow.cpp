@@ -3,7 +3,7 @@
 #include "synth/grow.hpp"
 
 #include "core/error.hpp"
-#include "synth/random.hpp"
+#include "core/random.hpp"
 
 #include <Eigen/Geometry>
 

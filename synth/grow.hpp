@@ -7,7 +7,7 @@
 // remaining length of their parent; phyllotaxis by `rotate` (spiral) or alternate sprays, whorls;
 // dichotomous forks (`seg_splits`) for decurrent crowns; tropism toward or away from the sky;
 // radii by taper and `ratio_power` with a pipe-model split at forks; leaves on the last level.
-// docs/species.md describes every parameter. Everything random comes from synth/random.hpp, so
+// docs/species.md describes every parameter. Everything random comes from core/random.hpp, so
 // the same (species, seed, options) gives the same tree bit for bit.
 #pragma once
 

@@ -1,8 +1,8 @@
 #include "synth/scan_stats.hpp"
 
 #include "core/error.hpp"
-#include "core/grid_thinning.hpp"
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/grid_thinning.hpp"
+#include "geometry/ransac_fit.hpp"
 
 #include <Eigen/Core>
 

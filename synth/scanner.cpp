@@ -1,7 +1,7 @@
 #include "synth/scanner.hpp"
 
 #include "core/error.hpp"
-#include "synth/random.hpp"
+#include "core/random.hpp"
 #include "synth/ray_scene.hpp"
 
 #include <Eigen/Geometry>

@@ -1,7 +1,7 @@
 #include "synth/scene.hpp"
 
 #include "core/error.hpp"
-#include "synth/random.hpp"
+#include "core/random.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>

@@ -2,7 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "synth/random.hpp"
+#include "core/random.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,8 +1,8 @@
-// Triangle meshes of synthetic trees: the branch tubes of reconstruct/branch_mesh (generalized
+// Triangle meshes of synthetic trees: the branch tubes of geometry/branch_mesh (generalized
 // cylinders with smooth joints) plus one quad (two triangles) per leaf.
 #pragma once
 
-#include "reconstruct/branch_mesh.hpp"
+#include "geometry/branch_mesh.hpp"
 #include "synth/grow.hpp"
 
 namespace treelobes::synth {

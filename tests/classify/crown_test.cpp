@@ -4,7 +4,7 @@
 #include "classify/crown.hpp"
 #include "classify/features.hpp"
 #include "support/test_support.hpp"
-#include "synth/random.hpp"
+#include "core/random.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,7 +28,7 @@ void add_point(PointCloud& c, float x, float y, float z, std::uint8_t cls, std::
 // A clip as NEON gives it: ground returns at 300 m (class 2), a crown 12-20 m above the ground,
 // understorey at 1-3 m, one noise point (class 7) and one unclassified return 170 m up.
 PointCloud survey_clip(std::uint64_t seed) {
-    synth::Rng rng(seed);
+    Rng rng(seed);
     PointCloud c;
     for (int i = 0; i < 60; ++i) add_point(c, rng.uniform(-5, 5), rng.uniform(-5, 5), 300.0f + rng.uniform(-0.1, 0.1), 2, 40);
     for (int i = 0; i < 200; ++i) {

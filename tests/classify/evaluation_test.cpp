@@ -8,8 +8,8 @@
 #include "classify/xgboost_baseline.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/random.hpp"
 #include "support/test_support.hpp"
-#include "synth/random.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -30,7 +30,7 @@ namespace {
 // is noise. Positions: same-species rows along streets 300 m apart (class c from x = 300 c, 8 m apart) when
 // `grouped`, otherwise scattered at random over the same area.
 LabelledSet clustered_set(int classes, int per_class, double sigma, bool grouped, std::uint64_t seed) {
-    synth::Rng rng(seed);
+    Rng rng(seed);
     LabelledSet set;
     set.features.feature_names = {"f0", "f1"};
     for (int c = 0; c < classes; ++c) set.classes.push_back("species" + std::to_string(c));

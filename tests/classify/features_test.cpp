@@ -5,8 +5,8 @@
 #include "config/species_profile.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/random.hpp"
 #include "support/test_support.hpp"
-#include "synth/random.hpp"
 #include "synth/scanner.hpp"
 
 #include <gtest/gtest.h>
@@ -73,7 +73,7 @@ PointCloud transformed(const PointCloud& cloud, double heading_deg, const Eigen:
 }
 
 PointCloud random_half(const PointCloud& cloud, std::uint64_t seed) {
-    synth::Rng rng(seed);
+    Rng rng(seed);
     std::vector<bool> keep(cloud.size());
     for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = rng.uniform(0, 1) < 0.5;
     return cloud.subset(keep);
@@ -269,7 +269,7 @@ TEST(ClassifyFeatures, RejectsCloudsThatAreNotTrees) {
     for (int i = 0; i < 20; ++i) few.positions.emplace_back(i * 0.1f, 0.0f, i * 0.2f);
     EXPECT_TRUE(std::isnan(feature(compute_features(few, {}, "few.xyz"), "height")));
     PointCloud flat;
-    synth::Rng rng(2);
+    Rng rng(2);
     for (int i = 0; i < 2000; ++i)
         flat.positions.emplace_back(static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.normal(0, 0.02)));
     try {
@@ -319,7 +319,7 @@ TEST(ClassifyFeatures, AirborneGroupInvariantToPositionHeadingAndDensity) {
         for (auto& p : moved.positions) p = turn37 * p + Eigen::Vector3f(120.0f, -80.0f, 15.0f);
         for (auto& p : turned.positions) p = turn200 * p;
         std::vector<bool> keep(scans[s].size());
-        synth::Rng rng(4);
+        Rng rng(4);
         for (std::size_t i = 0; i < keep.size(); ++i) keep[i] = rng.uniform(0, 1) < 0.5;
         const auto half = airborne(compute_features(scans[s].subset(keep)));
         EXPECT_LT(scaled_distance(vectors[s], airborne(compute_features(moved)), scale), 0.05);

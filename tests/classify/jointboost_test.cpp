@@ -2,9 +2,9 @@
 // implementation of the same rounds, and model files.
 #include "classify/features.hpp"
 #include "classify/jointboost.hpp"
-#include "core/error.hpp"
-#include "synth/random.hpp"
 #include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "core/random.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -38,7 +38,7 @@ FeatureTable empty_table(int features) {
 // `per_class` samples of each class; class c has mean +-5 on feature c % dims (sign by c / dims)
 // and unit noise elsewhere, plus one pure-noise feature.
 void gaussian_clusters(int classes, int dims, int per_class, std::uint64_t seed, FeatureTable& table, std::vector<int>& y) {
-    synth::Rng rng(seed);
+    Rng rng(seed);
     table = empty_table(dims + 1);
     std::vector<double> row(dims + 1);
     for (int i = 0; i < per_class; ++i)
@@ -199,7 +199,7 @@ void expect_rounds_match_naive(const FeatureTable& t, const std::vector<int>& y,
 
 TEST(JointBoost, FirstRoundsMatchNaiveReference) {
     // Integer-valued features create repeated values (thresholds only between distinct values).
-    synth::Rng rng(5);
+    Rng rng(5);
     FeatureTable t = empty_table(3);
     std::vector<int> y;
     for (int i = 0; i < 36; ++i) {
@@ -217,7 +217,7 @@ TEST(JointBoost, ManyRoundsOverManyFeaturesMatchNaiveReference) {
     // thresholds against the best gain of any feature so far; over many rounds the order changes
     // and duplicated columns tie exactly (the lower index must win), yet every stump must be the
     // exhaustive search's.
-    synth::Rng rng(17);
+    Rng rng(17);
     const int classes = 5, features = 9;
     FeatureTable t = empty_table(features);
     std::vector<int> y;
@@ -244,7 +244,7 @@ TEST(JointBoost, ClassesWithACommonFeatureShareTheFirstStump) {
     // features. The best first stump is feature 0 shared by {0, 1}: below the threshold every
     // tree is a negative for both, which one shared stump says at once (gain 11.4 n against 10.2 n
     // for a single class and 9 n for all classes; see the derivation in docs/classify.md).
-    synth::Rng rng(3);
+    Rng rng(3);
     FeatureTable t = empty_table(4);
     std::vector<int> y;
     for (int i = 0; i < 30; ++i)
@@ -280,7 +280,7 @@ TEST(JointBoost, DeterministicAndIndependentOfThreads) {
 }
 
 TEST(JointBoost, EarlyStoppingOnNoise) {
-    synth::Rng rng(8);
+    Rng rng(8);
     FeatureTable t = empty_table(5);
     std::vector<int> y;
     for (int i = 0; i < 120; ++i) {
@@ -425,7 +425,7 @@ namespace {
 // the dense kind, with the opposite sign, so that no single threshold of either serves both; the
 // scan descriptor (tens against thousands of points per m^2) tells the kinds apart.
 void two_scan_kinds(int per_class_and_kind, std::uint64_t seed, FeatureTable& table, std::vector<int>& y) {
-    synth::Rng rng(seed);
+    Rng rng(seed);
     table = empty_table(3);
     table.feature_names.push_back(kScanDensityFeature);
     for (int i = 0; i < per_class_and_kind; ++i)
@@ -585,7 +585,7 @@ TEST(JointBoost, ProbabilityAveragingEnsembleKeepsItsMembersThroughTheFile) {
 TEST(JointBoost, LearnsWhichSideMissingValuesGo) {
     FeatureTable t = empty_table(2);
     std::vector<int> y;
-    synth::Rng rng(3);
+    Rng rng(3);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     for (int i = 0; i < 30; ++i) {
         const double missing_or_high[2] = {i % 2 ? nan : rng.uniform(3, 4), rng.normal()};
@@ -619,7 +619,7 @@ TEST(JointBoost, LearnsWhichSideMissingValuesGo) {
 TEST(JointBoost, BalancedClassWeightsFavourTheRareClass) {
     FeatureTable t = empty_table(1);
     std::vector<int> y;
-    synth::Rng rng(8);
+    Rng rng(8);
     for (int i = 0; i < 40; ++i) {
         const double v[1] = {rng.normal(0, 1)};
         t.add_row(test::numbered("a", static_cast<std::size_t>(i)), v), y.push_back(0);

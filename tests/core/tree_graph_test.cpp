@@ -58,6 +58,30 @@ TEST(TreeGraph, ValidateRejectsBrokenLinks) {
     EXPECT_THROW(TreeGraph().validate("t"), Error);
 }
 
+TEST(TreeGraph, KeepNodesReattachesToTheNearestKeptAncestor) {
+    const TreeGraph tree = small_tree();
+    std::vector<int> new_index;
+    // Drop node 1 (the fork) and the twig tip 5: 2 and 3 hang from the root now.
+    const TreeGraph kept = keep_nodes(tree, {true, false, true, true, true, false}, new_index);
+    ASSERT_EQ(kept.size(), 4u);
+    EXPECT_EQ(new_index, (std::vector<int>{0, 0, 1, 2, 3, 1}));
+    EXPECT_EQ(kept.nodes[1].parent, 0);
+    EXPECT_EQ(kept.nodes[2].parent, 0);
+    EXPECT_EQ(kept.nodes[3].parent, 2);
+    EXPECT_FLOAT_EQ(kept.nodes[3].radius, 0.05f);
+    EXPECT_NO_THROW(kept.validate("kept"));
+    EXPECT_THROW(keep_nodes(tree, {false, true, true, true, true, true}, new_index), Error);  // the root must stay
+}
+
+TEST(TreeGraph, ChainsRunBetweenForksAndTips) {
+    const auto chains = tree_chains(small_tree());
+    // From the root to the fork 1, then from 1 along the trunk to the tip 5 and along the lateral.
+    ASSERT_EQ(chains.size(), 3u);
+    EXPECT_EQ(chains[0], (std::vector<int>{0, 1}));
+    EXPECT_EQ(chains[1], (std::vector<int>{1, 2, 5}));
+    EXPECT_EQ(chains[2], (std::vector<int>{1, 3, 4}));
+}
+
 TEST(AtomicFile, FailureKeepsThePreviousFileAndLeavesNoTemporary) {
     test::TempDir dir;
     write_file_atomically(dir / "out.txt", "old");

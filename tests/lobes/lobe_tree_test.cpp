@@ -3,7 +3,7 @@
 #include "lobes/tlobe_io.hpp"
 
 #include "core/error.hpp"
-#include "reconstruct/synthetic_clouds.hpp"
+#include "support/synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 

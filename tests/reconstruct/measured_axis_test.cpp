@@ -3,7 +3,7 @@
 // thick stem an internode may hold only a patch of bark, whose centre is not the stem's.
 #include "reconstruct/reconstruct_tree.hpp"
 #include "reconstruct/skeleton.hpp"
-#include "synthetic_clouds.hpp"
+#include "support/synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 

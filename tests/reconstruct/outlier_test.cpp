@@ -5,8 +5,8 @@
 #include "core/error.hpp"
 #include "reconstruct/preprocess.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
+#include "support/synthetic_clouds.hpp"
 #include "support/test_support.hpp"
-#include "synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -3,8 +3,8 @@
 #include "core/error.hpp"
 #include "reconstruct/recentre.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
+#include "support/synthetic_clouds.hpp"
 #include "support/test_support.hpp"
-#include "synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

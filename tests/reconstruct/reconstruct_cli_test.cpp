@@ -3,8 +3,8 @@
 #include "core/cloud_io.hpp"
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
+#include "support/synthetic_clouds.hpp"
 #include "support/test_support.hpp"
-#include "synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>

@@ -2,7 +2,7 @@
 #include "core/error.hpp"
 #include "reconstruct/allometry.hpp"
 #include "reconstruct/skeleton.hpp"
-#include "synthetic_clouds.hpp"
+#include "support/synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 

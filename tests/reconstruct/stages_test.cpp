@@ -1,14 +1,14 @@
 // Cleaning, tree base, stem fit, "not a tree" check and the whole single-tree pipeline on
 // synthetic clouds.
 #include "core/error.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/neighbour_graph.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/neighbour_graph.hpp"
+#include "geometry/ransac_fit.hpp"
 #include "reconstruct/preprocess.hpp"
-#include "reconstruct/ransac_fit.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
 #include "reconstruct/tree_base.hpp"
 #include "reconstruct/tree_quality.hpp"
-#include "synthetic_clouds.hpp"
+#include "support/synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 
@@ -116,29 +116,6 @@ TEST(Preprocess, HandedOnTableMatchesAFreshQuery) {
         std::sort(inner_fresh.begin(), inner_fresh.end());
         ASSERT_EQ(inner_given, inner_fresh) << "row " << i;
     }
-}
-
-TEST(CircleFit, LeastSquaresRecoversANoisyArcAndRefusesDegenerateInput) {
-    // A half circle (a one-sided scan of a stem) of radius 0.2 m around (1, -2) with 2 mm noise.
-    std::mt19937 random(3);
-    std::normal_distribution<double> noise(0.0, 0.002);
-    std::vector<Eigen::Vector2d> arc;
-    for (int i = 0; i < 200; ++i) {
-        const double angle = std::numbers::pi * i / 199.0;
-        arc.push_back(Eigen::Vector2d(1 + 0.2 * std::cos(angle) + noise(random), -2 + 0.2 * std::sin(angle) + noise(random)));
-    }
-    const auto circle = fit_circle_least_squares(arc);
-    ASSERT_TRUE(circle.has_value());
-    EXPECT_NEAR(circle->radius, 0.2, 0.005);
-    EXPECT_NEAR(circle->centre.x(), 1.0, 0.005);
-    EXPECT_NEAR(circle->centre.y(), -2.0, 0.005);
-
-    const std::vector<Eigen::Vector2d> two{{0, 0}, {1, 0}};
-    EXPECT_FALSE(fit_circle_least_squares(two).has_value());
-    const std::vector<Eigen::Vector2d> same(10, Eigen::Vector2d(0.5, 0.5));
-    EXPECT_FALSE(fit_circle_least_squares(same).has_value());
-    const std::vector<Eigen::Vector2d> line{{0, 0}, {1, 1}, {2, 2}, {3, 3}};
-    EXPECT_FALSE(fit_circle_least_squares(line).has_value());
 }
 
 TEST(TreeBase, HangingBranchTipIsNotTheRoot) {

@@ -1,5 +1,5 @@
 // KdTree: the project's one nearest-neighbour index over 3-D points (FLANN's single kd-tree,
-// kept inside reconstruct/kd_tree.cpp). Construction copies the points, so the index does not
+// kept inside geometry/kd_tree.cpp). Construction copies the points, so the index does not
 // depend on the lifetime of the caller's vector. Queries are const and thread-safe.
 #pragma once
 

@@ -1,10 +1,10 @@
-#include "reconstruct/neighbour_graph.hpp"
+#include "geometry/neighbour_graph.hpp"
 
 #include "core/error.hpp"
 #include "core/log.hpp"
-#include "core/point_cloud.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/union_find.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/point_scatter.hpp"
+#include "geometry/union_find.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <tbb/parallel_for.h>

@@ -1,9 +1,9 @@
 // kd-tree, neighbour graph (with component bridging) and Dijkstra on small clouds whose
 // answers can be worked out by hand or by brute force.
 #include "core/error.hpp"
-#include "reconstruct/kd_tree.hpp"
-#include "reconstruct/neighbour_graph.hpp"
-#include "reconstruct/shortest_paths.hpp"
+#include "geometry/kd_tree.hpp"
+#include "geometry/neighbour_graph.hpp"
+#include "geometry/shortest_paths.hpp"
 
 #include <gtest/gtest.h>
 

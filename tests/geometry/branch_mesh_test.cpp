@@ -1,6 +1,6 @@
 #include "core/error.hpp"
 #include "core/mesh_io.hpp"
-#include "reconstruct/branch_mesh.hpp"
+#include "geometry/branch_mesh.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-#include "reconstruct/ransac_fit.hpp"
+#include "geometry/ransac_fit.hpp"
 
 #include <Eigen/QR>
 #include <pcl/console/print.h>

@@ -1,4 +1,4 @@
-#include "reconstruct/shortest_paths.hpp"
+#include "geometry/shortest_paths.hpp"
 
 #include "core/error.hpp"
 

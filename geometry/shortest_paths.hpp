@@ -3,7 +3,7 @@
 // plot at the same time (each vertex then records which source reached it).
 #pragma once
 
-#include "reconstruct/neighbour_graph.hpp"
+#include "geometry/neighbour_graph.hpp"
 
 #include <span>
 #include <vector>

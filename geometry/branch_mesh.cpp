@@ -1,4 +1,4 @@
-#include "reconstruct/branch_mesh.hpp"
+#include "geometry/branch_mesh.hpp"
 
 #include "core/error.hpp"
 

@@ -1,12 +1,13 @@
-// Deterministic random numbers for synthesis. std:: distributions are implementation-defined
-// (libstdc++ and libc++ give different numbers for the same engine), so the generator and the
-// distributions are spelled out here: same seed -> same trees and scans on every platform.
+// The one random source of treelobes: synthetic trees and scans, stochastic L-systems, lobe
+// texturing and patch libraries, classification splits. std:: distributions are
+// implementation-defined (libstdc++ and libc++ give different numbers for the same engine), so the
+// generator and the distributions are spelled out here: same seed -> same output on every platform.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 
-namespace treelobes::synth {
+namespace treelobes {
 
 // SplitMix64 (Steele, Lea, Flood 2014): used to derive independent streams from (seed, key).
 inline std::uint64_t splitmix64(std::uint64_t x) {
@@ -66,4 +67,4 @@ private:
     std::uint64_t s_[4];
 };
 
-}  // namespace treelobes::synth
+}  // namespace treelobes

@@ -1,6 +1,6 @@
 // point_scatter: mean and (undivided) scatter matrix of a subset of a cloud.
 #include "core/error.hpp"
-#include "core/point_cloud.hpp"
+#include "geometry/point_scatter.hpp"
 
 #include <gtest/gtest.h>
 

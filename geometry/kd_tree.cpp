@@ -1,4 +1,4 @@
-#include "reconstruct/kd_tree.hpp"
+#include "geometry/kd_tree.hpp"
 
 #include <flann/flann.hpp>
 #include <tbb/parallel_for.h>

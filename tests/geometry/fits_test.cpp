@@ -1,0 +1,90 @@
+// The general fits of geometry/: least-squares and RANSAC circles (ransac_fit.hpp), least-squares
+// cylinders (cylinder_fit.hpp) and disjoint sets (union_find.hpp).
+#include "geometry/cylinder_fit.hpp"
+#include "geometry/ransac_fit.hpp"
+#include "geometry/union_find.hpp"
+#include "support/synthetic_clouds.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <random>
+#include <vector>
+
+using namespace treelobes;
+
+TEST(CircleFit, LeastSquaresRecoversANoisyArcAndRefusesDegenerateInput) {
+    // A half circle (a one-sided scan of a stem) of radius 0.2 m around (1, -2) with 2 mm noise.
+    std::mt19937 random(3);
+    std::normal_distribution<double> noise(0.0, 0.002);
+    std::vector<Eigen::Vector2d> arc;
+    for (int i = 0; i < 200; ++i) {
+        const double angle = std::numbers::pi * i / 199.0;
+        arc.push_back(Eigen::Vector2d(1 + 0.2 * std::cos(angle) + noise(random), -2 + 0.2 * std::sin(angle) + noise(random)));
+    }
+    const auto circle = fit_circle_least_squares(arc);
+    ASSERT_TRUE(circle.has_value());
+    EXPECT_NEAR(circle->radius, 0.2, 0.005);
+    EXPECT_NEAR(circle->centre.x(), 1.0, 0.005);
+    EXPECT_NEAR(circle->centre.y(), -2.0, 0.005);
+
+    const std::vector<Eigen::Vector2d> two{{0, 0}, {1, 0}};
+    EXPECT_FALSE(fit_circle_least_squares(two).has_value());
+    const std::vector<Eigen::Vector2d> same(10, Eigen::Vector2d(0.5, 0.5));
+    EXPECT_FALSE(fit_circle_least_squares(same).has_value());
+    const std::vector<Eigen::Vector2d> line{{0, 0}, {1, 1}, {2, 2}, {3, 3}};
+    EXPECT_FALSE(fit_circle_least_squares(line).has_value());
+}
+
+TEST(CircleFit, RansacIgnoresOutliersAndReportsCoverage) {
+    // A full ring of radius 0.15 m around (0.5, 0.5) plus 40 % scattered points inside it.
+    std::mt19937 random(7);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<Eigen::Vector2f> points;
+    for (int i = 0; i < 300; ++i) {
+        const float angle = 2.0f * std::numbers::pi_v<float> * unit(random);
+        points.emplace_back(0.5f + 0.15f * std::cos(angle), 0.5f + 0.15f * std::sin(angle));
+    }
+    for (int i = 0; i < 200; ++i) points.emplace_back(0.4f + 0.2f * unit(random), 0.4f + 0.2f * unit(random));
+    const CircleFit fit = fit_circle(points, 0.01f, 0.05f, 0.5f);
+    ASSERT_TRUE(fit.ok);
+    EXPECT_NEAR(fit.radius, 0.15f, 0.003f);
+    EXPECT_NEAR(fit.centre.x(), 0.5f, 0.003f);
+    EXPECT_NEAR(fit.centre.y(), 0.5f, 0.003f);
+    EXPECT_GE(fit.inliers, 300u);
+    EXPECT_GT(fit.coverage, 0.9f);
+    EXPECT_FALSE(fit_circle(std::vector<Eigen::Vector2f>(points.begin(), points.begin() + 4), 0.01f, 0.05f, 0.5f).ok);
+}
+
+TEST(CylinderFit, RecoversAFullCylinderFromAPoorStart) {
+    std::vector<Eigen::Vector3d> points;
+    std::mt19937 rng(2);
+    std::vector<Eigen::Vector3f> bark;
+    test::add_cylinder(bark, {{0.1f, 0.2f, 0.0f}, {0.3f, 0.1f, 0.5f}, 0.04f}, 20000.0f, rng);
+    for (const auto& p : bark) points.push_back(p.cast<double>());
+    // Started 2 cm off the axis, tilted, with half the radius.
+    const CylinderFit fit = fit_cylinder(points, {0.12, 0.21, 0.25}, {0.3, -0.1, 1.0}, 0.02);
+    ASSERT_TRUE(fit.converged);
+    EXPECT_NEAR(fit.radius, 0.04, 0.001);
+    const Eigen::Vector3d axis = Eigen::Vector3d(0.2, -0.1, 0.5).normalized();
+    EXPECT_GT(std::abs(fit.direction.dot(axis)), std::cos(0.01));
+    const Eigen::Vector3d off = fit.point - Eigen::Vector3d(0.1, 0.2, 0.0);
+    EXPECT_LT((off - axis * off.dot(axis)).norm(), 0.001);
+    EXPECT_LT(fit.rms, 0.005);
+    EXPECT_GT(fit.arc, 340.0);
+    EXPECT_FALSE(fit_cylinder(std::vector<Eigen::Vector3d>(points.begin(), points.begin() + 5), {0, 0, 0}, {0, 0, 1}, 0.04).converged);
+}
+
+TEST(UnionFind, SetsMergeOnceAndTheLargerRootSurvives) {
+    UnionFind sets(6);
+    EXPECT_TRUE(sets.unite(0, 1));
+    EXPECT_TRUE(sets.unite(2, 1));
+    EXPECT_FALSE(sets.unite(0, 2));  // already one set
+    EXPECT_EQ(sets.set_size(2), 3);
+    EXPECT_EQ(sets.find(2), 0);      // {0, 1} was larger than {2}: its root survives
+    EXPECT_TRUE(sets.unite(4, 3));   // equal sizes: the smaller index is the root
+    EXPECT_EQ(sets.find(4), 3);
+    EXPECT_NE(sets.find(5), sets.find(0));
+    EXPECT_EQ(sets.set_size(5), 1);
+}
