@@ -26,7 +26,7 @@ done
 points=$(python3 -c "import glob, struct
 print(sum(struct.unpack_from('<Q', open(f, 'rb').read(255), 247)[0] for f in glob.glob('tiles/*.las')))")  # LAS 1.4 point count
 
-seconds() { local start=$SECONDS; "$@"; echo $((SECONDS - start)); }
+seconds() { local start=$SECONDS; "$@" >/dev/null; echo $((SECONDS - start)); }
 batch() { "$cli" --log-level warn batch tiles --out "$1" "${@:2}" $options >/dev/null; }
 merge() { "$cli" --log-level warn merge "${@:2}" --out "$1" >/dev/null || true; }
 
@@ -34,9 +34,9 @@ t_single=$(seconds batch single)
 merge single_merged single
 for i in 0 1 2 3; do batch shards --shard "$i/4"; done
 merge shards_merged shards
-t_j1=$(seconds parallel -j1 "$cli" --log-level warn --threads 1 batch tiles --out par1 --shard {}/4 $options ::: 0 1 2 3)
+t_j1=$(seconds parallel -j1 "$cli" --log-level warn --threads 1 batch tiles --out par1 --shard {}/4 $options ::: 0 1 2 3 >/dev/null)
 merge par1_merged par1
-t_j2=$(seconds parallel -j2 "$cli" --log-level warn --threads 1 batch tiles --out par2 --shard {}/4 $options ::: 0 1 2 3)
+t_j2=$(seconds parallel -j2 "$cli" --log-level warn --threads 1 batch tiles --out par2 --shard {}/4 $options ::: 0 1 2 3 >/dev/null)
 merge par2_merged par2
 mkdir -p jobs
 PATH="$(dirname "$cli"):$PATH" "$root/tests/survey/local_slurm_cluster.sh" "$work/cluster" sh -c \
