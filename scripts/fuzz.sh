@@ -45,12 +45,19 @@ echo "$targets" | grep -qx "$target" || { echo "fuzz.sh: no target '$target' (sc
 corpus=$SAN_BUILD_DIR/fuzz-corpus/$target
 artifacts=$SAN_BUILD_DIR/fuzz-artifacts/$target
 mkdir -p "$corpus" "$artifacts"
-seeds=(fuzz/seeds/"$target")
+seeds=()
+[ -d "fuzz/seeds/$target" ] && seeds+=(fuzz/seeds/"$target")
 # Small real LAS tiles join the seeds when the data is there.
 real=${TREELOBES_REAL_DATA:-$(cd .. && pwd)/shared/data}
 if [ "$target" = las ] && [ -d "$real" ]; then
   mkdir -p "$corpus-real"
   find "$real" -name '*.las' -size -8k 2>/dev/null | sort | head -40 | xargs -r cp -t "$corpus-real"
+  seeds+=("$corpus-real")
+fi
+# The LAZ target has no committed seeds: the real LAZ/COPC files under 64 kB are its seeds.
+if [ "$target" = laz ] && [ -d "$real" ]; then
+  mkdir -p "$corpus-real"
+  find "$real" -name '*.laz' -size -64k 2>/dev/null | sort | xargs -r cp -t "$corpus-real"
   seeds+=("$corpus-real")
 fi
 flags=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 -malloc_limit_mb=1024
