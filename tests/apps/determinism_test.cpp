@@ -58,7 +58,10 @@ private:
             " --out " + quoted(in / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
         run("lobes " + quoted(data / "palm_1.las") + " --out " + quoted(in / "lobes"));
         run("encode " + quoted(data / "birch_3_skeleton.ply") + " --resolution 5 --lods 3 --out " + quoted(in / "birch.dbf6"));
-        run("encode --forest " + quoted(data / "tile/skeletons") + " --resolution 5 --out " + quoted(in / "tile.forest"));
+        fs::create_directories(in / "skeletons");
+        for (const char* tree : {"birch_3", "lagerstroemia_2", "palm_1"})
+            fs::copy_file(data / (std::string(tree) + "_skeleton.ply"), in / "skeletons" / (std::string(tree) + ".ply"));
+        run("encode --forest " + quoted(in / "skeletons") + " --resolution 5 --out " + quoted(in / "tile.forest"));
     }
     static void run(const std::string& arguments) {
         const auto r = test::run_cli(arguments + " --log-level error");
@@ -80,13 +83,17 @@ const Command kCommands[] = {
     {"classify_predict", "classify predict {in}/model.json {in}/features.csv --out {out}/predictions.csv"},
     {"classify_evaluate", "classify evaluate {in}/clouds --features {in}/features.csv --splits 4 --max-rounds 20 --out {out}"},
     {"encode", "encode {data}/birch_3_skeleton.ply --resolution 5 --lods 3 --out {out}/birch.dbf6 --json"},
-    {"encode_forest", "encode --forest {data}/tile/skeletons --resolution 5 --lods 2 --out {out}/tile.forest --json"},
+    {"encode_forest", "encode --forest {in}/skeletons --resolution 5 --lods 2 --out {out}/tile.forest --json"},
     {"decode", "decode {in}/birch.dbf6 --lod 1 --out {out}/birch.ply --json"},
     {"decode_forest", "decode {in}/tile.forest --out {out}/trees --json"},
     {"lod", "lod --code 00080006000700087 --radii 9,8,4,6,3 --levels 3 --json"},
     {"decode_code", "decode-code --code 00080006000700087 --radii 9,8,4,6,3 --resolution 5 --internode-length 0.1 --out {out}/code.ply --json"},
     {"multires", "multires {src}/lsystem/examples/stochastic_bush.lsys --out {out} --all --json"},
     {"render", "render {data}/palm_1.las {data}/palm_1_skeleton.ply --out {out}/preview.png"},
+    {"convert", "convert {data}/palm_1.las --out {out}/palm_1.ply --json"},
+    {"tile", "tile {data}/tile/tile.las --out {out}/tile --json"},
+    {"export_glb", "export {data}/birch_3_skeleton.ply --format glb --out {out}/birch.glb --json"},
+    {"export_qsm", "export {data}/birch_3_skeleton.ply --format qsm-csv --out {out}/birch.csv --json"},
 };
 
 std::string replaced(std::string text, const std::string& key, const std::string& value) {
