@@ -1,6 +1,6 @@
 #include "export/tree_measures.hpp"
 
-#include "export/convex_hull.hpp"
+#include "geometry/convex_hull.hpp"
 #include "export/qsm.hpp"
 
 #include <algorithm>
