@@ -1,4 +1,4 @@
-// Every subcommand gives byte-identical outputs with --threads 1 and --threads 2: each row of
+// Every subcommand gives byte-identical outputs with --threads 1 and --threads 2 (and another heap layout): each row of
 // the table runs twice into two folders, and every file (and the --json summary on stdout) is
 // compared. JSON summaries are compared without their timing and memory fields (the only
 // values allowed to differ, DESIGN.md "summary.json") and without the thread count; the one
@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -173,6 +174,24 @@ std::string comparable_stdout(const std::string& out, const std::string& folder)
 
 class Determinism : public testing::TestWithParam<Command> {};
 
+// Moves the second run's allocations elsewhere (no thread cache, small mmap threshold, a padded
+// heap top), so that output depending on where objects sit in memory (pointer-keyed sets, CGAL
+// handles) differs between the runs and is caught.
+class HeapLayout {
+public:
+    explicit HeapLayout(bool perturbed) : perturbed_(perturbed) {
+        if (perturbed_) setenv("GLIBC_TUNABLES", "glibc.malloc.tcache_count=0:glibc.malloc.mmap_threshold=4096:glibc.malloc.top_pad=1000000", 1);
+    }
+    ~HeapLayout() {
+        if (perturbed_) unsetenv("GLIBC_TUNABLES");
+    }
+    HeapLayout(const HeapLayout&) = delete;
+    HeapLayout& operator=(const HeapLayout&) = delete;
+
+private:
+    bool perturbed_;
+};
+
 }  // namespace
 
 TEST_P(Determinism, OneAndTwoThreadsGiveIdenticalOutputs) {
@@ -188,6 +207,7 @@ TEST_P(Determinism, OneAndTwoThreadsGiveIdenticalOutputs) {
         arguments = replaced(arguments, "{src}", test::source_dir().string());
         arguments = replaced(arguments, "{out}", folder.string());
         if (arguments.find(folder.string() + "/") != std::string::npos) fs::create_directories(folder);
+        const HeapLayout layout(threads == 2);
         const auto r = test::run_cli(arguments + " --threads " + std::to_string(threads) + " --log-level error");
         ASSERT_EQ(r.exit_code, 0) << "treelobes " << arguments << "\n" << r.err;
         files[threads - 1] = outputs_of(folder);
