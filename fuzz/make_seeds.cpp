@@ -72,18 +72,18 @@ void skeleton_and_mesh_seeds(const fs::path& source, const fs::path& out) {
     const TreeGraph small = first_nodes(palm, 40);
     write_skeleton_ply(small, out / "skeleton_ply/palm_binary.ply", true);
     write_skeleton_ply(small, out / "skeleton_ply/palm_ascii.ply", false);
-    const TriangleMesh palm = read_mesh(source / "data/synthetic/palm_1_mesh.ply");
+    const TriangleMesh palm_mesh = read_mesh(source / "data/synthetic/palm_1_mesh.ply");
     // The first 60 faces with the vertices they use, renumbered.
     TriangleMesh mesh;
-    mesh.origin = palm.origin;
-    std::vector<int> index(palm.vertices.size(), -1);
-    for (std::size_t f = 0; f < std::min<std::size_t>(palm.faces.size(), 60); ++f) {
+    mesh.origin = palm_mesh.origin;
+    std::vector<int> index(palm_mesh.vertices.size(), -1);
+    for (std::size_t f = 0; f < std::min<std::size_t>(palm_mesh.faces.size(), 60); ++f) {
         std::array<int, 3> face{};
         for (int k = 0; k < 3; ++k) {
-            int& i = index[static_cast<std::size_t>(palm.faces[f][k])];
+            int& i = index[static_cast<std::size_t>(palm_mesh.faces[f][k])];
             if (i < 0) {
                 i = static_cast<int>(mesh.vertices.size());
-                mesh.vertices.push_back(palm.vertices[static_cast<std::size_t>(palm.faces[f][k])]);
+                mesh.vertices.push_back(palm_mesh.vertices[static_cast<std::size_t>(palm_mesh.faces[f][k])]);
             }
             face[k] = i;
         }
