@@ -247,7 +247,7 @@ BufferPlan plan_buffer(const TileCliOptions& o) {
 void check_tile_memory(const TileCliOptions& o, const BufferPlan& plan) {
     const double budget = o.max_memory.empty() ? default_memory_budget_bytes() : parse_memory_size(o.max_memory);
     std::size_t points = header_point_count(o.input);
-    if (plan.core) points += survey::estimate_buffer_points(o.input, *plan.core, o.buffer, plan.candidates);
+    if (o.buffer > 0) points += survey::estimate_buffer_points(o.input, plan.core, o.buffer, plan.candidates);
     if (const auto refusal = memory_refusal(points, kTileBytesPerPoint, budget)) throw Error::input(o.input, *refusal);
 }
 

@@ -68,17 +68,18 @@ Box3d buffered_box(const TileCore& core, double buffer) {
     return {{core.min_x - buffer, core.min_y - buffer, -inf}, {core.max_x + buffer, core.max_y + buffer, inf}};
 }
 
-std::size_t estimate_buffer_points(const fs::path& input, const TileCore& core, double buffer, const std::vector<fs::path>& candidates) {
-    const Box3d box = buffered_box(core, buffer);
+std::size_t estimate_buffer_points(const fs::path& input, const std::optional<TileCore>& core, double buffer,
+                                   const std::vector<fs::path>& candidates) {
     double points = 0;
     for (const fs::path& neighbour : candidates) {
         if (same_file(neighbour, input)) continue;
         const auto count = static_cast<double>(header_point_count(neighbour));
         const auto bounds = header_bounds(neighbour);
-        if (!bounds) {
+        if (!bounds || !core) {
             points += count;
             continue;
         }
+        const Box3d box = buffered_box(*core, buffer);
         const Eigen::Vector2d lo = bounds->min.head<2>().cwiseMax(box.min.head<2>()), hi = bounds->max.head<2>().cwiseMin(box.max.head<2>());
         if ((lo.array() > hi.array()).any()) continue;
         const Eigen::Vector2d extent = bounds->max.head<2>() - bounds->min.head<2>();

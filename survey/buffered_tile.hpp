@@ -49,8 +49,9 @@ BufferedTile add_buffer(PointCloud tile, const std::filesystem::path& input, con
 
 // Points the buffer will add, from the headers only (for the memory estimate): for each
 // candidate but the input whose header bounds meet the buffered box, its point count times the
-// share of its bounds' area inside the box; the whole count for a file without header bounds.
-std::size_t estimate_buffer_points(const std::filesystem::path& input, const TileCore& core, double buffer,
+// share of its bounds' area inside the box; the whole count for a file without header bounds,
+// and for every candidate when the core is not known before reading (an input without header bounds).
+std::size_t estimate_buffer_points(const std::filesystem::path& input, const std::optional<TileCore>& core, double buffer,
                                    const std::vector<std::filesystem::path>& candidates);
 
 // The box of original coordinates a buffered tile covers: the core grown by `buffer` in x and y,
