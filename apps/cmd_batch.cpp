@@ -4,15 +4,16 @@
 // each other (docs/survey.md). Each tile runs in this process through the `tile` subcommand
 // itself, with its own error boundary: a bad tile is listed in failures.jsonl and the batch goes
 // on. A tile's folder is finished when its completion marker exists (written last, atomically);
-// a re-run skips finished tiles and redoes partial ones from scratch.
+// a re-run skips finished tiles and redoes partial ones from scratch. With --buffer, a tile's
+// neighbours are the other tiles of the batch (all shards') unless --neighbours names others.
 #include "apps/command.hpp"
 #include "apps/summary_values.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/memory_limit.hpp"
 #include "core/version.hpp"
 #include "survey/completion.hpp"
-#include "survey/memory_estimate.hpp"
 #include "survey/tile_list.hpp"
 
 #include <nlohmann/json.hpp>
@@ -41,6 +42,30 @@ struct BatchCliOptions {
     bool overwrite = false;
     std::vector<std::string> tile_arguments;  // passed on to every `tile` run
 };
+
+bool has_option(const std::vector<std::string>& arguments, const std::string& name) {
+    return std::any_of(arguments.begin(), arguments.end(),
+                       [&](const std::string& a) { return a == name || a.rfind(name + "=", 0) == 0; });
+}
+
+// The tile options of every run: the user's, and with --buffer the batch's tiles as neighbours.
+std::vector<std::string> tile_arguments_of(const BatchCliOptions& o) {
+    std::vector<std::string> arguments = o.tile_arguments;
+    if (has_option(arguments, "--buffer") && !has_option(arguments, "--neighbours")) {
+        arguments.push_back("--neighbours");
+        arguments.push_back(o.source);
+    }
+    return arguments;
+}
+
+// The memory budget is the tile's own check (before it reads anything); not part of the key.
+std::vector<std::string> with_memory_budget(std::vector<std::string> arguments, const BatchCliOptions& o) {
+    if (!o.max_memory.empty()) {
+        arguments.push_back("--max-memory");
+        arguments.push_back(o.max_memory);
+    }
+    return arguments;
+}
 
 // Parses `tile <input> --out <dir> <tile arguments>` the way the CLI does and returns its job.
 // The tile's global options: this process's threads, and its summary as JSON (swallowed below)
@@ -109,11 +134,10 @@ struct TileResult {
     std::string reason;  // of a failed tile
 };
 
-// One tile inside its error boundary: refused when its header says it would not fit, else run.
-TileResult process_tile(const fs::path& input, const fs::path& dir, const BatchCliOptions& o, double budget, const GlobalOptions& global) {
+// One tile inside its error boundary (the tile refuses itself when its header says it would not fit).
+TileResult process_tile(const fs::path& input, const fs::path& dir, const std::vector<std::string>& arguments, const GlobalOptions& global) {
     try {
-        if (const auto refusal = survey::refuse_if_too_big(input, budget)) return {static_cast<int>(ExitCode::InvalidInput), *refusal};
-        return {run_one_tile(input, dir, o.tile_arguments, global), {}};
+        return {run_one_tile(input, dir, arguments, global), {}};
     } catch (const Error& e) {
         return {static_cast<int>(e.code()), e.what()};
     } catch (const std::bad_alloc&) {
@@ -125,12 +149,14 @@ TileResult process_tile(const fs::path& input, const fs::path& dir, const BatchC
 
 int run_batch(BatchCliOptions& o, const GlobalOptions& global) {
     const survey::Shard shard = o.shard.empty() ? survey::Shard{} : survey::parse_shard(o.shard);
-    const double budget = o.max_memory.empty() ? survey::default_memory_budget_bytes() : survey::parse_memory_size(o.max_memory);
+    if (!o.max_memory.empty()) parse_memory_size(o.max_memory);  // a bad size is a usage error before any tile runs
+    const std::vector<std::string> key_arguments = tile_arguments_of(o);
+    const std::vector<std::string> run_arguments = with_memory_budget(key_arguments, o);
     const std::vector<fs::path> all = survey::list_tiles(o.source);
     const std::vector<fs::path> tiles = survey::shard_tiles(all, shard);
     {
         CLI::App check;  // tile options are checked once, before any tile runs
-        tile_job(check, global, all.front(), fs::path(o.out) / survey::tile_name(all.front()), o.tile_arguments);
+        tile_job(check, global, all.front(), fs::path(o.out) / survey::tile_name(all.front()), run_arguments);
     }
     std::error_code ec;
     fs::create_directories(o.out, ec);
@@ -143,14 +169,14 @@ int run_batch(BatchCliOptions& o, const GlobalOptions& global) {
     for (const fs::path& input : tiles) {
         const std::string name = survey::tile_name(input);
         const fs::path dir = fs::path(o.out) / name;
-        const std::string key = completion_key(input, o.tile_arguments);
+        const std::string key = completion_key(input, key_arguments);
         if (!o.overwrite && survey::is_complete(dir, key)) {
             ++skipped;
             progress.advance();
             continue;
         }
         fs::remove_all(dir, ec);  // a partial folder (killed, failed, other options) is redone from scratch
-        const TileResult result = process_tile(input, dir, o, budget, global);
+        const TileResult result = process_tile(input, dir, run_arguments, global);
         if (result.exit_code == 0 || result.exit_code == static_cast<int>(ExitCode::PartialFailure)) {
             survey::mark_complete(dir, key, result.exit_code);
             ++done;
@@ -200,7 +226,7 @@ void add_batch_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("--out", o->out, "Output folder: one subfolder per tile, named after the tile's file")->required();
     sub->add_option("--shard", o->shard, "Run only shard i of n (0 <= i < n): every n-th tile of the sorted list, starting at i");
     sub->add_option("--max-memory", o->max_memory,
-                    "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM)");
+                    "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM); passed to every `tile` run");
     sub->add_flag("--overwrite", o->overwrite, "Redo tiles that an earlier run finished");
     sub->allow_extras();
     sub->fallthrough(false);  // unknown options are the tile's, not the main command's

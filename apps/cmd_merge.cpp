@@ -30,6 +30,8 @@ int run_merge(const MergeCliOptions& o, const GlobalOptions& global) {
     const survey::TileFolders folders = survey::find_tile_folders(dirs);
     for (const std::string& name : folders.incomplete) log_warn("tile " + name + " is not finished (no completion marker): left out");
     const survey::MergedSurvey merged = survey::merge_tiles(folders);
+    for (const std::string& duplicate : merged.duplicated_ids)
+        log_warn("tree " + duplicate + ": one tree modelled by two tiles; run the tiles with --buffer so that each tree belongs to one");
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");

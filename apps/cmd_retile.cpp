@@ -2,8 +2,9 @@
 // square LAS 1.4 tiles named by their lower-left corner, so a survey delivered as a few huge
 // files can be run by `treelobes batch` (docs/survey.md).
 #include "apps/command.hpp"
+#include "core/cloud_header.hpp"
 #include "core/error.hpp"
-#include "survey/memory_estimate.hpp"
+#include "core/memory_limit.hpp"
 #include "survey/retile.hpp"
 
 #include <nlohmann/json.hpp>
@@ -27,10 +28,10 @@ struct RetileCliOptions {
 };
 
 int run_retile(const RetileCliOptions& o, const GlobalOptions& global) {
-    const double budget = o.max_memory.empty() ? survey::default_memory_budget_bytes() : survey::parse_memory_size(o.max_memory);
+    const double budget = o.max_memory.empty() ? default_memory_budget_bytes() : parse_memory_size(o.max_memory);
     std::size_t points = 0;
-    for (const std::string& input : o.inputs) points += survey::header_point_count(input);
-    if (const auto refusal = survey::memory_refusal(points, survey::kRetileBytesPerPoint, budget))
+    for (const std::string& input : o.inputs) points += header_point_count(input);
+    if (const auto refusal = memory_refusal(points, kRetileBytesPerPoint, budget))
         throw Error::input(o.inputs.front(), "retile: the inputs' " + *refusal);
     const std::vector<fs::path> inputs(o.inputs.begin(), o.inputs.end());
     const auto tiles = survey::retile(inputs, o.retile, o.out);

@@ -3,14 +3,18 @@
 // pipeline (forestry/tree_pipeline.hpp: skeleton, lobes, DBF6, measures, species) in its own
 // error boundary, then the tile's tables, points, forest file and pictures (docs/tile.md).
 // Finished outputs are kept on a re-run unless --overwrite (trees whose record and files exist
-// are read back instead of made again).
+// are read back instead of made again). With --buffer the neighbouring tiles' points within the
+// buffer are read too, and the tile keeps the trees whose stem base lies in its core
+// (survey/buffered_tile.hpp); every tree gets a survey-wide id from its base (survey/tree_id.hpp).
 #include "apps/command.hpp"
 #include "apps/summary_values.hpp"
 #include "classify/jointboost.hpp"
 #include "core/atomic_file.hpp"
+#include "core/cloud_header.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/memory_limit.hpp"
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
@@ -20,6 +24,9 @@
 #include "render/tile_map.hpp"
 #include "segment/segment_trees.hpp"
 #include "segment/terrain.hpp"
+#include "survey/buffered_tile.hpp"
+#include "survey/tile_list.hpp"
+#include "survey/tree_id.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -32,7 +39,10 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <numeric>
 #include <optional>
+#include <set>
+#include <tuple>
 
 namespace fs = std::filesystem;
 
@@ -56,6 +66,10 @@ struct TileCliOptions {
     forestry::TreePipelineOptions trees;
     std::string outlier_test = "auto";
     int map_px = 1600;
+    double buffer = 0;        // metres; 0 = no buffer
+    std::string neighbours;   // LIST|DIR|GLOB; empty = the input's folder
+    double tile_size = 0;     // a retile square's side: the core from the name; 0 = from the header
+    std::string max_memory;   // empty = default_memory_budget_bytes()
 };
 
 // Names of the outputs in DIR (docs/tile.md).
@@ -112,6 +126,8 @@ json options_json(const TileCliOptions& o, const TreeSegmentation& segmentation)
             {"min_tree_height", o.segment.min_tree_height},
             {"vote_radius", o.voting.radius_m},
             {"vote_confidence", o.voting.confidence_factor},
+            {"buffer", o.buffer},
+            {"tile_size", o.tile_size},
             {"trees", tree_options_json(o)}};
 }
 
@@ -209,6 +225,87 @@ std::string dbh_counts(const std::vector<forestry::TreeRow>& rows, json& counts)
            std::to_string(by_quality["not_visible"]) + " not visible";
 }
 
+// The tile's buffer plan: its core and the files that may hold its buffer points.
+struct BufferPlan {
+    std::optional<survey::TileCore> core;  // from the retile name or the header; else from the points once read
+    std::vector<fs::path> candidates;
+};
+
+BufferPlan plan_buffer(const TileCliOptions& o) {
+    if (o.buffer <= 0) {
+        if (!o.neighbours.empty() || o.tile_size > 0) throw Error::usage("--neighbours and --tile-size go with --buffer METRES");
+        return {};
+    }
+    BufferPlan plan;
+    plan.core = o.tile_size > 0 ? survey::core_from_retile_name(o.input, o.tile_size) : survey::core_from_header(o.input);
+    const fs::path folder = fs::path(o.input).parent_path();
+    plan.candidates = survey::list_tiles(o.neighbours.empty() ? (folder.empty() ? std::string(".") : folder.string()) : o.neighbours);
+    return plan;
+}
+
+// Refuses the tile before it is read when its points (and its buffer's) would not fit in --max-memory.
+void check_tile_memory(const TileCliOptions& o, const BufferPlan& plan) {
+    const double budget = o.max_memory.empty() ? default_memory_budget_bytes() : parse_memory_size(o.max_memory);
+    std::size_t points = header_point_count(o.input);
+    if (o.buffer > 0) points += survey::estimate_buffer_points(o.input, plan.core, o.buffer, plan.candidates);
+    if (const auto refusal = memory_refusal(points, kTileBytesPerPoint, budget)) throw Error::input(o.input, *refusal);
+}
+
+// Keeps the trees whose stem base lies in the core; the others (their base in the buffer) are
+// the neighbours' and lose their ids here. Returns how many were dropped.
+std::size_t keep_core_trees(std::vector<forestry::TreeInput>& trees, std::vector<std::int32_t>& tree_id, const survey::TileCore& core,
+                            const Eigen::Vector3d& origin) {
+    std::set<std::int32_t> dropped;
+    std::vector<forestry::TreeInput> kept;
+    for (forestry::TreeInput& tree : trees) {
+        const Eigen::Vector3d base = origin + tree.base;
+        if (core.holds(base.x(), base.y())) kept.push_back(std::move(tree));
+        else dropped.insert(tree.id);
+    }
+    trees = std::move(kept);
+    for (std::int32_t& id : tree_id)
+        if (dropped.count(id)) id = 0;
+    return dropped.size();
+}
+
+// A tree's points in the order of their coordinates (x, then y, then z), so that its model does
+// not depend on where its points sat in the file: a tree read whole from a buffer (its points
+// from several files) is modelled as in one file.
+void order_points_by_position(forestry::TreeInput& tree) {
+    std::vector<std::size_t> order(tree.points.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    const auto& p = tree.points.positions;
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return std::make_tuple(p[a].x(), p[a].y(), p[a].z()) < std::make_tuple(p[b].x(), p[b].y(), p[b].z());
+    });
+    std::vector<float> heights(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) heights[k] = tree.height_above_ground[order[k]];
+    tree.points = tree.points.subset(order);
+    tree.height_above_ground = std::move(heights);
+}
+
+// Survey-wide ids of the trees (by tile tree id), from their stem bases.
+std::map<int, std::string> survey_ids(const std::vector<forestry::TreeInput>& trees, const Eigen::Vector3d& origin) {
+    std::vector<Eigen::Vector3d> bases;
+    for (const auto& tree : trees) bases.push_back(origin + tree.base);
+    const std::vector<std::string> ids = survey::stable_tree_ids(bases);
+    std::map<int, std::string> by_tree;
+    for (std::size_t i = 0; i < trees.size(); ++i) by_tree[trees[i].id] = ids[i];
+    return by_tree;
+}
+
+json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::BufferedTile& buffered) {
+    if (!plan.core) return nullptr;
+    json read = json::array();
+    for (const fs::path& file : buffered.neighbours_read) read.push_back(file.filename().string());
+    const survey::TileCore& c = *plan.core;
+    return {{"metres", o.buffer},
+            {"core", {{"min_x", c.min_x}, {"min_y", c.min_y}, {"max_x", c.max_x}, {"max_y", c.max_y}, {"from", c.source},
+                      {"half_open", c.half_open}}},
+            {"neighbours_read", read},
+            {"neighbours_skipped", buffered.neighbours_skipped}};
+}
+
 int run_tile(TileCliOptions& o, const GlobalOptions& global) {
     const auto start = Clock::now();
     auto mark = start;
@@ -221,14 +318,23 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
         model = classify::load_jointboost(o.model);
         o.trees.model = &*model;
     }
+    BufferPlan plan = plan_buffer(o);
+    check_tile_memory(o, plan);
     const TileOutputs out(o.out);
     std::error_code ec;
     fs::create_directories(out.trees, ec);
     if (!fs::is_directory(out.trees)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
 
-    const PointCloud cloud = read_point_cloud(o.input);
-    if (cloud.empty()) throw Error::input(o.input, "the tile holds no points");
-    if (cloud.georef.empty()) log_warn(o.input + ": no CRS in the input; outputs keep its coordinates without one");
+    survey::BufferedTile buffered;
+    buffered.cloud = read_point_cloud(o.input);
+    if (buffered.cloud.empty()) throw Error::input(o.input, "the tile holds no points");
+    if (buffered.cloud.georef.empty()) log_warn(o.input + ": no CRS in the input; outputs keep its coordinates without one");
+    buffered.own_points = buffered.cloud.size();
+    if (o.buffer > 0) {
+        if (!plan.core) plan.core = survey::core_from_points(buffered.cloud);
+        buffered = survey::add_buffer(std::move(buffered.cloud), o.input, *plan.core, o.buffer, plan.candidates);
+    }
+    const PointCloud& cloud = buffered.cloud;
     seconds["read"] = rounded(seconds_since(mark));
 
     const Terrain terrain = analyse_terrain(cloud, o.terrain);
@@ -242,6 +348,9 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
         for (const auto& tree : segmentation.trees) bases[tree.id] = tree.base.cast<double>();
     }
     std::vector<forestry::TreeInput> trees = forestry::split_trees(cloud, segmentation.tree_id, terrain.height_above_ground, bases);
+    const std::size_t trees_in_buffer = plan.core ? keep_core_trees(trees, segmentation.tree_id, *plan.core, cloud.origin) : 0;
+    const std::map<int, std::string> global_ids = survey_ids(trees, cloud.origin);
+    for (forestry::TreeInput& tree : trees) order_points_by_position(tree);
     seconds["segmentation"] = rounded(seconds_since(mark));
     if (trees.empty()) log_warn(o.input + ": no trees found (" + std::to_string(terrain.ground_points) + " of " + std::to_string(cloud.size()) +
                                 " points are ground); the outputs list none");
@@ -298,7 +407,7 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
             continue;
         }
         row_of[i] = rows.size();
-        rows.push_back({outcome.measures, {}, std::nullopt, lobe_counts[i]});
+        rows.push_back({outcome.measures, {}, std::nullopt, lobe_counts[i], global_ids.at(outcome.id)});
         stems.push_back({outcome.id, outcome.measures.position});
         encode::ForestTree placed;
         placed.skeleton = outcome.skeleton;
@@ -316,7 +425,14 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
 
     // Tile outputs.
     write_output(out.points, o.overwrite, [&] {
-        write_las(labelled_points(cloud, terrain, segmentation.tree_id, !o.use_input_segmentation), out.points);
+        const PointCloud labelled = labelled_points(cloud, terrain, segmentation.tree_id, !o.use_input_segmentation);
+        if (labelled.size() == buffered.own_points) {
+            write_las(labelled, out.points);
+        } else {  // the tile's own points only: the buffer's are its neighbours'
+            std::vector<std::size_t> own(buffered.own_points);
+            std::iota(own.begin(), own.end(), std::size_t{0});
+            write_las(labelled.subset(own), out.points);
+        }
     });
     write_file_atomically(out.csv, forestry::trees_csv(rows, cloud.origin));
     write_file_atomically(out.geojson, forestry::trees_geojson(rows, cloud.origin, cloud.georef.crs_wkt));
@@ -348,7 +464,9 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
         {"input", o.input},
         {"out", o.out},
         {"options", options},
-        {"counts", {{"points", cloud.size()}, {"non_finite_dropped", cloud.source.dropped_non_finite},
+        {"buffer", buffer_json(o, plan, buffered)},
+        {"counts", {{"points", buffered.own_points}, {"buffer_points", cloud.size() - buffered.own_points},
+                    {"non_finite_dropped", cloud.source.dropped_non_finite}, {"trees_in_buffer", trees_in_buffer},
                     {"ground_points", terrain.ground_points}, {"ground_source", terrain.ground_source},
                     {"tree_points", tree_points}, {"trees_found", outcomes.size()}, {"trees", rows.size()},
                     {"trees_reused", reused}, {"trees_failed", failures.size()}, {"dbh", dbh}}},
@@ -407,6 +525,10 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
         ->check(CLI::Range(1.0, 64.0))->capture_default_str();
     sub->add_option("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16))->capture_default_str();
     sub->add_option("--map-size", o->map_px, "Longer side of top_view.png, pixels")->check(CLI::Range(200, 20000))->capture_default_str();
+    sub->add_option("--buffer", o->buffer, "Also read the neighbouring tiles' points within this many metres of the tile's core; the tile keeps the trees whose stem base lies in its core (docs/survey.md)")->check(NonNegativeNumber);
+    sub->add_option("--neighbours", o->neighbours, "With --buffer: the neighbouring tiles, a folder, a quoted pattern or a list file (default: the tile's folder)");
+    sub->add_option("--tile-size", o->tile_size, "With --buffer: the tile is a `retile` square of this side, its core [x, x+size) x [y, y+size) from its name <prefix>_<x>_<y> (default: the header's bounds)")->check(PositiveNumber);
+    sub->add_option("--max-memory", o->max_memory, "Refuse the tile before reading it when its header point count (buffer included) needs more memory than this (e.g. 8G; default: half of the RAM)");
     sub->add_flag("--overwrite", o->overwrite, "Redo outputs and trees that exist from an earlier run");
     sub->callback([o, &global, &job] { job = [o, &global] { return run_tile(*o, global); }; });
 }

@@ -4,10 +4,10 @@
 
 #include <unistd.h>
 
-#include <charconv>
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <string_view>
 
 namespace treelobes {
 namespace {
@@ -18,42 +18,61 @@ std::uint64_t physical_memory() {
     return static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page_size);
 }
 
-// "512M" -> 536870912; throws Error(Usage) naming the variable for anything else.
-std::uint64_t parse_byte_count(std::string_view text) {
-    std::uint64_t value = 0;
-    const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-    const std::string_view suffix(end, static_cast<std::size_t>(text.data() + text.size() - end));
-    int shift = -1;
-    if (suffix.empty()) shift = 0;
-    else if (suffix == "K" || suffix == "k") shift = 10;
-    else if (suffix == "M" || suffix == "m") shift = 20;
-    else if (suffix == "G" || suffix == "g") shift = 30;
-    if (error != std::errc() || end == text.data() || shift < 0 || value > (UINT64_MAX >> shift))
-        throw Error::usage("TREELOBES_MAX_MEMORY='" + std::string(text) + "' is not a byte count such as 4G, 512M or 1000000");
-    return value << shift;
-}
-
-std::string gibibytes(std::uint64_t bytes) {
+std::string gibibytes(double bytes) {
     char text[32];
-    std::snprintf(text, sizeof text, "%.3g GiB", static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0));
+    std::snprintf(text, sizeof text, "%.3g GiB", bytes / (1024.0 * 1024.0 * 1024.0));
     return text;
 }
 
 }  // namespace
 
+double parse_memory_size(const std::string& text, const std::string& setting) {
+    double value = 0;
+    char unit = 0;
+    char rest = 0;
+    const int fields = std::sscanf(text.c_str(), "%lf%c%c", &value, &unit, &rest);
+    double factor = 1;
+    if (fields == 2) {
+        switch (unit) {
+            case 'k': case 'K': factor = 1024.0; break;
+            case 'm': case 'M': factor = 1024.0 * 1024; break;
+            case 'g': case 'G': factor = 1024.0 * 1024 * 1024; break;
+            case 't': case 'T': factor = 1024.0 * 1024 * 1024 * 1024; break;
+            default: factor = 0;
+        }
+    }
+    if (fields < 1 || fields > 2 || factor == 0 || !std::isfinite(value) || value <= 0 || value * factor > 1.8e19)
+        throw Error::usage(setting + " '" + text + "': expected a size such as 512M, 8G or a number of bytes");
+    return value * factor;
+}
+
 std::uint64_t memory_limit() {
     std::uint64_t limit = physical_memory();
-    if (const char* env = std::getenv("TREELOBES_MAX_MEMORY"); env && *env) limit = std::min(limit, parse_byte_count(env));
+    if (const char* env = std::getenv("TREELOBES_MAX_MEMORY"); env && *env)
+        limit = std::min(limit, static_cast<std::uint64_t>(parse_memory_size(env, "TREELOBES_MAX_MEMORY")));
     return limit;
 }
+
+double default_memory_budget_bytes() { return 0.5 * static_cast<double>(memory_limit()); }
 
 void check_memory_estimate(std::uint64_t bytes, const std::string& file, const std::string& what) {
     const std::uint64_t limit = memory_limit();
     if (bytes <= limit) return;
     const bool capped = std::getenv("TREELOBES_MAX_MEMORY") && limit < physical_memory();
-    throw Error::input(file, what + " needs about " + gibibytes(bytes) + " of memory, more than the " + gibibytes(limit) +
-                                 (capped ? " TREELOBES_MAX_MEMORY allows" : " this machine has") +
-                                 "; split the file into tiles (e.g. `pdal tile`) or thin it first");
+    throw Error::input(file, what + " needs about " + gibibytes(static_cast<double>(bytes)) + " of memory, more than the " +
+                                 gibibytes(static_cast<double>(limit)) + (capped ? " TREELOBES_MAX_MEMORY allows" : " this machine has") +
+                                 "; split the file into tiles (`treelobes retile --size METRES`) or thin it first");
+}
+
+std::optional<std::string> memory_refusal(std::size_t points, double bytes_per_point, double budget_bytes) {
+    const double estimate = static_cast<double>(points) * bytes_per_point;
+    if (estimate <= budget_bytes) return std::nullopt;
+    char message[512];
+    std::snprintf(message, sizeof message,
+                  "%zu points need about %.1f GiB (%.0f bytes per point), more than the memory budget of %.1f GiB: "
+                  "cut it with `treelobes retile --size METRES` into smaller tiles, or raise --max-memory",
+                  points, estimate / (1024.0 * 1024 * 1024), bytes_per_point, budget_bytes / (1024.0 * 1024 * 1024));
+    return std::string(message);
 }
 
 }  // namespace treelobes

@@ -49,7 +49,8 @@ DbhQuality parse_quality(const std::string& name) {
 // The values a user reads, rounded for the tables (the record keeps full precision).
 json row_properties(const TreeRow& row, const Eigen::Vector3d& origin) {
     const TreeMeasures& m = row.measures;
-    return {{"tree_id", m.id},
+    return {{"global_id", row.global_id},
+            {"tree_id", m.id},
             {"height_m", value_or_null(m.height, 2)},
             {"dbh_m", value_or_null(m.dbh.diameter, 3)},
             {"dbh_quality", dbh_quality_name(m.dbh.quality)},
@@ -125,12 +126,12 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
 
 std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin) {
     std::string csv =
-        "tree_id,x,y,z,height_m,dbh_m,dbh_quality,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
+        "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
         "woody_volume_m3,species,species_confidence,points,lobes\n";
     for (const TreeRow& row : rows) {
         const TreeMeasures& m = row.measures;
         const Eigen::Vector3d p = origin + m.position;
-        csv += std::to_string(m.id) + "," + fixed(p.x(), 3) + "," + fixed(p.y(), 3) + "," + fixed(p.z(), 3) + "," + fixed(m.height, 2) +
+        csv += row.global_id + "," + std::to_string(m.id) + "," + fixed(p.x(), 3) + "," + fixed(p.y(), 3) + "," + fixed(p.z(), 3) + "," + fixed(m.height, 2) +
                "," + cell(m.dbh.diameter, 3) + "," + dbh_quality_name(m.dbh.quality) + "," + cell(m.crown.base_height, 2) + "," +
                cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," + cell(m.crown.volume, 2) + "," +
                fixed(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," + std::to_string(m.points) +

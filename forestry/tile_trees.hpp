@@ -35,9 +35,10 @@ struct TreeRow {
     std::string species;                      // voted species; empty without a model
     std::optional<double> species_confidence; // the tree's own probability of that species
     std::size_t lobes = 0;
+    std::string global_id;                    // the tree's id across a survey (from its stem base; set by the caller)
 };
 
-// trees.csv: header then one row per tree; global coordinates (origin added) to the millimetre;
+// trees.csv: header then one row per tree (global_id first, then the tile's tree_id); global coordinates (origin added) to the millimetre;
 // measures that are not available are empty cells. docs/tile.md lists the columns.
 std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin);
 // trees.geojson: a FeatureCollection of points (x, y, z in the tile's CRS) with the csv's values

@@ -28,7 +28,7 @@ echo
 echo "trees found (from $OUT/tile/trees.csv; heights in metres above the ground; an airborne scan"
 echo "does not see stems, so DBH is 'not_visible' rather than guessed):"
 awk -F, 'NR == 1 { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", "tree", "x", "y", "height", "DBH", "crown_d", "crown_m3", "wood_m3", "points"; next }
-         { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $1, $2, $3, $5, ($6 == "" ? $7 : $6 " m"), $9, $11, $12, $15 }' \
+         { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $2, $3, $4, $6, ($7 == "" ? $8 : $7 " m"), $10, $12, $13, $16 }' \
     "$OUT/tile/trees.csv"
 echo "$(($(wc -l <"$OUT/tile/trees.csv") - 1)) trees modelled; the tile holds $(($(wc -l <"$SAMPLE/tile/truth.csv") - 1)) true trees ($SAMPLE/tile/truth.csv)"
 if [[ -f "$OUT/tile/failures.jsonl" ]]; then

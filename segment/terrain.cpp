@@ -17,6 +17,8 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <numeric>
+#include <tuple>
 
 namespace treelobes {
 
@@ -163,8 +165,25 @@ void fill_empty_cells(DtmGrid& grid) {
     for (std::size_t c = 0; c < grid.heights.size(); ++c) {
         if (std::isfinite(grid.heights[c])) continue;
         const Eigen::Vector2f xy = cell_centre(grid, c);
-        index.knn(Eigen::Vector3f(xy.x(), xy.y(), 0.0f), kNeighbours, near, squared);
-        grid.heights[c] = interpolate_from_neighbours(xy, known, values, near, squared);
+        const Eigen::Vector3f query(xy.x(), xy.y(), 0.0f);
+        index.knn(query, kNeighbours, near, squared);
+        // On a grid many cells lie at the same distance: take every cell as near as the k-th and
+        // order them by distance, then position, so that the height does not depend on how the
+        // index broke ties (another tile extent, the same ground, gives the same DTM).
+        index.radius_search(query, std::sqrt(squared.back()) * 1.0001f + 1e-6f, near, squared);
+        std::vector<std::size_t> order(near.size());
+        std::iota(order.begin(), order.end(), std::size_t{0});
+        std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+            const Eigen::Vector3f &pa = known[static_cast<std::size_t>(near[a])], &pb = known[static_cast<std::size_t>(near[b])];
+            return std::make_tuple(squared[a], pa.x(), pa.y()) < std::make_tuple(squared[b], pb.x(), pb.y());
+        });
+        std::vector<int> sorted_near;
+        std::vector<float> sorted_squared;
+        for (std::size_t k : order) {
+            sorted_near.push_back(near[k]);
+            sorted_squared.push_back(squared[k]);
+        }
+        grid.heights[c] = interpolate_from_neighbours(xy, known, values, sorted_near, sorted_squared);
     }
 }
 

@@ -71,26 +71,53 @@ void add_counts(json& into, const json& from) {
     }
 }
 
+// A merged tree's key: its survey-wide id, then its tile (the same id in two tiles is one tree
+// modelled twice, by tiles run without a buffer; both rows are kept and reported).
+using TreeKey = std::pair<std::string, std::string>;
+
 struct CsvRows {
-    std::string header;
-    std::map<std::string, std::string> rows;  // by global id
+    std::string header;                             // the tiles' header
+    std::map<TreeKey, std::string> rows;            // by global id and tile
+    std::map<TreeKey, std::string> global_of_tree;  // (tile, tile tree id) -> global id
 };
+
+constexpr const char* kGlobalIdColumn = "global_id,tree_id,";
 
 void add_csv(CsvRows& all, const fs::path& tile_dir) {
     const std::string tile = tile_of(tile_dir);
-    std::istringstream in(read_text(tile_dir / "trees.csv"));
+    const fs::path path = tile_dir / "trees.csv";
+    std::istringstream in(read_text(path));
     std::string header;
     std::getline(in, header);
+    if (header.rfind(kGlobalIdColumn, 0) != 0)
+        throw Error::input(path.string(), "no global_id column first (made by an older treelobes): run the tile again");
     if (all.header.empty()) all.header = header;
-    else if (header != all.header) throw Error::input((tile_dir / "trees.csv").string(), "its columns differ from the other tiles'");
+    else if (header != all.header) throw Error::input(path.string(), "its columns differ from the other tiles'");
     for (std::string line; std::getline(in, line);) {
         if (line.empty()) continue;
-        const std::string global = global_tree_id(tile, std::stol(line.substr(0, line.find(','))));
-        all.rows[global] = global + "," + tile + "," + line + "\n";
+        const std::size_t first = line.find(','), second = line.find(',', first + 1);
+        if (first == std::string::npos || second == std::string::npos || first == 0) throw Error::input(path.string(), "a row without its ids");
+        const std::string global = line.substr(0, first), tree = line.substr(first + 1, second - first - 1);
+        all.rows[{global, tile}] = global + "," + tile + line.substr(first) + "\n";
+        all.global_of_tree[{tile, tree}] = global;
     }
 }
 
-void add_features(std::map<std::string, json>& features, std::string& crs, const fs::path& tile_dir) {
+// The ids found in more than one tile, each with its tiles ("id in a, b").
+std::vector<std::string> duplicated_ids(const CsvRows& csv) {
+    std::map<std::string, std::vector<std::string>> tiles_of;
+    for (const auto& [key, row] : csv.rows) tiles_of[key.first].push_back(key.second);
+    std::vector<std::string> duplicated;
+    for (const auto& [id, tiles] : tiles_of) {
+        if (tiles.size() < 2) continue;
+        std::string text = id + " in";
+        for (std::size_t i = 0; i < tiles.size(); ++i) text += (i ? ", " : " ") + tiles[i];
+        duplicated.push_back(text);
+    }
+    return duplicated;
+}
+
+void add_features(std::map<TreeKey, json>& features, std::string& crs, const fs::path& tile_dir) {
     const std::string tile = tile_of(tile_dir);
     const json collection = read_json(tile_dir / "trees.geojson");
     const std::string tile_crs = collection.value("crs_wkt", std::string());
@@ -99,27 +126,29 @@ void add_features(std::map<std::string, json>& features, std::string& crs, const
         crs = tile_crs;
     }
     for (json feature : collection.at("features")) {
-        const std::string global = global_tree_id(tile, feature.at("properties").at("tree_id").get<long>());
-        feature["properties"]["global_id"] = global;
+        const std::string global = feature.at("properties").at("global_id").get<std::string>();
         feature["properties"]["tile"] = tile;
-        features[global] = std::move(feature);
+        features[{global, tile}] = std::move(feature);
     }
 }
 
 // The tile's forest trees, placed as `treelobes tile` places them (root at the position).
-void add_forest_trees(std::map<std::string, encode::ForestTree>& trees, const fs::path& tile_dir) {
+void add_forest_trees(std::map<TreeKey, encode::ForestTree>& trees, const CsvRows& csv, const fs::path& tile_dir) {
     const std::string tile = tile_of(tile_dir);
     const fs::path path = tile_dir / "tile.forest";
     encode::ForestReader reader(path);
     for (std::size_t i = 0; i < reader.size(); ++i) {
-        const std::string global = global_tree_id(tile, tree_id_of_name(reader.entry(i).name, path.string()));
+        const std::string tree = std::to_string(tree_id_of_name(reader.entry(i).name, path.string()));
+        const auto global_of = csv.global_of_tree.find({tile, tree});
+        if (global_of == csv.global_of_tree.end()) throw Error::input(path.string(), "tree_" + tree + " is not in the tile's trees.csv");
+        const std::string& global = global_of->second;
         encode::ForestTree placed;
         placed.skeleton = reader.decode(i, 0);
         const Eigen::Vector3d root = placed.skeleton.origin + placed.skeleton.nodes.at(0).position.cast<double>();
         placed.skeleton.origin = -placed.skeleton.nodes[0].position.cast<double>();
         placed.position = root;
         placed.name = global;
-        trees[global] = std::move(placed);
+        trees[{global, tile}] = std::move(placed);
     }
 }
 
@@ -136,12 +165,6 @@ std::string failure_lines(const std::vector<fs::path>& lists) {
 }
 
 }  // namespace
-
-std::string global_tree_id(const std::string& tile, long tree_id) {
-    char id[32];
-    std::snprintf(id, sizeof id, "%06ld", tree_id);
-    return tile + "/" + id;
-}
 
 TileFolders find_tile_folders(const std::vector<fs::path>& dirs) {
     TileFolders found;
@@ -178,8 +201,8 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
     if (folders.complete.empty()) throw Error::input("merge", "no finished tiles in the given folders");
     MergedSurvey merged;
     CsvRows csv;
-    std::map<std::string, json> features;
-    std::map<std::string, encode::ForestTree> forest_trees;
+    std::map<TreeKey, json> features;
+    std::map<TreeKey, encode::ForestTree> forest_trees;
     std::string crs;
     json counts = json::object();
     json tiles = json::array();
@@ -199,11 +222,12 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
         tiles.push_back({{"name", tile_of(dir)}, {"trees", tile_counts.value("trees", 0)}, {"trees_failed", tile_counts.value("trees_failed", 0)}});
         add_csv(csv, dir);
         add_features(features, crs, dir);
-        add_forest_trees(forest_trees, dir);
+        add_forest_trees(forest_trees, csv, dir);
     }
     merged.tiles = folders.complete.size();
     merged.trees = csv.rows.size();
-    merged.trees_csv = "global_id,tile," + csv.header + "\n";
+    merged.duplicated_ids = duplicated_ids(csv);
+    merged.trees_csv = "global_id,tile," + csv.header.substr(std::string("global_id,").size()) + "\n";
     for (const auto& [id, row] : csv.rows) merged.trees_csv += row;
     json collection = {{"type", "FeatureCollection"}, {"features", json::array()}};
     for (auto& [id, feature] : features) collection["features"].push_back(std::move(feature));
@@ -222,6 +246,7 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
                           {"tiles_incomplete", folders.incomplete},
                           {"tiles_failed", std::count(merged.failures_jsonl.begin(), merged.failures_jsonl.end(), '\n')},
                           {"trees", merged.trees},
+                          {"trees_in_several_tiles", merged.duplicated_ids.size()},
                           {"forest_trees", ordered.size()},
                           {"crs", crs.empty() ? json(nullptr) : json(crs)},
                           {"options", options}};

@@ -19,19 +19,20 @@ struct TileFolders {
 };
 TileFolders find_tile_folders(const std::vector<std::filesystem::path>& dirs);
 
-// A tree's id across the survey: "<tile name>/<tile tree id, 6 digits>". Sorting by it sorts by
-// tile, then by the tree's id in the tile.
-std::string global_tree_id(const std::string& tile, long tree_id);
-
 struct MergedSurvey {
     std::string trees_csv;              // global_id,tile, then the tiles' columns
     std::string trees_geojson;          // the tiles' features with global_id and tile properties
     std::vector<std::uint8_t> forest;   // every tree, named by its global id
     std::string summary_json;           // tiles, summed counts, CRS, options; no paths or timings
     std::string failures_jsonl;         // the batches' tile failures, sorted; empty when none
+    // Survey-wide ids found in more than one tile ("<id> in <tile>, <tile>"): one tree modelled
+    // by two tiles, which happens when tiles are run without --buffer.
+    std::vector<std::string> duplicated_ids;
     std::size_t tiles = 0, trees = 0;
 };
 
+// Trees are sorted by their survey-wide id (the tiles' global_id column, from the stem base;
+// survey/tree_id.hpp), then by tile.
 // Order-independent: the same folders in any order give the same bytes. Throws
 // Error(InvalidInput) when tiles disagree on the CSV columns, the CRS or the DBF6 options.
 MergedSurvey merge_tiles(const TileFolders& folders);

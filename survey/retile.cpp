@@ -3,6 +3,7 @@
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "survey/point_pieces.hpp"
 
 #include <cmath>
 #include <cstdint>
@@ -17,32 +18,6 @@ namespace treelobes::survey {
 namespace {
 
 using CellKey = std::pair<std::int64_t, std::int64_t>;
-
-template <typename T>
-void append_values(std::vector<T>& into, const std::vector<T>& from) {
-    into.insert(into.end(), from.begin(), from.end());
-}
-
-// The attributes a piece carries, as a comparable description.
-std::string attribute_signature(const PointCloud& cloud) {
-    std::string signature;
-    for (const std::string& name : cloud.attribute_names()) signature += name + ";";
-    for (const ExtraAttribute& extra : cloud.extras) signature += extra.name + ":" + attribute_type_name(extra.type) + ";";
-    return signature;
-}
-
-// Appends `piece` to `tile`; positions move from the piece's origin to the tile's.
-void append_piece(PointCloud& tile, const PointCloud& piece) {
-    const Eigen::Vector3d shift = piece.origin - tile.origin;
-    for (const Eigen::Vector3f& p : piece.positions) tile.positions.push_back((p.cast<double>() + shift).cast<float>());
-    append_values(tile.intensity, piece.intensity);
-    append_values(tile.return_number, piece.return_number);
-    append_values(tile.number_of_returns, piece.number_of_returns);
-    append_values(tile.classification, piece.classification);
-    append_values(tile.rgb, piece.rgb);
-    append_values(tile.gps_time, piece.gps_time);
-    for (std::size_t k = 0; k < tile.extras.size(); ++k) append_values(tile.extras[k].values, piece.extras[k].values);
-}
 
 // A tile's cloud: empty, with the first input's attributes, georeference and LAS choices, its
 // origin at the tile's corner (positions stay small floats).
@@ -97,7 +72,7 @@ std::vector<RetiledTile> retile(const std::vector<fs::path>& inputs, const Retil
                                              std::round(cloud.origin.z()));
                 it = tiles.emplace(key, empty_tile_like(first, corner)).first;
             }
-            append_piece(it->second, cloud.subset(indices));
+            append_points(it->second, cloud.subset(indices));
         }
         log_info(inputs[i].string() + ": " + std::to_string(cloud.size()) + " points into " + std::to_string(members.size()) + " tiles");
     }

@@ -78,13 +78,17 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
     // One row, one feature, one forest tree and one set of files per tree.
     const auto csv = lines_of(slurp(dir / "out" / "trees.csv"));
     ASSERT_EQ(csv.size(), static_cast<std::size_t>(trees + 1));
-    EXPECT_EQ(csv[0].rfind("tree_id,x,y,z,height_m,dbh_m,dbh_quality,", 0), 0u);
+    EXPECT_EQ(csv[0].rfind("global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,", 0), 0u);
     const auto geojson = nlohmann::json::parse(slurp(dir / "out" / "trees.geojson"));
     ASSERT_EQ(geojson["features"].size(), static_cast<std::size_t>(trees));
     EXPECT_EQ(geojson["crs_wkt"], kWkt);
     encode::ForestReader forest(dir / "out" / "tile.forest");
     EXPECT_EQ(forest.size(), static_cast<std::size_t>(trees));
+    std::set<std::string> global_ids;  // survey-wide ids from the stem base: "<x>_<y>" of its 1 cm cell
     for (const auto& feature : geojson["features"]) {
+        const std::string global_id = feature["properties"]["global_id"].get<std::string>();
+        EXPECT_EQ(global_id.rfind("5000", 0), 0u) << global_id;
+        EXPECT_TRUE(global_ids.insert(global_id).second) << global_id;
         char stem[32];
         std::snprintf(stem, sizeof stem, "tree_%04d", feature["properties"]["tree_id"].get<int>());
         for (const std::string suffix : {"_skeleton.ply", "_branches.ply", ".tlobe", ".dbf6", ".json"})
@@ -242,4 +246,32 @@ TEST(TileCliBadTiles, ASingleTree) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["counts"]["trees"], 1);
     EXPECT_EQ(lines_of(slurp(dir / "o" / "trees.csv")).size(), 2u);
+}
+
+TEST(TileCliBuffer, OptionsAreCheckedAndMemoryIsRefusedBeforeReading) {
+    TempDir dir;
+    EXPECT_EQ(run_cli(run_tile(dir / "a", "--neighbours " + quoted(dir.path()))).exit_code, 1);  // --neighbours needs --buffer
+    EXPECT_EQ(run_cli(run_tile(dir / "b", "--buffer 5 --tile-size 20")).exit_code, 1);          // tile.las is not a retile name
+    EXPECT_EQ(run_cli(run_tile(dir / "c", "--buffer -1")).exit_code, 1);
+    EXPECT_EQ(run_cli(run_tile(dir / "d", "--max-memory lots")).exit_code, 1);
+    const auto refused = run_cli(run_tile(dir / "e", "--max-memory 100K"));
+    EXPECT_EQ(refused.exit_code, 2);
+    EXPECT_NE(refused.err.find("points need about"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("retile"), std::string::npos) << refused.err;
+    EXPECT_FALSE(fs::exists(dir / "e"));
+}
+
+TEST(TileCliBuffer, WithoutNeighboursTheBufferChangesNothing) {
+    // The tile alone in its folder: the buffer finds no points, the core (its header bounds) holds
+    // every tree, and the outputs are those of a run without a buffer.
+    TempDir dir;
+    ASSERT_EQ(run_cli("--log-level warn " + run_tile(dir / "plain")).exit_code, 0);
+    const auto r = run_cli("--log-level warn --json " + run_tile(dir / "buffered", "--use-input-segmentation --buffer 10"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["buffer"]["core"]["from"], "header bounds");
+    EXPECT_EQ(summary["counts"]["buffer_points"], 0);
+    EXPECT_EQ(summary["counts"]["trees_in_buffer"], 0);
+    EXPECT_EQ(slurp(dir / "plain" / "trees.csv"), slurp(dir / "buffered" / "trees.csv"));
+    EXPECT_EQ(slurp(dir / "plain" / "points.las"), slurp(dir / "buffered" / "points.las"));
 }

@@ -73,7 +73,8 @@ TEST(SurveyCli, SingleRunMergesEveryTree) {
     EXPECT_EQ(summary["trees"], summary["forest_trees"]);
     const std::string csv = file_bytes(r.merged / "trees.csv");
     EXPECT_EQ(csv.rfind("global_id,tile,tree_id,x,y", 0), 0u) << csv.substr(0, 80);
-    EXPECT_NE(csv.find("\nt_3/0000"), std::string::npos);  // global ids: <tile>/<6-digit tree id>
+    EXPECT_NE(csv.find("\n5000"), std::string::npos);  // survey-wide ids from the stem base: "<x>_<y>" of its 1 cm cell
+    EXPECT_NE(csv.find(",t_3,"), std::string::npos);
 }
 
 TEST(SurveyCli, FourShardsMergeToTheBytesOfOneRun) {

@@ -1,10 +1,13 @@
 // Tile lists (folder, pattern, list file; sorted, unique names), shards (disjoint, complete,
 // parse errors), the header point count and the memory refusal.
+#include "core/cloud_header.hpp"
 #include "core/cloud_io.hpp"
+#include "core/memory_limit.hpp"
 #include "support/test_support.hpp"
-#include "survey/memory_estimate.hpp"
+#include "survey/buffered_tile.hpp"
 #include "survey/merge.hpp"
 #include "survey/tile_list.hpp"
+#include "survey/tree_id.hpp"
 
 #include <gtest/gtest.h>
 
@@ -71,24 +74,71 @@ TEST(MemoryEstimate, HeaderCountAndRefusal) {
     for (int i = 0; i < 1000; ++i) cloud.positions.emplace_back(static_cast<float>(i % 10), static_cast<float>(i / 10), 1.0f);
     write_point_cloud(cloud, dir / "t.las");
     write_point_cloud(cloud, dir / "t.ply");
-    EXPECT_EQ(survey::header_point_count(dir / "t.las"), 1000u);
-    EXPECT_EQ(survey::header_point_count(dir / "t.ply"), 1000u);
-    EXPECT_FALSE(survey::refuse_if_too_big(dir / "t.las", 1e9).has_value());
-    const auto refusal = survey::refuse_if_too_big(dir / "t.las", 1000.0);
+    EXPECT_EQ(header_point_count(dir / "t.las"), 1000u);
+    EXPECT_EQ(header_point_count(dir / "t.ply"), 1000u);
+    EXPECT_FALSE(memory_refusal(header_point_count(dir / "t.las"), kTileBytesPerPoint, 1e9).has_value());
+    const auto refusal = memory_refusal(header_point_count(dir / "t.las"), kTileBytesPerPoint, 1000.0);
     ASSERT_TRUE(refusal.has_value());
     EXPECT_NE(refusal->find("1000 points"), std::string::npos) << *refusal;
     EXPECT_NE(refusal->find("retile"), std::string::npos) << *refusal;
-    EXPECT_DOUBLE_EQ(survey::parse_memory_size("2G"), 2.0 * 1024 * 1024 * 1024);
-    EXPECT_DOUBLE_EQ(survey::parse_memory_size("512m"), 512.0 * 1024 * 1024);
+    EXPECT_DOUBLE_EQ(parse_memory_size("2G"), 2.0 * 1024 * 1024 * 1024);
+    EXPECT_DOUBLE_EQ(parse_memory_size("512m"), 512.0 * 1024 * 1024);
     for (const char* bad : {"", "0", "-1G", "2X", "G", "1GB"})
-        EXPECT_EQ(test::error_code_of([&] { survey::parse_memory_size(bad); }), ExitCode::Usage) << bad;
+        EXPECT_EQ(test::error_code_of([&] { parse_memory_size(bad); }), ExitCode::Usage) << bad;
     test::write_text(dir / "fake.las", "not a las file at all, just text that is long enough to look like a header to a careless reader"
                                        "..........................................................................................."
                                        "...........................................................................................");
-    EXPECT_EQ(test::error_code_of([&] { survey::header_point_count(dir / "fake.las"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(test::error_code_of([&] { header_point_count(dir / "fake.las"); }), ExitCode::InvalidInput);
 }
 
-TEST(GlobalTreeId, SortsByTileThenTree) {
-    EXPECT_EQ(survey::global_tree_id("tile_0_100", 7), "tile_0_100/000007");
-    EXPECT_LT(survey::global_tree_id("a", 9), survey::global_tree_id("a", 10));
+TEST(StableTreeId, OneCentimetreCellOfTheBase) {
+    EXPECT_EQ(survey::stable_tree_id(500012.345, 5400056.789), "500012.34_5400056.78");
+    EXPECT_EQ(survey::stable_tree_id(-0.005, -12.341), "-0.01_-12.35");
+    EXPECT_EQ(survey::stable_tree_id(0.0, 7.0), "0.00_7.00");
+    // A base on a cell edge (LAS coordinates on a 1 cm grid) seen through another float frame.
+    for (double noise : {-2e-6, 0.0, 2e-6}) EXPECT_EQ(survey::stable_tree_id(500012.34 + noise, 5400056.70 - noise), "500012.34_5400056.70");
+    // Two bases in one cell: the lower keeps the id.
+    const auto ids = survey::stable_tree_ids({{10.001, 20.001, 301.0}, {10.004, 20.002, 300.0}, {11.0, 20.0, 299.0}});
+    EXPECT_EQ(ids, (std::vector<std::string>{"10.00_20.00~2", "10.00_20.00", "11.00_20.00"}));
+}
+
+TEST(BufferedTile, CoreFromRetileNameIsHalfOpen) {
+    const survey::TileCore core = survey::core_from_retile_name("tiles/tile_500040_5400000.las", 40.0);
+    EXPECT_TRUE(core.holds(500040.0, 5400000.0));
+    EXPECT_TRUE(core.holds(500079.999, 5400039.999));
+    EXPECT_FALSE(core.holds(500080.0, 5400010.0));  // the next square's
+    EXPECT_FALSE(core.holds(500050.0, 5400040.0));
+    EXPECT_EQ(survey::core_from_retile_name("t_-20.50_3.25.las", 1.0).min_x, -20.5);
+    EXPECT_EQ(test::error_code_of([] { survey::core_from_retile_name("plot.las", 40.0); }), ExitCode::Usage);
+    EXPECT_EQ(test::error_code_of([] { survey::core_from_retile_name("t_1_y.las", 40.0); }), ExitCode::Usage);
+}
+
+TEST(BufferedTile, ReadsNeighbourPointsWithinTheBufferOnly) {
+    TempDir dir;
+    // Three 10 m squares in a row, a point every metre; the middle one is the tile.
+    for (int t = 0; t < 3; ++t) {
+        PointCloud cloud;
+        cloud.origin = {10.0 * t, 0.0, 0.0};
+        for (int i = 0; i < 10; ++i)
+            for (int j = 0; j < 10; ++j) cloud.positions.emplace_back(static_cast<float>(i) + 0.5f, static_cast<float>(j) + 0.5f, 1.0f);
+        write_point_cloud(cloud, dir / ("t_" + std::to_string(10 * t) + "_0.las"));
+    }
+    PointCloud far;
+    far.origin = {200.0, 0.0, 0.0};
+    far.positions.emplace_back(0.5f, 0.5f, 1.0f);
+    write_point_cloud(far, dir / "t_200_0.las");
+    const fs::path input = dir / "t_10_0.las";
+    const survey::TileCore core = survey::core_from_retile_name(input, 10.0);
+    const auto candidates = survey::list_tiles(dir.path().string());
+    // Each neighbour: 100 points over bounds 9 m wide, of which 1.5 m lie in the box (the 40 points read are a grid edge effect).
+    EXPECT_EQ(survey::estimate_buffer_points(input, core, 2.0, candidates), 34u);
+    const survey::BufferedTile buffered = survey::add_buffer(read_point_cloud(input), input, core, 2.0, candidates);
+    EXPECT_EQ(buffered.own_points, 100u);
+    EXPECT_EQ(buffered.cloud.size(), 140u);  // columns x = 8.5, 9.5 and 20.5, 21.5
+    EXPECT_EQ(buffered.neighbours_read.size(), 2u);
+    EXPECT_EQ(buffered.neighbours_skipped, 1u);  // t_200_0: its header bounds miss the box
+    for (std::size_t i = buffered.own_points; i < buffered.cloud.size(); ++i) {
+        const double x = buffered.cloud.global(i).x();
+        EXPECT_TRUE((x >= 8.0 && x < 10.0) || (x >= 20.0 && x <= 22.0)) << x;
+    }
 }
