@@ -369,6 +369,7 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
     for (std::size_t k = 1; k < chain.lod_count(); ++k) growing += chain.lod_length[k] > chain.lod_length[k - 1];
     nlohmann::json summary = {{"treelobes", kVersion},
                               {"command", "multires"},
+                              {"options", table.json()},
                               {"input", name},
                               {"input_kind", source.kind},
                               {"metric", to_string(*metric)},
