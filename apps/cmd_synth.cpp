@@ -119,8 +119,8 @@ void apply_beam(SynthFlags& f) {
     if (f.separation) beam.min_separation_m = *f.separation;
     if (f.threshold) beam.detection_threshold = *f.threshold;
     f.grow.leaves = !f.no_leaves;
-    if (f.scanner == "als") synth::validate(f.als);
-    else synth::validate(f.tls);
+    if (f.scanner == "als") synth::check_options(f.als);
+    else synth::check_options(f.tls);
 }
 
 json beam_json(const synth::BeamOptions& b) {
