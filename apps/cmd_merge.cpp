@@ -38,16 +38,16 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
     write_file_atomically(out / "trees.csv", merged.trees_csv);
     write_file_atomically(out / "trees.geojson", merged.trees_geojson);
     write_file_atomically(out / "survey.forest", std::string(merged.forest.begin(), merged.forest.end()));
-    // The tiles' options are the summary's "options"; merge's own flags go beside them.
-    nlohmann::json summary = nlohmann::json::parse(merged.summary_json);
-    summary["merge_options"] = table.json();
-    const std::string summary_text = summary.dump(2) + "\n";
-    write_file_atomically(out / "summary.json", summary_text);
+    write_file_atomically(out / "summary.json", merged.summary_json);
     if (merged.failures_jsonl.empty()) fs::remove(out / "failures.jsonl", ec);
     else write_file_atomically(out / "failures.jsonl", merged.failures_jsonl);
     const bool partial = !merged.failures_jsonl.empty() || !folders.incomplete.empty();
     if (global.json) {
-        std::cout << summary_text;
+        // summary.json holds no paths (the same survey merges into the same bytes wherever it goes), so
+        // merge's own flag, --out, is reported beside the tiles' options on stdout only.
+        nlohmann::json summary = nlohmann::json::parse(merged.summary_json);
+        summary["merge_options"] = table.json();
+        std::cout << summary.dump(2) << "\n";
     } else {
         std::printf("merge: %zu tiles, %zu trees -> %s (trees.csv, trees.geojson, survey.forest, summary.json)%s\n", merged.tiles,
                     merged.trees, o.out.c_str(),

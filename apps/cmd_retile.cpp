@@ -64,7 +64,7 @@ void add_retile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--out", o->out, "Output folder")->required();
     table->add("--prefix", o->retile.prefix, "File name prefix: <prefix>_<x>_<y>.las");
     table->add("--max-memory", o->max_memory, "Refuse inputs whose header point counts need more memory than this (e.g. 8G; default: "
-                                                   "half of the RAM)");
+                                              "half of the RAM)");
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_retile(*o, *table, global); }; });
 }
 

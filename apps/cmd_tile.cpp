@@ -385,7 +385,7 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, PLY, PCD or XYZ/CSV (decompress LAZ first)")->required();
     table->add("--out", o->out, "Output folder")->required();
     table->add("--mode", o->mode, "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
-                                       "paths) or auto (from the point density)")
+                                  "paths) or auto (from the point density)")
         ->check(CLI::IsMember({"auto", "als", "tls"}));
     table->add_flag("--use-input-segmentation", o->use_input_segmentation,
                     "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");

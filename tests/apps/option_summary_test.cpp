@@ -78,7 +78,7 @@ const Row kRows[] = {
      "report.json", "/options", R"({"samples": 20000, "image_height": 160, "species": "palm"})"},
     {"tile", "tile {data}/tile/tile.las --out {out} --map-size 300", "summary.json", "/options", R"({"map_size": 300, "mode": "auto"})"},
     {"batch", "--json batch {in}/tiles --out {out} --max-memory 8G --map-size 300", "", "/options", R"({"max_memory": "8G"})"},
-    {"merge", "merge {in}/tile --out {out}", "summary.json", "/merge_options", "{}"},
+    {"merge", "--json merge {in}/tile --out {out}", "", "/merge_options", "{}"},
     {"retile", "--json retile {data}/palm_1.las --size 5 --prefix part --out {out}", "", "/options", R"({"size": 5, "prefix": "part"})"},
 };
 
@@ -88,42 +88,51 @@ std::string replaced(std::string text, const std::string& key, const std::string
     return text;
 }
 
-// Inputs made once for the commands that read other commands' outputs.
+// The inputs a row reads from {in} (other commands' outputs), made on first use: each row runs in
+// a process of its own, so it makes only what it reads.
 class Inputs {
 public:
-    static const fs::path& folder() {
+    static fs::path for_arguments(const std::string& arguments) {
         static Inputs inputs;
-        return inputs.dir_.path();
+        const auto wants = [&](const std::string& name) { return arguments.find("{in}/" + name) != std::string::npos; };
+        if (wants("clouds") || wants("features.csv") || wants("labels.csv") || wants("model.json")) inputs.make_clouds();
+        if (wants("features.csv") || wants("model.json")) inputs.run("classify features " + quoted(inputs.in() / "clouds") + "/*.las --relative-to " +
+                                                                     quoted(inputs.in() / "clouds") + " --no-skeleton --out " + quoted(inputs.in() / "features.csv"));
+        if (wants("model.json"))
+            inputs.run("classify train " + quoted(inputs.in() / "features.csv") + " --labels " + quoted(inputs.in() / "labels.csv") + " --out " +
+                       quoted(inputs.in() / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
+        if (wants("lobes")) inputs.run("lobes " + quoted(inputs.data() / "palm_1.las") + " --out " + quoted(inputs.in() / "lobes"));
+        if (wants("birch.dbf6"))
+            inputs.run("encode " + quoted(inputs.data() / "birch_3_skeleton.ply") + " --resolution 5 --lods 3 --out " + quoted(inputs.in() / "birch.dbf6"));
+        if (wants("palm/"))
+            inputs.run("synth tree --species palm --seed 3 --height 6 --max-leaves 4000 --angular-step 0.5 --mesh-format obj --out " +
+                       quoted(inputs.in() / "palm"));
+        if (wants("tiles")) {
+            fs::create_directories(inputs.in() / "tiles");
+            fs::copy_file(inputs.data() / "tile/tile.las", inputs.in() / "tiles" / "tile.las");
+        }
+        if (wants("tile ")) inputs.run("tile " + quoted(inputs.data() / "tile/tile.las") + " --out " + quoted(inputs.in() / "tile"));
+        return inputs.in();
     }
 
 private:
-    Inputs() {
-        const fs::path data = test::source_dir() / "data/synthetic";
-        const fs::path in = dir_.path();
-        fs::create_directories(in / "clouds");
-        fs::create_directories(in / "tiles");
-        std::ofstream labels(in / "labels.csv");
+    const fs::path& in() const { return dir_.path(); }
+    fs::path data() const { return test::source_dir() / "data/synthetic"; }
+    // Two copies of two trees with labels.csv (here and beside the clouds).
+    void make_clouds() {
+        fs::create_directories(in() / "clouds");
+        std::ofstream labels(in() / "labels.csv");
         labels << "file,species\n";
         for (const char* tree : {"birch_3", "palm_1"})
             for (int copy : {1, 2}) {
                 const std::string id = std::string(tree) + "_" + std::to_string(copy);
-                fs::copy_file(data / (std::string(tree) + ".las"), in / "clouds" / (id + ".las"));
+                fs::copy_file(data() / (std::string(tree) + ".las"), in() / "clouds" / (id + ".las"));
                 labels << id << ".las," << std::string(tree).substr(0, std::string(tree).find('_')) << "\n";
             }
         labels.close();
-        fs::copy_file(in / "labels.csv", in / "clouds" / "labels.csv");
-        fs::copy_file(data / "tile/tile.las", in / "tiles" / "tile.las");
-        run("classify features " + quoted(in / "clouds") + "/*.las --relative-to " + quoted(in / "clouds") + " --no-skeleton --out " +
-            quoted(in / "features.csv"));
-        run("classify train " + quoted(in / "features.csv") + " --labels " + quoted(in / "labels.csv") + " --out " +
-            quoted(in / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
-        run("lobes " + quoted(data / "palm_1.las") + " --out " + quoted(in / "lobes"));
-        run("encode " + quoted(data / "birch_3_skeleton.ply") + " --resolution 5 --lods 3 --out " + quoted(in / "birch.dbf6"));
-        run("synth tree --species palm --seed 3 --height 6 --max-leaves 4000 --angular-step 0.5 --mesh-format obj --out " +
-            quoted(in / "palm"));
-        run("tile " + quoted(data / "tile/tile.las") + " --out " + quoted(in / "tile"));
+        fs::copy_file(in() / "labels.csv", in() / "clouds" / "labels.csv");
     }
-    static void run(const std::string& arguments) {
+    void run(const std::string& arguments) {
         const auto r = test::run_cli(arguments + " --log-level error");
         if (r.exit_code != 0) ADD_FAILURE() << "preparing the inputs: treelobes " << arguments << "\n" << r.err;
     }
@@ -213,7 +222,7 @@ TEST_P(OptionSummary, EveryDeclaredFlagAppearsWithItsResolvedValue) {
     const Row& row = GetParam();
     TempDir dir;
     const fs::path out = dir / "out";
-    std::string arguments = replaced(row.arguments, "{in}", Inputs::folder().string());
+    std::string arguments = replaced(row.arguments, "{in}", Inputs::for_arguments(row.arguments).string());
     arguments = replaced(arguments, "{data}", (test::source_dir() / "data/synthetic").string());
     arguments = replaced(arguments, "{src}", test::source_dir().string());
     arguments = replaced(arguments, "{out}", out.string());
