@@ -7,6 +7,7 @@
 // a re-run skips finished tiles and redoes partial ones from scratch. With --buffer, a tile's
 // neighbours are the other tiles of the batch (all shards') unless --neighbours names others.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "apps/summary_values.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -147,7 +148,7 @@ TileResult process_tile(const fs::path& input, const fs::path& dir, const std::v
     }
 }
 
-int run_batch(BatchCliOptions& o, const GlobalOptions& global) {
+int run_batch(BatchCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const survey::Shard shard = o.shard.empty() ? survey::Shard{} : survey::parse_shard(o.shard);
     if (!o.max_memory.empty()) parse_memory_size(o.max_memory);  // a bad size is a usage error before any tile runs
     const std::vector<std::string> key_arguments = tile_arguments_of(o);
@@ -195,6 +196,7 @@ int run_batch(BatchCliOptions& o, const GlobalOptions& global) {
                           {"command", "batch"},
                           {"source", o.source},
                           {"out", o.out},
+                          {"options", table.json()},
                           {"shard", o.shard.empty() ? json(nullptr) : json(o.shard)},
                           {"tiles_total", all.size()},
                           {"tiles", tiles.size()},
@@ -221,21 +223,22 @@ void add_batch_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand(
         "batch", "The tile pipeline over many tiles: one folder per tile, resumable, shardable for Slurm arrays and GNU parallel "
                  "(docs/survey.md). Options after the source that batch does not know are passed to every `tile` run");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("source", o->source, "The tiles: a folder, a quoted pattern (\"tiles/*.las\") or a list file (one path per line)")
         ->required();
-    sub->add_option("--out", o->out, "Output folder: one subfolder per tile, named after the tile's file")->required();
-    sub->add_option("--shard", o->shard, "Run only shard i of n (0 <= i < n): every n-th tile of the sorted list, starting at i");
-    sub->add_option("--max-memory", o->max_memory,
-                    "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM); passed to every `tile` run");
-    sub->add_flag("--overwrite", o->overwrite, "Redo tiles that an earlier run finished");
+    table->add("--out", o->out, "Output folder: one subfolder per tile, named after the tile's file")->required();
+    table->add("--shard", o->shard, "Run only shard i of n (0 <= i < n): every n-th tile of the sorted list, starting at i");
+    table->add("--max-memory", o->max_memory,
+               "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM); passed to every `tile` run");
+    table->add_flag("--overwrite", o->overwrite, "Redo tiles that an earlier run finished");
     sub->allow_extras();
     sub->fallthrough(false);  // unknown options are the tile's, not the main command's
-    sub->callback([o, sub, &global, &job] {
+    sub->callback([o, table, sub, &global, &job] {
         o->tile_arguments = sub->remaining();
         for (const std::string& argument : o->tile_arguments)
             if (argument == "--json" || argument.rfind("--threads", 0) == 0 || argument.rfind("--log-level", 0) == 0)
                 throw CLI::ValidationError(argument, "a global flag goes before the subcommand: treelobes " + argument + " batch ...");
-        job = [o, &global] { return run_batch(*o, global); };
+        job = [o, table, &global] { return run_batch(*o, *table, global); };
     });
 }
 

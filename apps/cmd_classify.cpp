@@ -4,6 +4,7 @@
 //   predict   model.jb INPUT...|features.csv [--positions P.csv] [--vote]    species per tree
 //   evaluate  DATASET_DIR... --splits 100 --out report/   the paper's protocol, voting, XGBoost
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "classify/batch.hpp"
 #include "classify/evaluation.hpp"
 #include "classify/feature_table.hpp"
@@ -64,10 +65,10 @@ struct FeatureFlags {
     }
 };
 
-void add_feature_flags(CLI::App* sub, FeatureFlags& f) {
-    sub->add_option("--tree-attribute", f.tree_attribute, "Split each input into trees by this per-point attribute (e.g. treeID)");
-    sub->add_option("--relative-to", f.relative_to, "Row ids are input paths relative to this folder (as in a dataset's labels.csv)");
-    sub->add_flag("--no-skeleton", f.no_skeleton, "Skip the skeleton features (zeros; faster)");
+void add_feature_flags(OptionTable& table, FeatureFlags& f) {
+    table.add("--tree-attribute", f.tree_attribute, "Split each input into trees by this per-point attribute (e.g. treeID)");
+    table.add("--relative-to", f.relative_to, "Row ids are input paths relative to this folder (as in a dataset's labels.csv)");
+    table.add_flag("--no-skeleton", f.no_skeleton, "Skip the skeleton features (zeros; faster)");
 }
 
 std::vector<BatchInput> batch_inputs(const std::vector<std::string>& files, const FeatureFlags& f) {
@@ -97,7 +98,7 @@ struct FeaturesCommand {
     FeatureFlags flags;
 };
 
-int run_features(const FeaturesCommand& c, const GlobalOptions& global) {
+int run_features(const FeaturesCommand& c, const OptionTable& option_table, const GlobalOptions& global) {
     if (c.list) {
         std::cout << features_markdown();
         return 0;
@@ -107,7 +108,7 @@ int run_features(const FeaturesCommand& c, const GlobalOptions& global) {
     if (batch.table.rows() == 0) throw Error::input(c.inputs.front(), "no tree gave features (" + batch.failures.front().reason + ")");
     write_feature_csv(batch.table, c.out);
     if (!batch.failures.empty()) write_failures(batch.failures, fs::absolute(c.out));
-    const json summary = {{"command", "classify features"}, {"treelobes", kVersion},   {"trees", batch.table.rows()},
+    const json summary = {{"command", "classify features"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"trees", batch.table.rows()},
                           {"features", batch.table.cols()},  {"failed", batch.failures.size()}, {"points", batch.points},
                           {"seconds", batch.seconds},        {"feature_seconds_per_tree", batch.feature_seconds / batch.table.rows()},
                           {"cpu_seconds_per_tree", batch.cpu_seconds / batch.table.rows()},
@@ -128,7 +129,7 @@ struct TrainCommand {
     JointBoostOptions options;
 };
 
-int run_train(const TrainCommand& c, const GlobalOptions& global) {
+int run_train(const TrainCommand& c, const OptionTable& option_table, const GlobalOptions& global) {
     const FeatureTable table = read_feature_csv(c.features);
     const LabelledSet set = make_labelled_set(table, read_labels_csv(c.labels), c.labels);
     const auto start = std::chrono::steady_clock::now();
@@ -142,7 +143,7 @@ int run_train(const TrainCommand& c, const GlobalOptions& global) {
         correct += std::max_element(p.begin(), p.end()) - p.begin() == set.labels[r];
     }
     const double accuracy = static_cast<double>(correct) / static_cast<double>(table.rows());
-    json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"trees", table.rows()},
+    json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"trees", table.rows()},
                           {"features", table.cols()},    {"classes", set.classes}, {"rounds", report.rounds},
                           {"rounds_tried", report.rounds_tried}, {"temperature", report.temperature}, {"training_accuracy", accuracy}, {"seconds", seconds},
                           {"out", c.out}};
@@ -177,7 +178,7 @@ bool is_feature_table(const std::vector<std::string>& inputs) {
     return inputs.size() == 1 && fs::path(inputs.front()).extension() == ".csv" && read_file(inputs.front()).rfind("id,", 0) == 0;
 }
 
-int run_predict(const PredictCommand& c, const GlobalOptions& global) {
+int run_predict(const PredictCommand& c, const OptionTable& option_table, const GlobalOptions& global) {
     const JointBoostModel model = load_jointboost(c.model);
     FeatureTable table;
     std::vector<Eigen::Vector2d> positions;
@@ -231,7 +232,7 @@ int run_predict(const PredictCommand& c, const GlobalOptions& global) {
     }
     if (!c.out.empty()) write_file_atomically(c.out, csv);
     if (!failures.empty()) write_failures(failures, fs::absolute(c.out.empty() ? std::string("predictions.csv") : c.out));
-    const json summary = {{"command", "classify predict"}, {"treelobes", kVersion}, {"trees", trees}, {"confident", confident},
+    const json summary = {{"command", "classify predict"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"trees", trees}, {"confident", confident},
                           {"changed_by_vote", changed},    {"failed", failures.size()}, {"out", c.out}};
     std::string human;
     if (c.out.empty()) human = csv;
@@ -346,7 +347,7 @@ NamedClassifier xgboost_classifier(const XGBoostOptions& base) {
             }};
 }
 
-int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
+int run_evaluate(const EvaluateCommand& c, const OptionTable& option_table, const GlobalOptions& global) {
     const bool transfer = !c.train_dataset.empty() || !c.test_dataset.empty();
     if (transfer && (c.train_dataset.empty() || c.test_dataset.empty() || !c.datasets.empty()))
         throw Error::usage("classify evaluate: give DATASET... (random splits) or both --train DATASET and --test DATASET");
@@ -366,7 +367,7 @@ int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
     // Dataset folders that are not tiles have no site groups of their own.
     FeatureTable table;
     std::vector<BatchFailure> failures;
-    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion}, {"datasets", datasets}, {"baseline", xgboost_version()},
+    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"datasets", datasets}, {"baseline", xgboost_version()},
                   {"class_weights", c.no_class_weights ? "none" : "balanced"}};
     if (!c.features.empty()) {
         table = read_feature_csv(c.features);
@@ -439,7 +440,7 @@ int run_evaluate(const EvaluateCommand& c, const GlobalOptions& global) {
     }
     extra["trees"] = set.labels.size();
     extra["failed"] = failures.size();
-    write_report(report, options, c.out, extra.dump());
+    write_report(report, c.out, extra.dump());
     if (!failures.empty()) write_failures(failures, fs::path(c.out) / "features.csv");
     json summary = json::parse(read_file(fs::path(c.out) / "summary.json"));
     print(summary, global,
@@ -456,98 +457,100 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
 
     auto features = std::make_shared<FeaturesCommand>();
     CLI::App* f = classify->add_subcommand("features", "Shape features of tree point clouds -> features.csv");
+    auto features_table = std::make_shared<OptionTable>(f);
     f->add_option("inputs", features->inputs, "Point clouds, one tree each (or many with --tree-attribute)");
-    f->add_option("--out,-o", features->out, "Output CSV");
-    f->add_flag("--list", features->list, "Print the feature catalogue (docs/features.md) and exit");
-    add_feature_flags(f, features->flags);
-    f->callback([features, &global, &job] { job = [features, &global] { return run_features(*features, global); }; });
+    features_table->add("--out,-o", features->out, "Output CSV");
+    features_table->add_flag("--list", features->list, "Print the feature catalogue (docs/features.md) and exit");
+    add_feature_flags(*features_table, features->flags);
+    f->callback([features, features_table, &global, &job] { job = [features, features_table, &global] { return run_features(*features, *features_table, global); }; });
 
     auto train = std::make_shared<TrainCommand>();
     CLI::App* t = classify->add_subcommand("train", "Train a JointBoost model from features.csv and labels.csv");
+    auto train_table = std::make_shared<OptionTable>(t);
     t->add_option("features", train->features, "Feature table from `classify features`")->required();
-    t->add_option("--labels", train->labels, "CSV with id and species columns")->required();
-    t->add_option("--out,-o", train->out, "Model file")->required();
-    t->add_option("--max-rounds", train->options.max_rounds, "Maximum boosting rounds")->check(CLI::Range(1, 100000))->capture_default_str();
-    t->add_option("--folds", train->options.folds, "Cross-validation folds for early stopping and calibration (0 = off)")
-        ->check(CLI::Range(0, 20))->capture_default_str();
-    t->add_option("--patience", train->options.patience, "Rounds without improvement before stopping")->check(cli::NonNegativeNumber)->capture_default_str();
-    t->add_option("--seed", train->options.seed, "Seed of the cross-validation folds")->capture_default_str();
-    t->add_flag("--no-calibration{false}", train->options.calibrate,
-                "Keep the probability temperature at 1 instead of fitting it out of fold");
-    t->add_flag("--no-scan-routing{false}", train->options.route_by_scan,
-                "One model for all trees instead of one per scan kind (told apart by scan_point_density)");
-    t->add_flag("--refit{false}", train->options.fold_ensemble,
-                "Boost the final model again on all training trees instead of averaging the cross-validation runs");
-    t->add_flag("--average-scores{false}", train->options.average_probabilities,
-                "The fold ensemble averages its members' scores H instead of their probabilities");
-    t->add_flag("--no-class-weights{false}", train->options.balance_classes,
-                "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
-    t->callback([train, &global, &job] { job = [train, &global] { return run_train(*train, global); }; });
+    train_table->add("--labels", train->labels, "CSV with id and species columns")->required();
+    train_table->add("--out,-o", train->out, "Model file")->required();
+    train_table->add("--max-rounds", train->options.max_rounds, "Maximum boosting rounds")->check(CLI::Range(1, 100000));
+    train_table->add("--folds", train->options.folds, "Cross-validation folds for early stopping and calibration (0 = off)")
+        ->check(CLI::Range(0, 20));
+    train_table->add("--patience", train->options.patience, "Rounds without improvement before stopping")->check(cli::NonNegativeNumber);
+    train_table->add("--seed", train->options.seed, "Seed of the cross-validation folds");
+    train_table->add_flag("--no-calibration{false}", train->options.calibrate,
+                          "Keep the probability temperature at 1 instead of fitting it out of fold");
+    train_table->add_flag("--no-scan-routing{false}", train->options.route_by_scan,
+                          "One model for all trees instead of one per scan kind (told apart by scan_point_density)");
+    train_table->add_flag("--refit{false}", train->options.fold_ensemble,
+                          "Boost the final model again on all training trees instead of averaging the cross-validation runs");
+    train_table->add_flag("--average-scores{false}", train->options.average_probabilities,
+                          "The fold ensemble averages its members' scores H instead of their probabilities");
+    train_table->add_flag("--no-class-weights{false}", train->options.balance_classes,
+                          "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
+    t->callback([train, train_table, &global, &job] { job = [train, train_table, &global] { return run_train(*train, *train_table, global); }; });
 
     auto predict = std::make_shared<PredictCommand>();
     CLI::App* p = classify->add_subcommand("predict", "Species of trees (point clouds or a feature table), optional spatial voting");
+    auto predict_table = std::make_shared<OptionTable>(p);
     p->add_option("model", predict->model, "Model file from `classify train`")->required();
     p->add_option("inputs", predict->inputs, "Point clouds or one features.csv")->required();
-    p->add_option("--positions", predict->positions, "CSV with id, x, y (default for clouds: the mean of their points)");
-    p->add_flag("--vote", predict->vote, "Spatial voting among the trees given");
-    p->add_option("--confidence", predict->voting.confidence_factor, "Confident when h1 > factor * h2")
-        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
-    p->add_option("--radius", predict->voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber)->capture_default_str();
-    p->add_option("--out,-o", predict->out, "predictions.csv (default: print the table)");
-    add_feature_flags(p, predict->flags);
-    p->callback([predict, &global, &job] { job = [predict, &global] { return run_predict(*predict, global); }; });
+    predict_table->add("--positions", predict->positions, "CSV with id, x, y (default for clouds: the mean of their points)");
+    predict_table->add_flag("--vote", predict->vote, "Spatial voting among the trees given");
+    predict_table->add("--confidence", predict->voting.confidence_factor, "Confident when h1 > factor * h2")
+        ->check(CLI::Range(1.0, 100.0));
+    predict_table->add("--radius", predict->voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber);
+    predict_table->add("--out,-o", predict->out, "predictions.csv (default: print the table)");
+    add_feature_flags(*predict_table, predict->flags);
+    p->callback([predict, predict_table, &global, &job] { job = [predict, predict_table, &global] { return run_predict(*predict, *predict_table, global); }; });
 
     auto evaluate = std::make_shared<EvaluateCommand>();
     CLI::App* e = classify->add_subcommand("evaluate", "The paper's protocol (50/50 splits), site split, voting, XGBoost baseline");
+    auto evaluate_table = std::make_shared<OptionTable>(e);
     e->add_option("datasets", evaluate->datasets, "`synth dataset` folders (labels.csv) or folders of `synth tile` outputs");
-    e->add_option("--train", evaluate->train_dataset, "Train on this dataset folder (with --test: one experiment, no random splits)");
-    e->add_option("--test", evaluate->test_dataset, "Test on this dataset folder (with --train)");
-    e->add_option("--groups", evaluate->groups,
-                  "Feature groups the classifiers see (default all; e.g. --groups airborne for sparse airborne crowns)")
+    evaluate_table->add("--train", evaluate->train_dataset, "Train on this dataset folder (with --test: one experiment, no random splits)");
+    evaluate_table->add("--test", evaluate->test_dataset, "Test on this dataset folder (with --train)");
+    evaluate_table->add("--groups", evaluate->groups,
+                        "Feature groups the classifiers see (default all; e.g. --groups airborne for sparse airborne crowns)")
         ->delimiter(',');
-    e->add_option("--train-fraction", evaluate->options.train_fraction, "Share of each species that trains in a random split")
-        ->check(CLI::Range(0.05, 0.95))
-        ->capture_default_str();
-    e->add_option("--level", evaluate->level,
-                  "Classes to train and test: species, or genus (the first word of labels.csv's scientific_name)")
-        ->check(CLI::IsMember({"species", "genus"}))
-        ->capture_default_str();
-    e->add_flag("--no-class-weights", evaluate->no_class_weights,
-                "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
-    e->add_option("--out,-o", evaluate->out, "Report folder")->required();
-    e->add_option("--splits", evaluate->options.splits, "Random 50/50 splits")->check(CLI::Range(1, 100000))->capture_default_str();
-    e->add_option("--seed", evaluate->options.seed, "Seed of the splits")->capture_default_str();
-    e->add_option("--features", evaluate->features, "Reuse a feature table (e.g. report/features.csv of an earlier run)");
-    e->add_option("--confidence", evaluate->options.voting.confidence_factor, "Confident when h1 > factor * h2")
-        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
-    e->add_option("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber)->capture_default_str();
-    e->add_option("--max-rounds", evaluate->jointboost.max_rounds, "JointBoost maximum rounds")->check(CLI::Range(1, 100000))->capture_default_str();
-    e->add_option("--folds", evaluate->jointboost.folds,
-                  "JointBoost: cross-validation folds on the training half for early stopping and calibration (0 = off)")
-        ->check(CLI::Range(0, 20))->capture_default_str();
-    e->add_option("--patience", evaluate->jointboost.patience, "JointBoost: rounds without improvement before stopping")
-        ->check(cli::NonNegativeNumber)->capture_default_str();
-    e->add_flag("--no-calibration{false}", evaluate->jointboost.calibrate,
-                "JointBoost: keep the probability temperature at 1 instead of fitting it out of fold");
-    e->add_flag("--no-scan-routing{false}", evaluate->jointboost.route_by_scan,
-                "JointBoost: one model for all trees instead of one per scan kind (told apart by scan_point_density)");
-    e->add_option("--settled-logloss", evaluate->jointboost.settled_logloss,
-                  "JointBoost: stop when every out-of-fold tree is right at a mean log-loss below this (0 = off)")
-        ->check(cli::NonNegativeNumber)->capture_default_str();
-    e->add_flag("--refit{false}", evaluate->jointboost.fold_ensemble,
-                "JointBoost: boost the final model again on all training trees instead of averaging the cross-validation runs");
-    e->add_flag("--average-scores{false}", evaluate->jointboost.average_probabilities,
-                "JointBoost: the fold ensemble averages its members' scores H instead of their probabilities");
-    e->add_option("--layout", evaluate->layout,
-                  "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
-                  "replaces the dataset's positions")
+    evaluate_table->add("--train-fraction", evaluate->options.train_fraction, "Share of each species that trains in a random split")
+        ->check(CLI::Range(0.05, 0.95));
+    evaluate_table->add("--level", evaluate->level,
+                        "Classes to train and test: species, or genus (the first word of labels.csv's scientific_name)")
+        ->check(CLI::IsMember({"species", "genus"}));
+    evaluate_table->add_flag("--no-class-weights", evaluate->no_class_weights,
+                             "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
+    evaluate_table->add("--out,-o", evaluate->out, "Report folder")->required();
+    evaluate_table->add("--splits", evaluate->options.splits, "Random 50/50 splits")->check(CLI::Range(1, 100000));
+    evaluate_table->add("--seed", evaluate->options.seed, "Seed of the splits");
+    evaluate_table->add("--features", evaluate->features, "Reuse a feature table (e.g. report/features.csv of an earlier run)");
+    evaluate_table->add("--confidence", evaluate->options.voting.confidence_factor, "Confident when h1 > factor * h2")
+        ->check(CLI::Range(1.0, 100.0));
+    evaluate_table->add("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber);
+    evaluate_table->add("--max-rounds", evaluate->jointboost.max_rounds, "JointBoost maximum rounds")->check(CLI::Range(1, 100000));
+    evaluate_table->add("--folds", evaluate->jointboost.folds,
+                        "JointBoost: cross-validation folds on the training half for early stopping and calibration (0 = off)")
+        ->check(CLI::Range(0, 20));
+    evaluate_table->add("--patience", evaluate->jointboost.patience, "JointBoost: rounds without improvement before stopping")
+        ->check(cli::NonNegativeNumber);
+    evaluate_table->add_flag("--no-calibration{false}", evaluate->jointboost.calibrate,
+                             "JointBoost: keep the probability temperature at 1 instead of fitting it out of fold");
+    evaluate_table->add_flag("--no-scan-routing{false}", evaluate->jointboost.route_by_scan,
+                             "JointBoost: one model for all trees instead of one per scan kind (told apart by scan_point_density)");
+    evaluate_table->add("--settled-logloss", evaluate->jointboost.settled_logloss,
+                        "JointBoost: stop when every out-of-fold tree is right at a mean log-loss below this (0 = off)")
+        ->check(cli::NonNegativeNumber);
+    evaluate_table->add_flag("--refit{false}", evaluate->jointboost.fold_ensemble,
+                             "JointBoost: boost the final model again on all training trees instead of averaging the cross-validation runs");
+    evaluate_table->add_flag("--average-scores{false}", evaluate->jointboost.average_probabilities,
+                             "JointBoost: the fold ensemble averages its members' scores H instead of their probabilities");
+    evaluate_table->add("--layout", evaluate->layout,
+                        "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
+                        "replaces the dataset's positions")
         ->check(CLI::IsMember({"grouped", "mixed"}));
-    e->add_option("--spacing", evaluate->spacing, "Distance between planted trees, m (with --layout)")
-        ->check(cli::PositiveNumber)->capture_default_str();
-    e->add_flag("--no-xgboost", evaluate->no_xgboost, "Skip the XGBoost baseline");
-    e->add_flag("--no-site-split", evaluate->no_site_split, "Skip the leave-one-site-out split");
-    add_feature_flags(e, evaluate->flags);
-    e->callback([evaluate, &global, &job] { job = [evaluate, &global] { return run_evaluate(*evaluate, global); }; });
+    evaluate_table->add("--spacing", evaluate->spacing, "Distance between planted trees, m (with --layout)")
+        ->check(cli::PositiveNumber);
+    evaluate_table->add_flag("--no-xgboost", evaluate->no_xgboost, "Skip the XGBoost baseline");
+    evaluate_table->add_flag("--no-site-split", evaluate->no_site_split, "Skip the leave-one-site-out split");
+    add_feature_flags(*evaluate_table, evaluate->flags);
+    e->callback([evaluate, evaluate_table, &global, &job] { job = [evaluate, evaluate_table, &global] { return run_evaluate(*evaluate, *evaluate_table, global); }; });
 }
 
 }  // namespace treelobes::cli

@@ -4,6 +4,7 @@
 // record, with the same header fields, VLRs and EVLRs); every other conversion goes through the
 // point cloud and keeps its attributes, scale/offset and CRS as the writers do.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/las_io.hpp"
@@ -58,7 +59,7 @@ ConvertResult convert_cloud(const std::filesystem::path& input, const std::files
     return {cloud.size(), "cloud", format};
 }
 
-int run_convert(const ConvertOptions& options, const GlobalOptions& global) {
+int run_convert(const ConvertOptions& options, const OptionTable& table, const GlobalOptions& global) {
     const std::filesystem::path input(options.input), output(options.out);
     std::error_code ec;
     if (std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
@@ -75,6 +76,7 @@ int run_convert(const ConvertOptions& options, const GlobalOptions& global) {
     if (global.json) {
         std::cout << nlohmann::json{{"treelobes", kVersion},
                                     {"input", options.input},
+                                    {"options", table.json()},
                                     {"input_format", result.input_format},
                                     {"output", options.out},
                                     {"points", result.points},
@@ -95,13 +97,14 @@ void add_convert_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand(
         "convert", "Convert a point cloud (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV) to LAS, PLY, PCD or XYZ/CSV; LAZ to LAS "
                    "gives the uncompressed file record for record");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", options->input, "Point cloud to read")->required();
-    sub->add_option("--out", options->out, "Output file; its extension picks the format (.las .ply .pcd .xyz .txt .csv)")
+    table->add("--out", options->out, "Output file; its extension picks the format (.las .ply .pcd .xyz .txt .csv)")
         ->required();
-    sub->add_option("--bounds", options->bounds,
-                    "Keep only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); COPC files "
-                    "read only the octree nodes that meet the box");
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_convert(*options, global); }; });
+    table->add("--bounds", options->bounds,
+               "Keep only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); COPC files "
+               "read only the octree nodes that meet the box");
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_convert(*options, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

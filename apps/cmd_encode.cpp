@@ -4,6 +4,7 @@
 // into a .dbf6 file (one tree, LODs) or a .forest file (many trees), which `decode` reads back
 // (seed 000 §3.3, §4; docs/dbf6.md, docs/forest.md).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/skeleton_io.hpp"
@@ -162,7 +163,7 @@ void print_lod_stats(const StoredTree& tree, const std::vector<StreamSizes>& siz
     }
 }
 
-int run_encode_file(const EncodeCliOptions& options, const GlobalOptions& global) {
+int run_encode_file(const EncodeCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     std::optional<CodeParameters> recorded;
     const TreeGraph tree = read_tree_input(options.skeleton, &recorded);
     const StoredTree stored = store_tree(tree, file_options_of(options, recorded), options.skeleton);
@@ -172,7 +173,7 @@ int run_encode_file(const EncodeCliOptions& options, const GlobalOptions& global
     const std::size_t internodes = stored.lods[0].radii.size();
     const std::size_t raw = 16 * internodes;  // seed 000 Table 5: 16 bytes per internode
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion},
+        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
                             {"input", options.skeleton},
                             {"out", options.out},
                             {"kind", code_kind_name(stored.kind)},
@@ -259,7 +260,7 @@ std::vector<ForestTree> read_forest_input(const fs::path& input) {
     return trees;
 }
 
-int run_encode_forest(const EncodeCliOptions& options, const GlobalOptions& global) {
+int run_encode_forest(const EncodeCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     const std::vector<ForestTree> trees = read_forest_input(options.forest);
     ForestStats stats;
     const std::vector<std::uint8_t> bytes = write_forest_bytes(trees, file_options_of(options), &stats);
@@ -267,7 +268,7 @@ int run_encode_forest(const EncodeCliOptions& options, const GlobalOptions& glob
     std::size_t internodes = 0;
     for (const auto& tree : stats.trees) internodes += tree.empty() ? 0 : tree[0].internodes;
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion},   {"input", options.forest},         {"out", options.out},
+        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()}, {"input", options.forest},         {"out", options.out},
                             {"trees", trees.size()},     {"internodes", internodes},        {"file_bytes", bytes.size()},
                             {"raw_bytes", 16 * internodes}, {"index_bytes", stats.header_and_index},
                             {"coder", options.coder},    {"lods", options.lods},            {"resolution", options.resolution}};
@@ -298,9 +299,9 @@ int run_encode_forest(const EncodeCliOptions& options, const GlobalOptions& glob
     return 0;
 }
 
-int run_encode(const EncodeCliOptions& options, const GlobalOptions& global) {
-    if (!options.forest.empty()) return run_encode_forest(options, global);
-    if (!options.out.empty()) return run_encode_file(options, global);
+int run_encode(const EncodeCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
+    if (!options.forest.empty()) return run_encode_forest(options, table, global);
+    if (!options.out.empty()) return run_encode_file(options, table, global);
     std::optional<CodeParameters> recorded;
     const TreeGraph tree = read_tree_input(options.skeleton, &recorded);
     const EncodeOptions encode_options = encode_options_of(options, recorded);
@@ -311,7 +312,7 @@ int run_encode(const EncodeCliOptions& options, const GlobalOptions& global) {
     const std::size_t dbf6_length = write_symbols(encoded.internodes, CodeKind::DBF6).size();
     const double bound = std::sqrt(3.0) * encoded.geometry.voxel_size / 2.0;
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion},
+        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
                             {"input", options.skeleton},
                             {"kind", code_kind_name(encode_options.kind)},
                             {"resolution", encoded.resolution},
@@ -369,7 +370,7 @@ nlohmann::json lod_json(const ChainCode& code, int level, double threshold) {
             {"radii", code.radii}};
 }
 
-int run_lod(const LodCliOptions& options, const GlobalOptions& global) {
+int run_lod(const LodCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     // LOD reduction does not depend on the code kind: F6 and DBF6 prune identically.
     const ChainCode code = code_from_options(options.code, options.radii, CodeKind::DBF6);
     const bool by_levels = options.levels > 0;
@@ -377,7 +378,7 @@ int run_lod(const LodCliOptions& options, const GlobalOptions& global) {
                                                      : std::vector<double>{options.threshold};
     const std::vector<ChainCode> levels = lod_chain(code, thresholds, "--code");
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion}, {"input_length", code.symbols.size()}};
+        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()}, {"input_length", code.symbols.size()}};
         if (by_levels) {
             j["levels"] = nlohmann::json::array();
             for (std::size_t k = 0; k < levels.size(); ++k)
@@ -401,7 +402,7 @@ int run_lod(const LodCliOptions& options, const GlobalOptions& global) {
     return 0;
 }
 
-int run_decode(const DecodeCliOptions& options, const GlobalOptions& global) {
+int run_decode(const DecodeCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     const ChainCode code = code_from_options(options.code, options.radii, options.f6 ? CodeKind::F6 : CodeKind::DBF6);
     CodeGeometry geometry;
     geometry.voxel_size = options.internode_length / options.resolution;  // Eq. 2
@@ -413,7 +414,7 @@ int run_decode(const DecodeCliOptions& options, const GlobalOptions& global) {
 
     const SymbolCounts counts = count_symbols(code.symbols);
     if (global.json) {
-        std::cout << nlohmann::json{{"treelobes", kVersion},     {"kind", code_kind_name(code.kind)},
+        std::cout << nlohmann::json{{"treelobes", kVersion}, {"options", table.json()}, {"kind", code_kind_name(code.kind)},
                                     {"internodes", counts.internodes}, {"nodes", tree.size()},
                                     {"tips", tree.tip_count()},     {"voxel_size", geometry.voxel_size},
                                     {"root_radius", geometry.root_radius}, {"out", options.out}}
@@ -443,7 +444,7 @@ CodeParameters code_parameters_of(const StoredTree& tree) {
     return {tree.resolution, tree.internode_length, tree.radius_unit};
 }
 
-int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& global) {
+int run_decode_forest(const DecodeFileCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     ForestReader forest{fs::path(options.input)};
     std::vector<std::size_t> selected;
     if (options.tree >= 0) {
@@ -484,7 +485,7 @@ int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& 
         }
     }
     if (global.json) {
-        std::cout << nlohmann::json{{"treelobes", kVersion}, {"input", options.input}, {"trees_in_file", forest.size()},
+        std::cout << nlohmann::json{{"treelobes", kVersion}, {"options", table.json()}, {"input", options.input}, {"trees_in_file", forest.size()},
                                     {"lod", options.lod},    {"internodes", internodes},  {"decoded", written}}
                          .dump(2)
                   << "\n";
@@ -495,9 +496,9 @@ int run_decode_forest(const DecodeFileCliOptions& options, const GlobalOptions& 
     return 0;
 }
 
-int run_decode_file(const DecodeFileCliOptions& options, const GlobalOptions& global) {
+int run_decode_file(const DecodeFileCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     if (options.lod < 0) throw Error::usage("--lod must be 0 or more");
-    if (is_forest_file(options.input)) return run_decode_forest(options, global);
+    if (is_forest_file(options.input)) return run_decode_forest(options, table, global);
     if (options.tree >= 0) throw Error::usage("--tree applies to .forest files; " + options.input + " holds one tree");
     std::vector<StreamSizes> sizes;
     const StoredTree stored = read_tree_file(options.input, options.lod, &sizes);
@@ -505,7 +506,7 @@ int run_decode_file(const DecodeFileCliOptions& options, const GlobalOptions& gl
     write_tree_output(tree, options.out, options.ascii, code_parameters_of(stored));
     const StreamSizes& level = sizes[static_cast<std::size_t>(options.lod)];
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion},
+        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
                             {"input", options.input},
                             {"kind", code_kind_name(stored.kind)},
                             {"coder", coder_name(stored.coder)},
@@ -531,36 +532,33 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand(
         "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (seed 000); with --out, compress it into "
                   "a .dbf6 file, or many trees (--forest) into a .forest file");
+    auto table = std::make_shared<OptionTable>(sub);
     auto* skeleton = sub->add_option("skeleton", options->skeleton, "Skeleton PLY (vertex 0 is the root) or .tlobe");
-    auto* forest = sub->add_option("--forest", options->forest,
-                                   "Directory of skeleton PLY/.tlobe files, or a list file with lines PATH [X Y Z [AZIMUTH_DEG]]");
+    auto* forest = table->add("--forest", options->forest,
+                              "Directory of skeleton PLY/.tlobe files, or a list file with lines PATH [X Y Z [AZIMUTH_DEG]]");
     skeleton->excludes(forest);
     forest->excludes(skeleton);
-    auto* out = sub->add_option("--out", options->out, "Output .dbf6 file (one tree) or .forest file (--forest)");
-    auto* resolution = sub->add_option("--resolution", options->resolution,
-                                       "Voxels per internode length (r of Eq. 2); required unless the skeleton is a "
-                                       "decoded one, which records r, l and the radius unit of its code")
+    auto* out = table->add("--out", options->out, "Output .dbf6 file (one tree) or .forest file (--forest)");
+    auto* resolution = table->add("--resolution", options->resolution,
+                                  "Voxels per internode length (r of Eq. 2); required unless the skeleton is a "
+                                  "decoded one, which records r, l and the radius unit of its code")
                            ->check(cli::PositiveNumber);
-    auto* internode_length = sub->add_option("--internode-length", options->internode_length,
-                                             "Internode length l in metres, or 'auto' for the median edge length (per "
-                                             "tree; a decoded skeleton's recorded l when not given)")
-                                 ->capture_default_str();
-    auto* radius_unit = sub->add_option("--radius-unit", options->radius_unit,
-                                        "Metres per radius step of the radius list (a decoded skeleton's recorded unit "
-                                        "when not given)")
-                            ->capture_default_str()
+    auto* internode_length = table->add("--internode-length", options->internode_length,
+                                        "Internode length l in metres, or 'auto' for the median edge length (per "
+                                        "tree; a decoded skeleton's recorded l when not given)");
+    auto* radius_unit = table->add("--radius-unit", options->radius_unit,
+                                   "Metres per radius step of the radius list (a decoded skeleton's recorded unit "
+                                   "when not given)")
                             ->check(cli::PositiveNumber);
-    sub->add_flag("--f6", options->f6, "Plain F6 code instead of the differential DBF6");
-    auto* print = sub->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
-    auto* lods = sub->add_option("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
-                     ->capture_default_str()
+    table->add_flag("--f6", options->f6, "Plain F6 code instead of the differential DBF6");
+    auto* print = table->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
+    auto* lods = table->add("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
                      ->check(CLI::Range(1, kMaxLods));
-    auto* coder = sub->add_option("--coder", options->coder, "Compression: ic (seed 000 §3.3) or best")
-                      ->capture_default_str()
+    auto* coder = table->add("--coder", options->coder, "Compression: ic (seed 000 §3.3) or best")
                       ->check(CLI::IsMember({"ic", "best"}));
-    sub->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");
+    table->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");
     print->excludes(out);
-    sub->callback([options, skeleton, forest, out, lods, coder, resolution, internode_length, radius_unit, &global, &job] {
+    sub->callback([options, table, skeleton, forest, out, lods, coder, resolution, internode_length, radius_unit, &global, &job] {
         if (skeleton->count() == 0 && forest->count() == 0) throw CLI::RequiredError("skeleton or --forest");
         if (forest->count() && resolution->count() == 0) throw CLI::RequiredError("--resolution (with --forest)");
         options->resolution_given = resolution->count() > 0;
@@ -569,65 +567,66 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
         if (forest->count() && out->count() == 0) throw CLI::RequiredError("--out (with --forest)");
         if (out->count() == 0 && (lods->count() || coder->count()))
             throw CLI::ValidationError("--lods/--coder", "apply to files: give --out");
-        job = [options, &global] { return run_encode(*options, global); };
+        job = [options, table, &global] { return run_encode(*options, *table, global); };
     });
 }
 
 void add_decode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<DecodeFileCliOptions>();
     CLI::App* sub = app.add_subcommand("decode", "Decode a .dbf6 tree or .forest trees into skeleton PLY files");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", options->input, "A .dbf6 or .forest file")->required();
-    sub->add_option("--lod", options->lod, "Level of detail to decode (0 = full detail)")
-        ->capture_default_str()
+    table->add("--lod", options->lod, "Level of detail to decode (0 = full detail)")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--tree", options->tree, "Forest files: decode only tree I (0-based) into the --out PLY")
+    table->add("--tree", options->tree, "Forest files: decode only tree I (0-based) into the --out PLY")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--out", options->out,
-                    "Output skeleton PLY; for a whole forest (no --tree) a directory receiving one PLY per tree")
+    table->add("--out", options->out,
+               "Output skeleton PLY; for a whole forest (no --tree) a directory receiving one PLY per tree")
         ->required();
-    sub->add_flag("--ascii", options->ascii, "Write ASCII PLY instead of binary");
-    sub->add_flag("--stats", options->stats, "Report the size of every stream");
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_decode_file(*options, global); }; });
+    table->add_flag("--ascii", options->ascii, "Write ASCII PLY instead of binary");
+    table->add_flag("--stats", options->stats, "Report the size of every stream");
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_decode_file(*options, *table, global); }; });
 }
 
 void add_lod(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<LodCliOptions>();
     CLI::App* sub = app.add_subcommand("lod", "Prune lateral branches thinner than a threshold directly on a chain code");
-    sub->add_option("--code", options->code, "Chain code (F6 or DBF6)")->required();
-    sub->add_option("--radii", options->radii, "Comma-separated radii, one per internode")->required();
-    auto* threshold = sub->add_option("--threshold", options->threshold,
-                                      "Prune laterals whose first radius is below T (radius units)");
-    auto* levels = sub->add_option("--levels", options->levels,
-                                   "Print K LODs with thresholds at uniform positions of the sorted unique radii")
+    auto table = std::make_shared<OptionTable>(sub);
+    table->add("--code", options->code, "Chain code (F6 or DBF6)")->required();
+    table->add("--radii", options->radii, "Comma-separated radii, one per internode")->required();
+    auto* threshold = table->add("--threshold", options->threshold,
+                                 "Prune laterals whose first radius is below T (radius units)");
+    auto* levels = table->add("--levels", options->levels,
+                              "Print K LODs with thresholds at uniform positions of the sorted unique radii")
                        ->check(cli::PositiveNumber);
     threshold->excludes(levels);
     levels->excludes(threshold);
-    sub->callback([options, threshold, levels, &global, &job] {
+    sub->callback([options, table, threshold, levels, &global, &job] {
         if (threshold->count() == 0 && levels->count() == 0) throw CLI::RequiredError("--threshold or --levels");
-        job = [options, &global] { return run_lod(*options, global); };
+        job = [options, table, &global] { return run_lod(*options, *table, global); };
     });
 }
 
 void add_decode_code(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<DecodeCliOptions>();
     CLI::App* sub = app.add_subcommand("decode-code", "Decode a chain code and radius list into a skeleton PLY");
-    sub->add_option("--code", options->code, "Chain code")->required();
-    sub->add_option("--radii", options->radii, "Comma-separated radii, one per internode")->required();
-    sub->add_option("--resolution", options->resolution, "Resolution r used for encoding")
+    auto table = std::make_shared<OptionTable>(sub);
+    table->add("--code", options->code, "Chain code")->required();
+    table->add("--radii", options->radii, "Comma-separated radii, one per internode")->required();
+    table->add("--resolution", options->resolution, "Resolution r used for encoding")
         ->required()
         ->check(cli::PositiveNumber);
-    sub->add_option("--internode-length", options->internode_length, "Internode length l (metres) used for encoding")
+    table->add("--internode-length", options->internode_length, "Internode length l (metres) used for encoding")
         ->required()
         ->check(cli::PositiveNumber);
-    sub->add_option("--radius-unit", options->radius_unit, "Metres per radius step")
-        ->capture_default_str()
+    table->add("--radius-unit", options->radius_unit, "Metres per radius step")
         ->check(cli::PositiveNumber);
-    sub->add_option("--root-radius", options->root_radius, "Root vertex radius in radius units (default: the first radius)")
+    table->add("--root-radius", options->root_radius, "Root vertex radius in radius units (default: the first radius)")
         ->check(cli::NonNegativeNumber);
-    sub->add_flag("--f6", options->f6, "The code is plain F6 (default: DBF6)");
-    sub->add_flag("--ascii", options->ascii, "Write an ASCII PLY instead of binary");
-    sub->add_option("--out", options->out, "Output skeleton PLY")->required();
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_decode(*options, global); }; });
+    table->add_flag("--f6", options->f6, "The code is plain F6 (default: DBF6)");
+    table->add_flag("--ascii", options->ascii, "Write an ASCII PLY instead of binary");
+    table->add("--out", options->out, "Output skeleton PLY")->required();
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_decode(*options, *table, global); }; });
 }
 
 }  // namespace

@@ -3,6 +3,7 @@
 // branch detection precision/recall. R is a skeleton PLY, a TreeQSM cylinder table or a
 // WoodSKE-style point list (reconstruct/skeleton_eval.hpp).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/version.hpp"
@@ -36,9 +37,10 @@ nlohmann::json stats_json(const DistanceStats& s) {
     return {{"samples", s.samples}, {"mean", s.mean}, {"median", s.median}, {"p95", s.p95}, {"max", s.max}};
 }
 
-nlohmann::json to_json(const EvalSkeletonOptions& o, const SkeletonGraph& ref, const SkeletonComparison& c) {
+nlohmann::json to_json(const EvalSkeletonOptions& o, const OptionTable& table, const SkeletonGraph& ref, const SkeletonComparison& c) {
     nlohmann::json j = {{"treelobes", kVersion},
                         {"command", "eval skeleton"},
+                        {"options", table.json()},
                         {"skeleton", o.skeleton},
                         {"reference", o.reference},
                         {"reference_kind", ref.kind},
@@ -96,7 +98,7 @@ void write_samples(const SkeletonComparison& c, const std::string& path) {
     write_point_cloud(cloud, path);
 }
 
-int run_eval_skeleton(const EvalSkeletonOptions& o, const GlobalOptions& global) {
+int run_eval_skeleton(const EvalSkeletonOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const SkeletonGraph skeleton = read_skeleton_graph(o.skeleton, o.skeleton_kind);
     SkeletonGraph reference = read_skeleton_graph(o.reference, o.reference_kind);
     if (!o.visible_in.empty()) {
@@ -109,7 +111,7 @@ int run_eval_skeleton(const EvalSkeletonOptions& o, const GlobalOptions& global)
     }
     const SkeletonComparison c = compare_skeletons(skeleton, reference, o.eval);
     if (!o.samples_out.empty()) write_samples(c, o.samples_out);
-    if (global.json) std::cout << to_json(o, reference, c).dump(2) << "\n";
+    if (global.json) std::cout << to_json(o, table, reference, c).dump(2) << "\n";
     else print_human(o, reference, c);
     return 0;
 }
@@ -121,25 +123,26 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     eval->require_subcommand(1);
     auto options = std::make_shared<EvalSkeletonOptions>();
     CLI::App* sub = eval->add_subcommand("skeleton", "Compare a skeleton PLY with a reference skeleton, TreeQSM cylinders or skeleton points");
-    sub->add_option("--skeleton", options->skeleton, "Skeleton PLY or QSM to score")->required();
-    sub->add_option("--reference", options->reference, "Skeleton PLY, QSM (TreeQSM cylinder table or SimpleForest/rTwig CSV) or x y z point list")->required();
-    sub->add_option("--reference-kind", options->reference_kind, "auto, skeleton, treeqsm or points")
-        ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}))->capture_default_str();
-    sub->add_option("--skeleton-kind", options->skeleton_kind, "auto, skeleton (PLY), treeqsm (TreeQSM table or SimpleForest/rTwig CSV) or points: score QSMs and other models too")
-        ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}))->capture_default_str();
-    sub->add_option("--sample-step", options->eval.sample_step, "Metres between samples along segments")
-        ->check(cli::PositiveNumber)->capture_default_str();
-    sub->add_option("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")
-        ->check(cli::PositiveNumber)->capture_default_str();
-    sub->add_option("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
-        ->check(cli::NonNegativeNumber)->capture_default_str();
-    sub->add_option("--visible-in", options->visible_in,
-                    "A synthetic scan of the reference (points labelled with `internode`): score against the part of the "
-                    "reference it sees, i.e. the internodes holding --visible-points of its points (bark or leaves) and their way to the root");
-    sub->add_option("--visible-points", options->visible_points, "Scan points an internode needs to count as seen")
-        ->check(CLI::Range(1, 1000000))->capture_default_str();
-    sub->add_option("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_eval_skeleton(*options, global); }; });
+    auto table = std::make_shared<OptionTable>(sub);
+    table->add("--skeleton", options->skeleton, "Skeleton PLY or QSM to score")->required();
+    table->add("--reference", options->reference, "Skeleton PLY, QSM (TreeQSM cylinder table or SimpleForest/rTwig CSV) or x y z point list")->required();
+    table->add("--reference-kind", options->reference_kind, "auto, skeleton, treeqsm or points")
+        ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}));
+    table->add("--skeleton-kind", options->skeleton_kind, "auto, skeleton (PLY), treeqsm (TreeQSM table or SimpleForest/rTwig CSV) or points: score QSMs and other models too")
+        ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}));
+    table->add("--sample-step", options->eval.sample_step, "Metres between samples along segments")
+        ->check(cli::PositiveNumber);
+    table->add("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")
+        ->check(cli::PositiveNumber);
+    table->add("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
+        ->check(cli::NonNegativeNumber);
+    table->add("--visible-in", options->visible_in,
+               "A synthetic scan of the reference (points labelled with `internode`): score against the part of the "
+               "reference it sees, i.e. the internodes holding --visible-points of its points (bark or leaves) and their way to the root");
+    table->add("--visible-points", options->visible_points, "Scan points an internode needs to count as seen")
+        ->check(CLI::Range(1, 1000000));
+    table->add("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_eval_skeleton(*options, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

@@ -2,6 +2,7 @@
 // (skeleton PLY, .tlobe, .dbf6, .forest, or a folder of them) in the formats other tools open
 // (docs/export.md). Float formats are written in a local frame with a georef sidecar.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
@@ -91,7 +92,7 @@ void write_mesh_file(const ExportInput& input, const ExportCliOptions& o) {
     write_georef_sidecar(o.out, all.origin, Georeference{o.crs.empty() ? input.crs : o.crs, {}});
 }
 
-nlohmann::json summary_json(const ExportCliOptions& o, const ExportInput& input, const std::vector<TreeSummary>& trees,
+nlohmann::json summary_json(const ExportCliOptions& o, const OptionTable& table, const ExportInput& input, const std::vector<TreeSummary>& trees,
                             const std::vector<std::string>& outputs) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& t : trees)
@@ -108,14 +109,13 @@ nlohmann::json summary_json(const ExportCliOptions& o, const ExportInput& input,
             {"command", "export"},
             {"input", o.input},
             {"format", o.format},
-            {"options", {{"lod", o.lod}, {"lods", o.geometry.lods}, {"sides", o.geometry.sides}, {"leaves", o.geometry.leaves},
-                         {"leaf_size", o.geometry.leaf_size}}},
+            {"options", table.json()},
             {"crs", o.crs.empty() ? input.crs : o.crs},
             {"outputs", outputs},
             {"trees", list}};
 }
 
-int run_export(ExportCliOptions o, const GlobalOptions& global) {
+int run_export(ExportCliOptions o, const OptionTable& table, const GlobalOptions& global) {
     o.geometry.leaves = !o.no_leaves;
     const ExportInput input = read_export_input(o.input, o.lod);
     std::vector<TreeSummary> summaries;
@@ -126,7 +126,7 @@ int run_export(ExportCliOptions o, const GlobalOptions& global) {
     else if (o.format == "cityjson") write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs));
     else write_mesh_file(input, o);
     if (global.json) {
-        std::cout << summary_json(o, input, summaries, outputs).dump(2) << "\n";
+        std::cout << summary_json(o, table, input, summaries, outputs).dump(2) << "\n";
         return 0;
     }
     std::printf("%s -> %s (%s): %zu tree%s\n", o.input.c_str(), o.out.c_str(), o.format.c_str(), input.trees.size(),
@@ -142,22 +142,23 @@ int run_export(ExportCliOptions o, const GlobalOptions& global) {
 void add_export_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<ExportCliOptions>();
     CLI::App* sub = app.add_subcommand("export", "Write trees as QSM tables, glTF 2.0 (.glb), CityJSON 2.0, PLY or OBJ meshes");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", options->input, "Skeleton PLY, .tlobe, .dbf6, .forest, or a folder of them")->required();
-    sub->add_option("--format", options->format,
-                    "ply|obj (branch tubes + lobes), glb (with LODs), cityjson, qsm-txt (TreeQSM cylinder, branch and tree tables), "
-                    "qsm-csv (SimpleForest/rTwig)")
+    table->add("--format", options->format,
+               "ply|obj (branch tubes + lobes), glb (with LODs), cityjson, qsm-txt (TreeQSM cylinder, branch and tree tables), "
+               "qsm-csv (SimpleForest/rTwig)")
         ->required()
         ->check(CLI::IsMember({"ply", "obj", "glb", "cityjson", "qsm-txt", "qsm-csv"}));
-    sub->add_option("--out", options->out, "Output file (QSM of several trees: a folder of <tree>.txt / <tree>.csv)")->required();
-    sub->add_option("--lod", options->lod, "LOD of .dbf6/.forest inputs to export (0 = full detail)")
-        ->check(cli::NonNegativeNumber)->capture_default_str();
-    sub->add_option("--lods", options->geometry.lods, "glb: levels of detail (MSFT_lod), 1..8")->check(CLI::Range(1, 8))->capture_default_str();
-    sub->add_option("--sides", options->geometry.sides, "Branch tube sides at full detail, 3..64")->check(CLI::Range(3, 64))->capture_default_str();
-    sub->add_flag("--no-leaves", options->no_leaves, "glb: no leaf cards on skeletons without lobes");
-    sub->add_option("--leaf-size", options->geometry.leaf_size, "glb: leaf card edge in metres")
-        ->check(cli::PositiveNumber)->capture_default_str();
-    sub->add_option("--crs", options->crs, "CRS of the input (EPSG:25832 or WKT) when its georef sidecar has none");
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_export(*options, global); }; });
+    table->add("--out", options->out, "Output file (QSM of several trees: a folder of <tree>.txt / <tree>.csv)")->required();
+    table->add("--lod", options->lod, "LOD of .dbf6/.forest inputs to export (0 = full detail)")
+        ->check(cli::NonNegativeNumber);
+    table->add("--lods", options->geometry.lods, "glb: levels of detail (MSFT_lod), 1..8")->check(CLI::Range(1, 8));
+    table->add("--sides", options->geometry.sides, "Branch tube sides at full detail, 3..64")->check(CLI::Range(3, 64));
+    table->add_flag("--no-leaves", options->no_leaves, "glb: no leaf cards on skeletons without lobes");
+    table->add("--leaf-size", options->geometry.leaf_size, "glb: leaf card edge in metres")
+        ->check(cli::PositiveNumber);
+    table->add("--crs", options->crs, "CRS of the input (EPSG:25832 or WKT) when its georef sidecar has none");
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_export(*options, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

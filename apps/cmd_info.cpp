@@ -1,6 +1,7 @@
 // `treelobes info FILE...`: format, version, counts, bounds, attributes and CRS of point
 // clouds, meshes and skeletons. Every file is reported; the exit code is 2 if any failed.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/error.hpp"
 #include "core/file_info.hpp"
 #include "core/version.hpp"
@@ -101,7 +102,7 @@ void print_human(const FileInfo& info) {
     if (!info.crs.empty()) std::cout << "  crs: " << info.crs.substr(0, 120) << (info.crs.size() > 120 ? "..." : "") << "\n";
 }
 
-int run_info(const InfoOptions& options, const GlobalOptions& global) {
+int run_info(const InfoOptions& options, const OptionTable& table, const GlobalOptions& global) {
     nlohmann::json files = nlohmann::json::array();
     int exit_code = 0;
     std::optional<Box3d> bounds;
@@ -117,7 +118,7 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
             exit_code = static_cast<int>(e.code());
         }
     }
-    if (global.json) std::cout << nlohmann::json{{"treelobes", kVersion}, {"files", files}}.dump(2) << "\n";
+    if (global.json) std::cout << nlohmann::json{{"treelobes", kVersion}, {"options", table.json()}, {"files", files}}.dump(2) << "\n";
     return exit_code;
 }
 
@@ -126,11 +127,12 @@ int run_info(const InfoOptions& options, const GlobalOptions& global) {
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<InfoOptions>();
     CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes (PLY, OBJ, OFF, glb), skeletons, QSMs and CityJSON");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("files", options->files, "Files to describe")->required();
-    sub->add_option("--bounds", options->bounds,
-                    "Describe only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); "
-                    "COPC files read only the octree nodes that meet the box");
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_info(*options, global); }; });
+    table->add("--bounds", options->bounds,
+              "Describe only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); "
+              "COPC files read only the octree nodes that meet the box");
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_info(*options, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

@@ -6,6 +6,7 @@
 // `treelobes synthesize FILE.tlobe --out MESH`: lobe texturing with the species' patch library,
 // the full (or --lod reduced) tree mesh, fidelity metrics against --points and a --preview PNG.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "apps/reconstruction_flags.hpp"
 #include "apps/summary_values.hpp"
 #include "core/cloud_io.hpp"
@@ -76,7 +77,7 @@ TriangleMesh merged_lobes(const lobes::LobeTree& tree) {
     return all;
 }
 
-nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const GlobalOptions& global) {
+nlohmann::json run_one(const LobesCliOptions& o, const OptionTable& table, const fs::path& input, const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const PointCloud cloud = read_point_cloud(input);
     const TreeReconstruction r = reconstruct_tree(cloud, o.stage, input.string());
@@ -120,10 +121,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
     nlohmann::json summary = {
         {"treelobes", kVersion},
         {"input", input.string()},
-        {"options", {{"species", o.flags.species.empty() ? nlohmann::json() : nlohmann::json(o.flags.species)},
-                     {"beta", tree.beta}, {"gamma", tree.gamma}, {"fs", tree.fs}, {"alpha_factor", tree.alpha_factor},
-                     {"min_cluster_points", o.lobes.min_cluster_points}, {"face_budget", o.lobes.face_budget},
-                     {"quantum", o.file.quantum}}},
+        {"options", table.json()},
         {"skeleton", {{"internodes", r.skeleton.size() > 0 ? r.skeleton.size() - 1 : 0},
                       {"main_nodes", tree.skeleton.size()},
                       {"root_diameter", rounded(tree.root_diameter, 4)},
@@ -149,7 +147,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const fs::path& input, const Gl
     return summary;
 }
 
-int run_lobes(LobesCliOptions& o, const GlobalOptions& global) {
+int run_lobes(LobesCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     apply_species_flags(o.flags, o.stage);
     std::error_code ec;
     fs::create_directories(o.out, ec);
@@ -161,7 +159,7 @@ int run_lobes(LobesCliOptions& o, const GlobalOptions& global) {
         try {
             if (!stems.insert(fs::path(name).stem().string()).second)
                 throw Error::input(name, "another input has the same name stem; its outputs would be overwritten");
-            trees.push_back(run_one(o, name, global));
+            trees.push_back(run_one(o, table, name, global));
         } catch (const Error& e) {
             if (e.code() == ExitCode::Usage) throw;
             std::cerr << "treelobes: error: " << e.what() << "\n";
@@ -260,7 +258,7 @@ PointCloud points_of_tree(const PointCloud& cloud, const lobes::LobeTree& tree) 
     return out;
 }
 
-int run_synthesize(const SynthesizeCliOptions& o, const GlobalOptions& global) {
+int run_synthesize(const SynthesizeCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const lobes::LobeTree tree = lobes::read_tlobe(o.input);
     std::string species = !o.species.empty() ? o.species : tree.species;
@@ -295,6 +293,7 @@ int run_synthesize(const SynthesizeCliOptions& o, const GlobalOptions& global) {
     nlohmann::json summary = {
         {"treelobes", kVersion},
         {"input", o.input},
+        {"options", table.json()},
         {"species", profile.entry.name},
         {"seed", o.synthesis.texturing.seed},
         {"lod", o.lod},
@@ -353,43 +352,47 @@ int run_synthesize(const SynthesizeCliOptions& o, const GlobalOptions& global) {
 void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<LobesCliOptions>();
     CLI::App* sub = app.add_subcommand("lobes", "Lobe-based representation (.tlobe) of single-tree scans: main skeleton + alpha-shape lobes");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("inputs", o->inputs, "Point clouds of single trees (LAS, PLY, PCD, XYZ/CSV)")->required();
-    sub->add_option("--out", o->out, "Output folder")->required();
-    add_species_flags(sub, o->flags, "Lobe diameter factor f_s of Eq. 2: larger -> more, smaller lobes (default 1.0, or the species')");
-    sub->add_option("--alpha-factor", o->lobes.alpha.alpha_factor, "alpha = FACTOR * alpha_min (ball radii)")
-        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
-    sub->add_option("--min-cluster-points", o->lobes.min_cluster_points, "Smaller clusters stay on the skeleton as branches")
-        ->check(CLI::Range(4, 100000))->capture_default_str();
-    sub->add_option("--max-shape-points", o->lobes.max_shape_points, "Larger clusters are thinned on a grid before the alpha shape")
-        ->check(CLI::Range(100, 10000000))->capture_default_str();
-    sub->add_option("--dropped-point-reach", o->lobes.dropped_point_reach, "Outliers dropped by the reconstruction within this many metres of a lobe's points join its occupancy (0 = off)")
-        ->check(CLI::Range(0.0, 10.0))->capture_default_str();
-    sub->add_option("--face-budget", o->lobes.face_budget, "Lobe faces over the whole tree after simplification")
-        ->check(CLI::Range(100, 10000000))->capture_default_str();
-    sub->add_option("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")
-        ->check(CLI::Range(0.0001, 0.1))->capture_default_str();
-    sub->callback([o, &global, &job] { job = [o, &global] { return run_lobes(*o, global); }; });
+    table->add("--out", o->out, "Output folder")->required();
+    add_species_flags(*table, o->flags, "Lobe diameter factor f_s of Eq. 2: larger -> more, smaller lobes (default 1.0, or the species')", o->stage);
+    table->add("--alpha-factor", o->lobes.alpha.alpha_factor, "alpha = FACTOR * alpha_min (ball radii)")
+        ->check(CLI::Range(1.0, 100.0));
+    table->add("--min-cluster-points", o->lobes.min_cluster_points, "Smaller clusters stay on the skeleton as branches")
+        ->check(CLI::Range(4, 100000));
+    table->add("--max-shape-points", o->lobes.max_shape_points, "Larger clusters are thinned on a grid before the alpha shape")
+        ->check(CLI::Range(100, 10000000));
+    table->add("--dropped-point-reach", o->lobes.dropped_point_reach, "Outliers dropped by the reconstruction within this many metres of a lobe's points join its occupancy (0 = off)")
+        ->check(CLI::Range(0.0, 10.0));
+    table->add("--face-budget", o->lobes.face_budget, "Lobe faces over the whole tree after simplification")
+        ->check(CLI::Range(100, 10000000));
+    table->add("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")
+        ->check(CLI::Range(0.0001, 0.1));
+    sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_lobes(*o, *table, global); }; });
 
     auto so = std::make_shared<SynthesizeCliOptions>();
     CLI::App* syn = app.add_subcommand("synthesize", "Full tree mesh from a .tlobe: main branches plus lobes textured with species patches");
+    auto syn_table = std::make_shared<OptionTable>(syn);
     syn->add_option("input", so->input, "Lobe-based representation (.tlobe) from `treelobes lobes`")->required();
-    syn->add_option("--out", so->out, "Output mesh (.ply, .obj, .off); a summary goes next to it as .json")->required();
-    syn->add_option("--species", so->species, "Patch library species (default: the file's species, else lagerstroemia)");
-    syn->add_option("--seed", so->synthesis.texturing.seed, "Random seed of patch fitting")->capture_default_str();
-    syn->add_option("--library-seed", so->synthesis.library.seed, "Random seed of the species' patch library")->capture_default_str();
-    syn->add_option("--lod", so->lod, "Level of detail: fraction of skeleton edges, twigs and leaves kept (0..1]")
-        ->check(CLI::Range(0.001, 1.0))->capture_default_str();
-    syn->add_option("--max-triangles", so->synthesis.max_triangles, "Triangles of the synthesized tree at most (a hard bound): the main branches', the rest shared by the lobes by volume; leafy patches are thinned")
-        ->check(CLI::Range(1000, 1000000000))->capture_default_str();
-    syn->add_option("--max-lobe-patches", so->synthesis.texturing.max_patches_per_lobe, "Patches per lobe at most (a safety bound; --max-triangles governs)")
-        ->check(CLI::Range(1, 10000000))->capture_default_str();
-    syn->add_option("--fill-cell", so->synthesis.texturing.fill_cell, "Smallest edge of the lobe fill cells, metres (cells are sized to the lobe's patch budget)")
-        ->check(CLI::Range(0.01, 10.0))->capture_default_str();
-    syn->add_option("--max-fill-cells", so->synthesis.texturing.max_fill_cells, "Fill cells per lobe at most (larger lobes get larger cells)")
-        ->check(CLI::Range(1.0, 1e7))->capture_default_str();
-    syn->add_option("--points", so->points, "The input cloud: report the one-sided distance from its points to the mesh");
-    syn->add_option("--preview", so->preview, "PNG preview: input points (with --points) next to the synthesized tree");
-    syn->callback([so, &global, &job] { job = [so, &global] { return run_synthesize(*so, global); }; });
+    syn_table->add("--out", so->out, "Output mesh (.ply, .obj, .off); a summary goes next to it as .json")->required();
+    syn_table->add("--species", so->species, "Patch library species (default: the file's species, else lagerstroemia)");
+    syn_table->add("--seed", so->synthesis.texturing.seed, "Random seed of patch fitting");
+    syn_table->add("--library-seed", so->synthesis.library.seed, "Random seed of the species' patch library");
+    syn_table->add("--lod", so->lod, "Level of detail: fraction of skeleton edges, twigs and leaves kept (0..1]")
+        ->check(CLI::Range(0.001, 1.0));
+    syn_table->add("--max-triangles", so->synthesis.max_triangles, "Triangles of the synthesized tree at most (a hard bound): the main branches', the rest shared by the lobes by volume; leafy patches are thinned")
+        ->check(CLI::Range(1000, 1000000000));
+    syn_table->add("--max-lobe-patches", so->synthesis.texturing.max_patches_per_lobe, "Patches per lobe at most (a safety bound; --max-triangles governs)")
+        ->check(CLI::Range(1, 10000000));
+    syn_table->add("--fill-cell", so->synthesis.texturing.fill_cell, "Smallest edge of the lobe fill cells, metres (cells are sized to the lobe's patch budget)")
+        ->check(CLI::Range(0.01, 10.0));
+    syn_table->add("--max-fill-cells", so->synthesis.texturing.max_fill_cells, "Fill cells per lobe at most (larger lobes get larger cells)")
+        ->check(CLI::Range(1.0, 1e7));
+    syn_table->add("--points", so->points, "The input cloud: report the one-sided distance from its points to the mesh");
+    syn_table->add("--preview", so->preview, "PNG preview: input points (with --points) next to the synthesized tree");
+    syn->callback([so, syn_table, &global, &job] {
+        job = [so, syn_table, &global] { return run_synthesize(*so, *syn_table, global); };
+    });
 }
 
 }  // namespace treelobes::cli

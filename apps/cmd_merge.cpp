@@ -2,6 +2,7 @@
 // trees.csv, trees.geojson, survey.forest and summary.json, sorted by the global tree id so that
 // the bytes do not depend on the order of the folders or on how the tiles were sharded.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -25,7 +26,7 @@ struct MergeCliOptions {
     std::string out;
 };
 
-int run_merge(const MergeCliOptions& o, const GlobalOptions& global) {
+int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     std::vector<fs::path> dirs(o.inputs.begin(), o.inputs.end());
     const survey::TileFolders folders = survey::find_tile_folders(dirs);
     for (const std::string& name : folders.incomplete) log_warn("tile " + name + " is not finished (no completion marker): left out");
@@ -44,7 +45,11 @@ int run_merge(const MergeCliOptions& o, const GlobalOptions& global) {
     else write_file_atomically(out / "failures.jsonl", merged.failures_jsonl);
     const bool partial = !merged.failures_jsonl.empty() || !folders.incomplete.empty();
     if (global.json) {
-        std::cout << merged.summary_json;
+        // summary.json holds no paths (the same survey merges into the same bytes wherever it goes), so
+        // merge's own flag, --out, is reported beside the tiles' options on stdout only.
+        nlohmann::json summary = nlohmann::json::parse(merged.summary_json);
+        summary["merge_options"] = table.json();
+        std::cout << summary.dump(2) << "\n";
     } else {
         std::printf("merge: %zu tiles, %zu trees -> %s (trees.csv, trees.geojson, survey.forest, summary.json)%s\n", merged.tiles,
                     merged.trees, o.out.c_str(),
@@ -59,9 +64,10 @@ void add_merge_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<MergeCliOptions>();
     CLI::App* sub = app.add_subcommand("merge", "Join tile and batch outputs into one trees.csv, trees.geojson, survey.forest and summary.json, "
                                                 "order-independent (docs/survey.md)");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("dirs", o->inputs, "Tile output folders or batch output folders (their finished tiles)")->required();
-    sub->add_option("--out", o->out, "Output folder")->required();
-    sub->callback([o, &global, &job] { job = [o, &global] { return run_merge(*o, global); }; });
+    table->add("--out", o->out, "Output folder")->required();
+    sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_merge(*o, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

@@ -8,6 +8,7 @@
 // box above the volume threshold packed into atlas.png; each LOD then also says which boxes'
 // textures stand in for the branches its chain prefix has not reached (combined LOD, §3.3).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -272,7 +273,7 @@ nlohmann::json write_foliage(const FoliageHierarchy& hierarchy, const std::vecto
     return summary;
 }
 
-int run_multires(const MultiresCliOptions& o, const GlobalOptions& global) {
+int run_multires(const MultiresCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     if (o.input.empty() == o.string.empty()) throw Error::usage("multires: give either an INPUT file or --string");
     const auto metric = parse_chain_metric(o.metric);
     const auto order = parse_chain_order(o.order);
@@ -368,6 +369,7 @@ int run_multires(const MultiresCliOptions& o, const GlobalOptions& global) {
     for (std::size_t k = 1; k < chain.lod_count(); ++k) growing += chain.lod_length[k] > chain.lod_length[k - 1];
     nlohmann::json summary = {{"treelobes", kVersion},
                               {"command", "multires"},
+                              {"options", table.json()},
                               {"input", name},
                               {"input_kind", source.kind},
                               {"metric", to_string(*metric)},
@@ -424,33 +426,34 @@ void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     auto o = std::make_shared<MultiresCliOptions>();
     CLI::App* sub = app.add_subcommand(
         "multires", "Multiresolution chain (seed 003) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", o->input, "L-system file (docs/lsystem.md) or skeleton PLY");
-    sub->add_option("--string", o->string, "A bracketed module string instead of a file, e.g. 'C1[C2[C3][C4]][C5]'");
-    sub->add_option("--out", o->out, "Output folder")->required();
-    sub->add_option("--metric", o->metric, "Child order: branching-length (default), children, descendants, longest-path")
+    table->add("--string", o->string, "A bracketed module string instead of a file, e.g. 'C1[C2[C3][C4]][C5]'");
+    table->add("--out", o->out, "Output folder")->required();
+    table->add("--metric", o->metric, "Child order: branching-length (default), children, descendants, longest-path")
         ->check(CLI::IsMember({"branching-length", "children", "descendants", "longest-path", "branching_length",
                                "longest_path"}));
-    sub->add_option("--order", o->order, "Resume at: greedy (largest remaining branch, default) or depth-first")
+    table->add("--order", o->order, "Resume at: greedy (largest remaining branch, default) or depth-first")
         ->check(CLI::IsMember({"greedy", "depth-first", "depth_first"}));
-    auto* lod = sub->add_option("--lod", o->lods, "LOD level(s) to write (0 = coarsest); default: coarsest and full");
-    sub->add_flag("--all", o->all, "Write every LOD level")->excludes(lod);
-    sub->add_option("--steps", o->steps, "Derivation length (overrides the file)")->check(CLI::Range(0, kMaxDerivationLength));
-    sub->add_option("--seed", o->seed, "Seed of stochastic rules (overrides the file)")->check(cli::NonNegativeNumber);
-    sub->add_option("--define,-D", o->defines, "Override a #define constant: NAME=VALUE (repeatable)");
-    sub->add_option("--max-modules", o->max_modules, "Largest module string a derivation may produce")
+    auto* lod = table->add("--lod", o->lods, "LOD level(s) to write (0 = coarsest); default: coarsest and full");
+    table->add_flag("--all", o->all, "Write every LOD level")->excludes(lod);
+    table->add("--steps", o->steps, "Derivation length (overrides the file)")->check(CLI::Range(0, kMaxDerivationLength));
+    table->add("--seed", o->seed, "Seed of stochastic rules (overrides the file)")->check(cli::NonNegativeNumber);
+    table->add("--define,-D", o->defines, "Override a #define constant: NAME=VALUE (repeatable)");
+    table->add("--max-modules", o->max_modules, "Largest module string a derivation may produce")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));
-    sub->add_option("--length-modules", o->length_modules, "Modules whose first parameter is a length in the tADT")
+    table->add("--length-modules", o->length_modules, "Modules whose first parameter is a length in the tADT")
         ->delimiter(',');
-    sub->add_flag("--mesh", o->mesh, "Also write a tube mesh per LOD (<lod>.mesh.ply)");
-    sub->add_option("--texture-threshold", o->texture_threshold,
-                    "Foliage boxes whose volume / root volume exceeds this get six textures (0 <= R < 1)")
+    table->add_flag("--mesh", o->mesh, "Also write a tube mesh per LOD (<lod>.mesh.ply)");
+    table->add("--texture-threshold", o->texture_threshold,
+               "Foliage boxes whose volume / root volume exceeds this get six textures (0 <= R < 1)")
         ->check(CLI::Range(0.0, 0.999999));
-    sub->add_option("--texture-size", o->texture_size, "Texture width and height in pixels")->check(CLI::Range(8, 1024));
-    sub->add_flag("--texture-planes", o->texture_planes, "Also write every texture as its own PNG (textures/)");
-    sub->add_option("--small-foliage", o->small_foliage,
-                    "Leaves of unreached sub-branches below the texture threshold: geometry (default) or omit")
+    table->add("--texture-size", o->texture_size, "Texture width and height in pixels")->check(CLI::Range(8, 1024));
+    table->add_flag("--texture-planes", o->texture_planes, "Also write every texture as its own PNG (textures/)");
+    table->add("--small-foliage", o->small_foliage,
+               "Leaves of unreached sub-branches below the texture threshold: geometry (default) or omit")
         ->check(CLI::IsMember({"geometry", "omit"}));
-    sub->callback([o, &global, &job] { job = [o, &global] { return run_multires(*o, global); }; });
+    sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_multires(*o, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

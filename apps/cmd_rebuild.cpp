@@ -5,6 +5,7 @@
 // stored as .tlobe (and its skeleton as .dbf6) and synthesized back from the .tlobe; report.json
 // compares the rebuilt tree with the original (docs/rebuild.md).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "apps/reconstruction_flags.hpp"
 #include "apps/summary_values.hpp"
 #include "classify/features.hpp"
@@ -247,7 +248,7 @@ void print_summary(const json& r) {
                 r["peak_memory_mb"].get<double>());
 }
 
-int run_rebuild(RebuildCliOptions& o, const GlobalOptions& global) {
+int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const auto started = Clock::now();
     StageClock clock;
     // Options first: a usage error must not wait for a big mesh to be read.
@@ -352,10 +353,7 @@ int run_rebuild(RebuildCliOptions& o, const GlobalOptions& global) {
         {"command", "rebuild"},
         {"input", o.input},
         {"out", o.out},
-        {"options", {{"species", species_flag}, {"model", o.model.empty() ? json() : json(o.model)}, {"scan", o.scan},
-                     {"samples", sampling.samples}, {"density", o.density}, {"stations", o.stations}, {"seed", o.seed},
-                     {"budget_kb", o.budget_kb}, {"leaf_materials", o.leaf_materials.empty() ? json() : json(o.leaf_materials)},
-                     {"max_triangles", o.synthesis.max_triangles}, {"dbf6_resolution", o.dbf6_resolution}}},
+        {"options", table.json()},
         {"input_mesh", {{"format", named.report.format}, {"bytes", original_bytes}, {"vertices", original.vertices.size()},
                         {"triangles", original.faces.size()}, {"polygons_split", named.report.polygons_split},
                         {"degenerate_faces_dropped", named.report.degenerate_faces}, {"normals_ignored", named.report.normals_ignored},
@@ -406,28 +404,28 @@ void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     o->synthesis.max_triangles = 200000;
     o->flags.species = "auto";
     CLI::App* sub = app.add_subcommand("rebuild", "A heavy polygonal tree (OBJ/PLY/OFF/STL) in, a light lobe-based tree (.tlobe, .dbf6) out, with a fidelity report");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("mesh", o->input, "Tree model: .obj (materials/groups name bark and leaves), .ply, .off, .stl")->required();
-    sub->add_option("--out", o->out, "Output folder: <stem>.tlobe, .dbf6, _rebuilt.ply, _skeleton.ply, _samples.ply, _compare.png, report.json")->required();
-    add_species_flags(sub, o->flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')");
+    table->add("--out", o->out, "Output folder: <stem>.tlobe, .dbf6, _rebuilt.ply, _skeleton.ply, _samples.ply, _compare.png, report.json")->required();
+    add_species_flags(*table, o->flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')", o->stage);
     sub->get_option("--species")->description("Species from config/species.yaml, or auto: the classifier's choice with --model, else generic parameters and lagerstroemia patches")
         ->capture_default_str();
-    sub->add_option("--model", o->model, "JointBoost model (`classify train`) that picks the species for --species auto");
-    sub->add_option("--scan", o->scan, "Sampling: uniform (area-weighted on the surface), tls (terrestrial scanner around the model), als (airborne)")
-        ->check(CLI::IsMember({"uniform", "tls", "als"}))->capture_default_str();
-    sub->add_option("--samples", o->samples, "Points sampled (scans: at most, about this many)")->check(CLI::Range(100, 50000000))->capture_default_str();
-    sub->add_option("--density", o->density, "Uniform sampling: points per m^2 of surface instead of --samples")->check(PositiveNumber);
-    sub->add_option("--stations", o->stations, "TLS stations around the model")->check(CLI::Range(1, 16))->capture_default_str();
-    sub->add_option("--seed", o->seed, "Random seed of sampling and synthesis")->capture_default_str();
-    sub->add_option("--budget-kb", o->budget_kb, "Size the .tlobe may take (kB); its lobe occupancy grid is coarsened to fit")
-        ->check(CLI::Range(2.0, 10000.0))->capture_default_str();
-    sub->add_option("--leaf-materials", o->leaf_materials, "Comma-separated names (substrings, any case) of leaf materials/groups/objects; other named faces are wood")
-        ;
-    sub->add_option("--max-triangles", o->synthesis.max_triangles, "Triangles of the synthesized tree at most")->check(CLI::Range(1000, 1000000000))->capture_default_str();
-    sub->add_option("--dbf6-resolution", o->dbf6_resolution, "DBF6 resolution r of the skeleton file")->check(PositiveNumber)->capture_default_str();
-    sub->add_option("--compare-samples", o->compare_samples, "Samples per surface for the distances original <-> rebuilt")
-        ->check(CLI::Range(1000, 10000000))->capture_default_str();
-    sub->add_option("--image-height", o->image_height, "Height of the comparison PNG, pixels")->check(CLI::Range(64, 4096))->capture_default_str();
-    sub->callback([o, &global, &job] { job = [o, &global] { return run_rebuild(*o, global); }; });
+    table->add("--model", o->model, "JointBoost model (`classify train`) that picks the species for --species auto");
+    table->add("--scan", o->scan, "Sampling: uniform (area-weighted on the surface), tls (terrestrial scanner around the model), als (airborne)")
+        ->check(CLI::IsMember({"uniform", "tls", "als"}));
+    table->add("--samples", o->samples, "Points sampled (scans: at most, about this many)")->check(CLI::Range(100, 50000000));
+    table->add("--density", o->density, "Uniform sampling: points per m^2 of surface instead of --samples")->check(PositiveNumber);
+    table->add("--stations", o->stations, "TLS stations around the model")->check(CLI::Range(1, 16));
+    table->add("--seed", o->seed, "Random seed of sampling and synthesis");
+    table->add("--budget-kb", o->budget_kb, "Size the .tlobe may take (kB); its lobe occupancy grid is coarsened to fit")
+        ->check(CLI::Range(2.0, 10000.0));
+    table->add("--leaf-materials", o->leaf_materials, "Comma-separated names (substrings, any case) of leaf materials/groups/objects; other named faces are wood");
+    table->add("--max-triangles", o->synthesis.max_triangles, "Triangles of the synthesized tree at most")->check(CLI::Range(1000, 1000000000));
+    table->add("--dbf6-resolution", o->dbf6_resolution, "DBF6 resolution r of the skeleton file")->check(PositiveNumber);
+    table->add("--compare-samples", o->compare_samples, "Samples per surface for the distances original <-> rebuilt")
+        ->check(CLI::Range(1000, 10000000));
+    table->add("--image-height", o->image_height, "Height of the comparison PNG, pixels")->check(CLI::Range(64, 4096));
+    sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_rebuild(*o, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

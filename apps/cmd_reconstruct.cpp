@@ -3,6 +3,7 @@
 // input is listed in DIR/failures.jsonl and the others go on (exit 3). Finished trees are
 // skipped on a re-run unless --overwrite.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "apps/reconstruction_flags.hpp"
 #include "apps/summary_values.hpp"
 #include "core/atomic_file.hpp"
@@ -56,33 +57,16 @@ TreeOutputs outputs_for(const ReconstructCliOptions& o, const fs::path& input) {
             dir / (stem + "_summary.json")};
 }
 
-nlohmann::json options_json(const ReconstructCliOptions& o, const TreeSummary& s) {
-    const auto& k = o.stage.skeleton;
-    return {{"species", o.flags.species.empty() ? nlohmann::json() : nlohmann::json(o.flags.species)},
-            {"beta", k.beta},
-            {"gamma", o.stage.allometry.gamma},
-            {"fs", o.stage.allometry.fs},
-            {"neighbours", k.neighbours},
-            {"bin_width", rounded(s.bin_width)},
-            {"internode_length", rounded(s.internode_length)},
-            {"min_twig_length", k.min_twig_length},
-            {"smoothing_iterations", k.smoothing_iterations},
-            {"bridge_direction", k.bridge_direction},
-            {"max_gap", k.max_gap},
-            {"max_gap_points", k.max_gap_points},
-            {"cylinder_axes", o.stage.cylinder_axes.enabled},
-            {"root_diameter", o.stage.root_diameter},
-            {"voxel_size", o.stage.preprocess.voxel_size},
-            {"outlier_neighbours", o.stage.preprocess.outlier_neighbours},
-            {"outlier_sigma", o.stage.preprocess.outlier_sigma},
-            {"outlier_ratio", o.stage.preprocess.outlier_ratio},
-            {"outlier_test", o.outlier_test},
-            {"ground", o.flags.ground},
-            {"mesh_sides", o.mesh.sides},
-            {"mesh_subdivisions", o.mesh.subdivisions}};
+// Every flag's value; the bin width and internode length as worked out from the scan when their
+// flags leave them at 0.
+nlohmann::json options_json(const OptionTable& table, const TreeSummary& s) {
+    nlohmann::json options = table.json();
+    options["bin_width"] = rounded(s.bin_width);
+    options["internode_length"] = rounded(s.internode_length);
+    return options;
 }
 
-nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& input, const TreeOutputs& out,
+nlohmann::json summary_json(const ReconstructCliOptions& o, const OptionTable& table, const fs::path& input, const TreeOutputs& out,
                             const TreeReconstruction& r) {
     const TreeSummary& s = r.summary;
     nlohmann::json seconds = nlohmann::json::object();
@@ -94,7 +78,7 @@ nlohmann::json summary_json(const ReconstructCliOptions& o, const fs::path& inpu
     seconds["total"] = rounded(total);
     return {{"treelobes", kVersion},
             {"input", input.string()},
-            {"options", options_json(o, s)},
+            {"options", options_json(table, s)},
             {"points", {{"input", s.input_points}, {"used", s.used_points}, {"duplicates", s.duplicates},
                         {"outliers", s.outliers}, {"ground", s.ground_points}, {"beyond_gaps", s.detached_points},
                         {"outlier_test", o.stage.preprocess.outlier_neighbours == 0 ? "off" : s.local_outlier_test ? "local" : "global"},
@@ -146,7 +130,7 @@ void print_human(const fs::path& input, const TreeSummary& s, double seconds) {
 }
 
 // Runs one input; returns its summary. Throws treelobes::Error for bad input.
-nlohmann::json run_one(const ReconstructCliOptions& o, const fs::path& input, const TreeOutputs& out, const GlobalOptions& global) {
+nlohmann::json run_one(const ReconstructCliOptions& o, const OptionTable& table, const fs::path& input, const TreeOutputs& out, const GlobalOptions& global) {
     const auto start = std::chrono::steady_clock::now();
     const PointCloud cloud = read_point_cloud(input);
     TreeReconstruction r = reconstruct_tree(cloud, o.stage, input.string());
@@ -161,13 +145,13 @@ nlohmann::json run_one(const ReconstructCliOptions& o, const fs::path& input, co
     write_mesh(mesh, out.branches);
     write_points(cloud, r, out.points);
     r.summary.seconds.emplace_back("write", std::chrono::duration<double>(std::chrono::steady_clock::now() - mark).count());
-    nlohmann::json summary = summary_json(o, input, out, r);
+    nlohmann::json summary = summary_json(o, table, input, out, r);
     write_file_atomically(out.summary, summary.dump(2) + "\n");  // last: its presence marks a finished tree
     if (!global.json) print_human(input, r.summary, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     return summary;
 }
 
-int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
+int run_reconstruct(ReconstructCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     std::unique_ptr<tbb::global_control> threads;
     if (global.threads > 0)
         threads = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(global.threads));
@@ -191,7 +175,7 @@ int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
                 skipped.push_back(name);
                 continue;
             }
-            trees.push_back(run_one(o, input, out, global));
+            trees.push_back(run_one(o, table, input, out, global));
         } catch (const Error& e) {
             if (e.code() == ExitCode::Usage) throw;  // a bad option fails every tree alike
             std::cerr << "treelobes: error: " << e.what() << "\n";
@@ -219,88 +203,75 @@ int run_reconstruct(ReconstructCliOptions& o, const GlobalOptions& global) {
     return o.inputs.size() == 1 ? last_code : static_cast<int>(ExitCode::PartialFailure);
 }
 
-void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
+void add_flags(CLI::App* sub, OptionTable& table, ReconstructCliOptions& o) {
     sub->add_option("inputs", o.inputs, "Point clouds of single trees (LAS, PLY, PCD, XYZ/CSV)")->required();
-    sub->add_option("--out", o.out, "Output folder")->required();
-    add_species_flags(sub, o.flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')");
+    table.add("--out", o.out, "Output folder")->required();
+    add_species_flags(table, o.flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')", o.stage);
     auto& k = o.stage.skeleton;
-    sub->add_option("--neighbours", k.neighbours, "k of the neighbour graph")->check(CLI::Range(2, 64))->capture_default_str();
-    sub->add_option("--bin-width", k.bin_width, "Geodesic bin width in metres (0 = from point spacing)")->check(cli::NonNegativeNumber);
-    sub->add_option("--internode-length", k.internode_length, "Skeleton internode length in metres (0 = from point spacing)")
+    table.add("--neighbours", k.neighbours, "k of the neighbour graph")->check(CLI::Range(2, 64));
+    table.add("--bin-width", k.bin_width, "Geodesic bin width in metres (0 = 2.5 x the point sampling distance, kept within 0.02..0.5)")->check(cli::NonNegativeNumber);
+    table.add("--internode-length", k.internode_length, "Skeleton internode length in metres (0 = the bin width)")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--min-twig-length", k.min_twig_length, "Prune leaf branches shorter than this, metres (0 = two bins)")
+    table.add("--min-twig-length", k.min_twig_length, "Prune leaf branches shorter than this, metres (0 = two bins)")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--smoothing", k.smoothing_iterations, "Smoothing passes over the skeleton")->check(CLI::Range(0, 100))->capture_default_str();
-    sub->add_option("--geodesic-smoothing", k.geodesic_smoothing, "Neighbour-averaging passes over the geodesic field before binning")
-        ->check(CLI::Range(0, 50))->capture_default_str();
-    sub->add_option("--max-gap", k.max_gap, "Leave parts joined only across a longer gap (metres) out of the skeleton (0 = keep all)")
+    table.add("--smoothing", k.smoothing_iterations, "Smoothing passes over the skeleton")->check(CLI::Range(0, 100));
+    table.add("--geodesic-smoothing", k.geodesic_smoothing, "Neighbour-averaging passes over the geodesic field before binning")
+        ->check(CLI::Range(0, 50));
+    table.add("--max-gap", k.max_gap, "Leave parts joined only across a longer gap (metres) out of the skeleton (0 = keep all)")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--max-gap-points", k.max_gap_points, "With --max-gap: leave out only parts of fewer points (0 = any size)")
+    table.add("--max-gap-points", k.max_gap_points, "With --max-gap: leave out only parts of fewer points (0 = any size)")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--bridge-direction", k.bridge_direction,
-                    "Weight of the angle between a gap bridge and its piece's own axis (0 = shortest bridges)")
-        ->check(cli::NonNegativeNumber)
-        ->capture_default_str();
-    sub->add_option("--fit-axes", k.fit_axes, "Centre wide branch slices on fitted circles (true/false)")->capture_default_str();
-    sub->add_option("--recentre", o.stage.recentre.enabled,
-                    "Move thin internodes across onto the centroid of their own points (true/false): on leafy scans the "
-                    "skeleton otherwise runs beside branches hidden in foliage")
-        ->capture_default_str();
-    sub->add_option("--recentre-max-spread", o.stage.recentre.max_spread,
-                    "Internodes whose points spread wider than this (RMS around their centroid, metres) are thick and stay put")
-        ->check(cli::PositiveNumber)
-        ->capture_default_str();
-    sub->add_option("--recentre-inside-band", o.stage.recentre.inside_band,
-                    "Nodes closer to their points' centroid than this many spreads are inside their branch and stay put")
-        ->check(cli::NonNegativeNumber)
-        ->capture_default_str();
+    table.add("--bridge-direction", k.bridge_direction,
+              "Weight of the angle between a gap bridge and its piece's own axis (0 = shortest bridges)")
+        ->check(cli::NonNegativeNumber);
+    table.add("--fit-axes", k.fit_axes, "Centre wide branch slices on fitted circles (true/false)");
+    table.add("--recentre", o.stage.recentre.enabled,
+              "Move thin internodes across onto the centroid of their own points (true/false): on leafy scans the "
+              "skeleton otherwise runs beside branches hidden in foliage");
+    table.add("--recentre-max-spread", o.stage.recentre.max_spread,
+              "Internodes whose points spread wider than this (RMS around their centroid, metres) are thick and stay put")
+        ->check(cli::PositiveNumber);
+    table.add("--recentre-inside-band", o.stage.recentre.inside_band,
+              "Nodes closer to their points' centroid than this many spreads are inside their branch and stay put")
+        ->check(cli::NonNegativeNumber);
     auto& c = o.stage.cylinder_axes;
-    sub->add_option("--cylinder-axes", c.enabled,
-                    "Move nodes onto the axes of least-squares cylinders fitted to stretches of branch (true/false): sparse "
-                    "one-sided scans see only the scanner-facing arc of a branch, whose centroid lies off the axis. Off by "
-                    "default: it lowers the WoodSKE medians but raises archi tree1's against TreeQSM")
-        ->capture_default_str();
-    sub->add_option("--cylinder-window", c.window, "Metres of branch whose points one cylinder is fitted to")
-        ->check(cli::PositiveNumber)
-        ->capture_default_str();
-    sub->add_option("--cylinder-min-points", c.min_points, "Stretches with fewer points keep their nodes")
-        ->check(CLI::Range(6, 100000))
-        ->capture_default_str();
-    sub->add_option("--cylinder-max-rms", c.max_rms, "Fits whose RMS residual exceeds this many radii are not trusted")
-        ->check(cli::PositiveNumber)
-        ->capture_default_str();
-    sub->add_option("--cylinder-min-spread", c.min_spread,
-                    "Fits wider than the points' cross-section spread (RMS about each internode's centroid) over this many "
-                    "radii are not trusted: a bent twig fits a wide cylinder")
-        ->check(cli::NonNegativeNumber)
-        ->capture_default_str();
-    sub->add_option("--root-diameter", o.stage.root_diameter, "Stem diameter at the base in metres (0 = from the stem fit)")
+    table.add("--cylinder-axes", c.enabled,
+              "Move nodes onto the axes of least-squares cylinders fitted to stretches of branch (true/false): sparse "
+              "one-sided scans see only the scanner-facing arc of a branch, whose centroid lies off the axis. Off by "
+              "default: it lowers the WoodSKE medians but raises archi tree1's against TreeQSM");
+    table.add("--cylinder-window", c.window, "Metres of branch whose points one cylinder is fitted to")
+        ->check(cli::PositiveNumber);
+    table.add("--cylinder-min-points", c.min_points, "Stretches with fewer points keep their nodes")
+        ->check(CLI::Range(6, 100000));
+    table.add("--cylinder-max-rms", c.max_rms, "Fits whose RMS residual exceeds this many radii are not trusted")
+        ->check(cli::PositiveNumber);
+    table.add("--cylinder-min-spread", c.min_spread,
+              "Fits wider than the points' cross-section spread (RMS about each internode's centroid) over this many "
+              "radii are not trusted: a bent twig fits a wide cylinder")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--voxel-size", o.stage.preprocess.voxel_size, "Keep one point per voxel of this size in metres (0 = off)")
+    table.add("--root-diameter", o.stage.root_diameter, "Stem diameter at the base in metres (0 = from the stem fit)")
         ->check(cli::NonNegativeNumber);
-    sub->add_option("--outlier-neighbours", o.stage.preprocess.outlier_neighbours, "k of the outlier filter (0 = off)")
-        ->check(CLI::Range(0, 64))->capture_default_str();
-    sub->add_option("--outlier-test", o.outlier_test,
-                    "Outlier test: global (mean k-NN distance beyond the scan's mean + --outlier-sigma deviations), local "
-                    "(beyond --outlier-ratio times the neighbours' own: keeps the sparse twigs of leafy TLS scans), auto "
-                    "(local when few points have linear neighbourhoods, as in leafy crowns)")
-        ->check(CLI::IsMember({"auto", "global", "local"}))
-        ->capture_default_str();
-    sub->add_option("--outlier-ratio", o.stage.preprocess.outlier_ratio,
-                    "Local outlier test: drop points whose mean k-NN distance exceeds this many times their neighbours' own")
-        ->check(cli::PositiveNumber)
-        ->capture_default_str();
-    sub->add_option("--outlier-sigma", o.stage.preprocess.outlier_sigma,
-                    "Global outlier test: drop points whose mean k-NN distance exceeds the scan's mean + this many "
-                    "standard deviations")
-        ->check(cli::PositiveNumber)
-        ->capture_default_str();
-    sub->add_option("--mesh-sides", o.mesh.sides, "Vertices per ring of the branch mesh")->check(CLI::Range(3, 64))->capture_default_str();
-    sub->add_option("--mesh-subdivisions", o.mesh.subdivisions, "Rings per internode of the branch mesh")->check(CLI::Range(1, 16))
-        ->capture_default_str();
-    sub->add_option("--mesh-format", o.mesh_format, "Branch mesh format")->check(CLI::IsMember({"ply", "obj", "off"}))->capture_default_str();
-    sub->add_flag("--overwrite", o.overwrite, "Redo trees whose outputs exist");
-    sub->add_flag("--reject-non-trees", o.reject_non_trees, "Fail inputs flagged as not a tree instead of only flagging them");
+    table.add("--voxel-size", o.stage.preprocess.voxel_size, "Keep one point per voxel of this size in metres (0 = off)")
+        ->check(cli::NonNegativeNumber);
+    table.add("--outlier-neighbours", o.stage.preprocess.outlier_neighbours, "k of the outlier filter (0 = off)")
+        ->check(CLI::Range(0, 64));
+    table.add("--outlier-test", o.outlier_test,
+              "Outlier test: global (mean k-NN distance beyond the scan's mean + --outlier-sigma deviations), local "
+              "(beyond --outlier-ratio times the neighbours' own: keeps the sparse twigs of leafy TLS scans), auto "
+              "(local when few points have linear neighbourhoods, as in leafy crowns)")
+        ->check(CLI::IsMember({"auto", "global", "local"}));
+    table.add("--outlier-ratio", o.stage.preprocess.outlier_ratio,
+              "Local outlier test: drop points whose mean k-NN distance exceeds this many times their neighbours' own")
+        ->check(cli::PositiveNumber);
+    table.add("--outlier-sigma", o.stage.preprocess.outlier_sigma,
+              "Global outlier test: drop points whose mean k-NN distance exceeds the scan's mean + this many "
+              "standard deviations")
+        ->check(cli::PositiveNumber);
+    table.add("--mesh-sides", o.mesh.sides, "Vertices per ring of the branch mesh")->check(CLI::Range(3, 64));
+    table.add("--mesh-subdivisions", o.mesh.subdivisions, "Rings per internode of the branch mesh")->check(CLI::Range(1, 16));
+    table.add("--mesh-format", o.mesh_format, "Branch mesh format")->check(CLI::IsMember({"ply", "obj", "off"}));
+    table.add_flag("--overwrite", o.overwrite, "Redo trees whose outputs exist");
+    table.add_flag("--reject-non-trees", o.reject_non_trees, "Fail inputs flagged as not a tree instead of only flagging them");
 }
 
 }  // namespace
@@ -308,8 +279,11 @@ void add_flags(CLI::App* sub, ReconstructCliOptions& o) {
 void add_reconstruct_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<ReconstructCliOptions>();
     CLI::App* sub = app.add_subcommand("reconstruct", "Skeleton, radii, branch mesh and summary of single-tree scans");
-    add_flags(sub, *options);
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_reconstruct(*options, global); }; });
+    auto table = std::make_shared<OptionTable>(sub);
+    add_flags(sub, *table, *options);
+    sub->callback([options, table, &global, &job] {
+        job = [options, table, &global] { return run_reconstruct(*options, *table, global); };
+    });
 }
 
 }  // namespace treelobes::cli

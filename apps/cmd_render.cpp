@@ -5,6 +5,7 @@
 // by their treeID attribute, radius|order colours skeletons by radius or branch order (inputs
 // the colouring does not apply to keep their plain colour).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/file_info.hpp"
@@ -129,7 +130,7 @@ render::View make_view(const RenderOptions& o, const Eigen::Vector3d& lo, const 
     return render::View::side(lo, hi, o.azimuth, o.elevation);
 }
 
-int run_render(const RenderOptions& options, const GlobalOptions& global) {
+int run_render(const RenderOptions& options, const OptionTable& table, const GlobalOptions& global) {
     std::vector<Drawable> items;
     for (const auto& input : options.inputs) items.push_back(load(input));
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
@@ -141,7 +142,7 @@ int run_render(const RenderOptions& options, const GlobalOptions& global) {
     std::vector<render::Image> panels;
     for (std::size_t i = 0; i < items.size(); ++i) panels.push_back(draw(items[i], options.inputs[i], options, view, width, options.size));
     render::write_png(render::side_by_side(panels), options.out);
-    if (global.json) std::cout << nlohmann::json{{"out", options.out}, {"panels", panels.size()}}.dump(2) << "\n";
+    if (global.json) std::cout << nlohmann::json{{"out", options.out}, {"options", table.json()}, {"panels", panels.size()}}.dump(2) << "\n";
     else std::cout << "wrote " << options.out << " (" << panels.size() << " panel(s))\n";
     return 0;
 }
@@ -151,17 +152,18 @@ int run_render(const RenderOptions& options, const GlobalOptions& global) {
 void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<RenderOptions>();
     CLI::App* sub = app.add_subcommand("render", "Draw point clouds, meshes and skeletons side by side into a PNG");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("inputs", options->inputs, "Point clouds, meshes (PLY/OBJ/OFF) or skeleton PLYs")->required();
-    sub->add_option("--out,-o", options->out, "Output PNG")->required();
-    sub->add_option("--size", options->size, "Panel height in pixels")->check(CLI::Range(64, 4096))->capture_default_str();
-    sub->add_option("--azimuth", options->azimuth, "View direction around the vertical axis, degrees")->capture_default_str();
-    sub->add_option("--elevation", options->elevation, "View elevation above the horizon, degrees")
-        ->check(CLI::Range(-90.0, 90.0))->capture_default_str();
-    sub->add_option("--view", options->view, "front (along +y), side (along -x) or top (down); overrides --azimuth/--elevation")
+    table->add("--out,-o", options->out, "Output PNG")->required();
+    table->add("--size", options->size, "Panel height in pixels")->check(CLI::Range(64, 4096));
+    table->add("--azimuth", options->azimuth, "View direction around the vertical axis, degrees");
+    table->add("--elevation", options->elevation, "View elevation above the horizon, degrees")
+        ->check(CLI::Range(-90.0, 90.0));
+    table->add("--view", options->view, "front (along +y), side (along -x) or top (down); overrides --azimuth/--elevation")
         ->check(CLI::IsMember({"front", "side", "top"}));
-    sub->add_option("--color", options->colour, "plain; clouds: height or tree (treeID); skeletons: radius or order (branch order)")
-        ->check(CLI::IsMember({"plain", "height", "tree", "radius", "order"}))->capture_default_str();
-    sub->callback([options, &global, &job] { job = [options, &global] { return run_render(*options, global); }; });
+    table->add("--color", options->colour, "plain; clouds: height or tree (treeID); skeletons: radius or order (branch order)")
+        ->check(CLI::IsMember({"plain", "height", "tree", "radius", "order"}));
+    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_render(*options, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

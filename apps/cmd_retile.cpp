@@ -2,6 +2,7 @@
 // square LAS 1.4 tiles named by their lower-left corner, so a survey delivered as a few huge
 // files can be run by `treelobes batch` (docs/survey.md).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "core/cloud_header.hpp"
 #include "core/error.hpp"
 #include "core/memory_limit.hpp"
@@ -27,7 +28,7 @@ struct RetileCliOptions {
     survey::RetileOptions retile;
 };
 
-int run_retile(const RetileCliOptions& o, const GlobalOptions& global) {
+int run_retile(const RetileCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const double budget = o.max_memory.empty() ? default_memory_budget_bytes() : parse_memory_size(o.max_memory);
     std::size_t points = 0;
     for (const std::string& input : o.inputs) points += header_point_count(input);
@@ -42,7 +43,7 @@ int run_retile(const RetileCliOptions& o, const GlobalOptions& global) {
         written_points += tile.points;
     }
     if (global.json) {
-        const nlohmann::json summary = {{"command", "retile"}, {"inputs", o.inputs}, {"size", o.retile.size},
+        const nlohmann::json summary = {{"command", "retile"}, {"inputs", o.inputs}, {"options", table.json()}, {"size", o.retile.size},
                                         {"points", written_points}, {"tiles", listed}};
         std::cout << summary.dump(2) << "\n";
     } else {
@@ -58,13 +59,14 @@ void add_retile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<RetileCliOptions>();
     CLI::App* sub = app.add_subcommand("retile", "Cut point clouds into square LAS 1.4 tiles (CRS, scale and offset kept), named by their "
                                                  "lower-left corner, for `treelobes batch` (docs/survey.md)");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("inputs", o->inputs, "Point clouds (LAS, PLY, PCD, XYZ), one CRS")->required()->check(CLI::ExistingFile);
-    sub->add_option("--size", o->retile.size, "Tile side, metres")->required()->check(PositiveNumber);
-    sub->add_option("--out", o->out, "Output folder")->required();
-    sub->add_option("--prefix", o->retile.prefix, "File name prefix: <prefix>_<x>_<y>.las")->capture_default_str();
-    sub->add_option("--max-memory", o->max_memory, "Refuse inputs whose header point counts need more memory than this (e.g. 8G; default: "
-                                                   "half of the RAM)");
-    sub->callback([o, &global, &job] { job = [o, &global] { return run_retile(*o, global); }; });
+    table->add("--size", o->retile.size, "Tile side, metres")->required()->check(PositiveNumber);
+    table->add("--out", o->out, "Output folder")->required();
+    table->add("--prefix", o->retile.prefix, "File name prefix: <prefix>_<x>_<y>.las");
+    table->add("--max-memory", o->max_memory, "Refuse inputs whose header point counts need more memory than this (e.g. 8G; default: "
+                                              "half of the RAM)");
+    sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_retile(*o, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

@@ -5,6 +5,7 @@
 //            skeletons/tree_<id>.ply
 // Every run is determined by --seed; summary.json records options, counts, timings and memory.
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "apps/summary_values.hpp"
 #include "config/species_profile.hpp"
 #include "core/atomic_file.hpp"
@@ -77,35 +78,35 @@ struct TileFlags {
     double station_spacing = 20;
 };
 
-void add_scan_flags(CLI::App* sub, SynthFlags& f) {
-    sub->add_option("--scanner", f.scanner, "tls (terrestrial) or als (airborne)")->check(CLI::IsMember({"tls", "als"}));
-    sub->add_option("--stations", f.tls.stations, "TLS stations around the scene (1-16)");
-    sub->add_option("--station-distance", f.tls.station_distance_m, "TLS distance of the stations from the trees, m (0 = auto)");
-    sub->add_option("--angular-step", f.tls.angular_step_deg, "TLS angular step, degrees");
-    sub->add_option("--max-range", f.tls.max_range_m, "TLS maximum range, m");
-    sub->add_option("--pulse-density", f.als.pulse_density, "ALS pulses per m^2 (one strip)");
-    sub->add_option("--altitude", f.als.altitude_m, "ALS flying height above the ground, m");
-    sub->add_option("--scan-angle", f.als.max_scan_angle_deg, "ALS maximum scan angle, +- degrees");
-    sub->add_option("--strip-overlap", f.als.strip_overlap, "ALS overlap of neighbouring strips (0-0.9)");
-    sub->add_option("--divergence", f.divergence, "Beam divergence, mrad (TLS 0.3, ALS 0.5)");
-    sub->add_option("--sub-rays", f.sub_rays, "Rays per pulse across the beam: 1, 7, 19 or 37 (TLS 1, ALS 19)");
-    sub->add_option("--noise", f.noise, "Gaussian range noise sigma, m (TLS 0.005, ALS 0.03)");
-    sub->add_option("--max-returns", f.max_returns, "Returns recorded per pulse (TLS 1, ALS 5)");
-    sub->add_option("--return-separation", f.separation, "Minimum distance between returns, m (TLS 0.5, ALS 1.5)");
-    sub->add_option("--detection-threshold", f.threshold, "Energy a return needs, fraction of the pulse (TLS 0.02, ALS 0.05)");
-    sub->add_option("--outliers", f.outliers, "Fraction of scattered noise points added (class 7)");
+void add_scan_flags(OptionTable& table, SynthFlags& f) {
+    table.add("--scanner", f.scanner, "tls (terrestrial) or als (airborne)")->check(CLI::IsMember({"tls", "als"}));
+    table.add("--stations", f.tls.stations, "TLS stations around the scene (1-16)");
+    table.add("--station-distance", f.tls.station_distance_m, "TLS distance of the stations from the trees, m (0 = auto)");
+    table.add("--angular-step", f.tls.angular_step_deg, "TLS angular step, degrees");
+    table.add("--max-range", f.tls.max_range_m, "TLS maximum range, m");
+    table.add("--pulse-density", f.als.pulse_density, "ALS pulses per m^2 (one strip)");
+    table.add("--altitude", f.als.altitude_m, "ALS flying height above the ground, m");
+    table.add("--scan-angle", f.als.max_scan_angle_deg, "ALS maximum scan angle, +- degrees");
+    table.add("--strip-overlap", f.als.strip_overlap, "ALS overlap of neighbouring strips (0-0.9)");
+    table.add("--divergence", f.divergence, "Beam divergence, mrad (TLS 0.3, ALS 0.5)");
+    table.add("--sub-rays", f.sub_rays, "Rays per pulse across the beam: 1, 7, 19 or 37 (TLS 1, ALS 19)");
+    table.add("--noise", f.noise, "Gaussian range noise sigma, m (TLS 0.005, ALS 0.03)");
+    table.add("--max-returns", f.max_returns, "Returns recorded per pulse (TLS 1, ALS 5)");
+    table.add("--return-separation", f.separation, "Minimum distance between returns, m (TLS 0.5, ALS 1.5)");
+    table.add("--detection-threshold", f.threshold, "Energy a return needs, fraction of the pulse (TLS 0.02, ALS 0.05)");
+    table.add("--outliers", f.outliers, "Fraction of scattered noise points added (class 7)");
 }
 
-void add_common_flags(CLI::App* sub, SynthFlags& f) {
-    sub->add_option("--out", f.out, "Output folder (created if missing)")->required();
-    sub->add_option("--seed", f.seed, "Random seed: the same seed gives byte-identical files");
-    sub->add_option("--species-file", f.species_file, "Species library (default: config/species.yaml or $TREELOBES_SPECIES)");
-    sub->add_option("--cloud-format", f.cloud_format, "Scan file format: las or ply")->check(CLI::IsMember({"las", "ply"}));
-    sub->add_option("--leaf-density", f.grow.leaf_density, "Leaves x this, each 1/sqrt(this) larger: same leaf area (0.001-4)");
-    sub->add_option("--max-leaves", f.grow.max_leaves, "Leaf budget per tree; beyond it leaves get fewer and larger");
-    sub->add_flag("--no-leaves", f.no_leaves, "Leafless trees");
-    sub->add_flag("--overwrite", f.overwrite, "Replace existing outputs (default: keep finished ones)");
-    add_scan_flags(sub, f);
+void add_common_flags(OptionTable& table, SynthFlags& f) {
+    table.add("--out", f.out, "Output folder (created if missing)")->required();
+    table.add("--seed", f.seed, "Random seed: the same seed gives byte-identical files");
+    table.add("--species-file", f.species_file, "Species library (default: config/species.yaml or $TREELOBES_SPECIES)");
+    table.add("--cloud-format", f.cloud_format, "Scan file format: las or ply")->check(CLI::IsMember({"las", "ply"}));
+    table.add("--leaf-density", f.grow.leaf_density, "Leaves x this, each 1/sqrt(this) larger: same leaf area (0.001-4)");
+    table.add("--max-leaves", f.grow.max_leaves, "Leaf budget per tree; beyond it leaves get fewer and larger");
+    table.add_flag("--no-leaves", f.no_leaves, "Leafless trees");
+    table.add_flag("--overwrite", f.overwrite, "Replace existing outputs (default: keep finished ones)");
+    add_scan_flags(table, f);
 }
 
 // Resolves the beam flags onto the chosen scanner's options.
@@ -118,8 +119,8 @@ void apply_beam(SynthFlags& f) {
     if (f.separation) beam.min_separation_m = *f.separation;
     if (f.threshold) beam.detection_threshold = *f.threshold;
     f.grow.leaves = !f.no_leaves;
-    if (f.scanner == "als") synth::validate(f.als);
-    else synth::validate(f.tls);
+    if (f.scanner == "als") synth::check_options(f.als);
+    else synth::check_options(f.tls);
 }
 
 json beam_json(const synth::BeamOptions& b) {
@@ -262,7 +263,7 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0) {
     return text;
 }
 
-int run_tree(SynthFlags f, const TreeFlags& t, const GlobalOptions& global) {
+int run_tree(SynthFlags f, const TreeFlags& t, const OptionTable& table, const GlobalOptions& global) {
     const auto start = Clock::now();
     if (f.scanner.empty()) f.scanner = "tls";
     apply_beam(f);
@@ -274,6 +275,7 @@ int run_tree(SynthFlags f, const TreeFlags& t, const GlobalOptions& global) {
 
     json summary = r.truth;
     summary["treelobes"] = kVersion;
+    summary["options"] = table.json();
     summary["scanner"] = scanner_json(f);
     summary["outputs"] = json::array();
     for (const std::string& suffix : {"." + f.cloud_format, std::string("_skeleton.ply"), std::string("_truth.json")})
@@ -309,7 +311,7 @@ std::string labels_row(const std::string& file, const json& truth) {
     return line;
 }
 
-int run_dataset(SynthFlags f, const DatasetFlags& d, const GlobalOptions& global) {
+int run_dataset(SynthFlags f, const DatasetFlags& d, const OptionTable& table, const GlobalOptions& global) {
     const auto start = Clock::now();
     if (f.scanner.empty()) f.scanner = "tls";
     apply_beam(f);
@@ -360,6 +362,7 @@ int run_dataset(SynthFlags f, const DatasetFlags& d, const GlobalOptions& global
 
     json summary = {{"treelobes", kVersion},
                     {"command", "synth dataset"},
+                    {"options", table.json()},
                     {"seed", f.seed},
                     {"per_species", d.per_species},
                     {"species", json::array()},
@@ -390,7 +393,7 @@ std::vector<Eigen::Vector2d> station_grid(double size, double spacing) {
     return stations;
 }
 
-int run_tile(SynthFlags f, TileFlags t, const GlobalOptions& global) {
+int run_tile(SynthFlags f, TileFlags t, const OptionTable& table, const GlobalOptions& global) {
     const auto start = Clock::now();
     if (f.scanner.empty()) f.scanner = "als";
     apply_beam(f);
@@ -433,6 +436,7 @@ int run_tile(SynthFlags f, TileFlags t, const GlobalOptions& global) {
     const double area = t.tile.size_m * t.tile.size_m;
     json summary = {{"treelobes", kVersion},
                     {"command", "synth tile"},
+                    {"options", table.json()},
                     {"seed", f.seed},
                     {"tile", {{"size_m", t.tile.size_m}, {"trees", tile.scene.trees.size()}, {"slope_deg", t.tile.slope_deg},
                               {"understory_per_100m2", t.tile.understory_per_100m2}, {"understory_blades", tile.scene.understory.size()}}},
@@ -463,16 +467,19 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto tree_flags = std::make_shared<SynthFlags>();
     auto tree = std::make_shared<TreeFlags>();
     CLI::App* tree_cmd = synth->add_subcommand("tree", "One tree: scan, true skeleton, mesh and truth");
-    tree_cmd->add_option("--species", tree->species, "Species name (see config/species.yaml)")->required();
-    tree_cmd->add_option("--height", tree->height, "Tree height, m (default: drawn from the species' range)");
-    tree_cmd->add_option("--ground-margin", tree->ground_margin, "Ground scanned beyond the crown, m");
-    tree_cmd->add_flag("--no-mesh", tree->no_mesh, "Do not write the tree mesh");
-    tree_cmd->add_option("--mesh-format", tree->mesh_format, "Tree mesh file: ply (geometry) or obj (objects, groups and materials: bark / leaf)")
-        ->check(CLI::IsMember({"ply", "obj"}))->capture_default_str();
-    tree_cmd->add_flag("--preview", tree_flags->preview, "Also write <name>_mesh.png, <name>_scan.png and both side by side, <name>_preview.png");
-    tree_cmd->add_option("--preview-height", tree_flags->preview_height, "Height of the preview PNGs, pixels")->check(CLI::Range(64, 4096));
-    add_common_flags(tree_cmd, *tree_flags);
-    tree_cmd->callback([tree_flags, tree, &global, &job] { job = [tree_flags, tree, &global] { return run_tree(*tree_flags, *tree, global); }; });
+    auto tree_table = std::make_shared<OptionTable>(tree_cmd);
+    tree_table->add("--species", tree->species, "Species name (see config/species.yaml)")->required();
+    tree_table->add("--height", tree->height, "Tree height, m (default: drawn from the species' range)");
+    tree_table->add("--ground-margin", tree->ground_margin, "Ground scanned beyond the crown, m");
+    tree_table->add_flag("--no-mesh", tree->no_mesh, "Do not write the tree mesh");
+    tree_table->add("--mesh-format", tree->mesh_format, "Tree mesh file: ply (geometry) or obj (objects, groups and materials: bark / leaf)")
+        ->check(CLI::IsMember({"ply", "obj"}));
+    tree_table->add_flag("--preview", tree_flags->preview, "Also write <name>_mesh.png, <name>_scan.png and both side by side, <name>_preview.png");
+    tree_table->add("--preview-height", tree_flags->preview_height, "Height of the preview PNGs, pixels")->check(CLI::Range(64, 4096));
+    add_common_flags(*tree_table, *tree_flags);
+    tree_cmd->callback([tree_flags, tree, tree_table, &global, &job] {
+        job = [tree_flags, tree, tree_table, &global] { return run_tree(*tree_flags, *tree, *tree_table, global); };
+    });
 
     auto data_flags = std::make_shared<SynthFlags>();
     auto data = std::make_shared<DatasetFlags>();
@@ -480,28 +487,34 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     data_flags->tls.angular_step_deg = 0.25;
     data_flags->grow.max_leaves = 100000;
     CLI::App* data_cmd = synth->add_subcommand("dataset", "K scanned trees per species with labels.csv");
-    data_cmd->add_option("--per-species", data->per_species, "Trees per species");
-    data_cmd->add_option("--species", data->species, "Species to include (default: all)");
-    data_cmd->add_flag("--mesh", data->mesh, "Also write tree meshes");
-    add_common_flags(data_cmd, *data_flags);
-    data_cmd->callback([data_flags, data, &global, &job] { job = [data_flags, data, &global] { return run_dataset(*data_flags, *data, global); }; });
+    auto data_table = std::make_shared<OptionTable>(data_cmd);
+    data_table->add("--per-species", data->per_species, "Trees per species");
+    data_table->add("--species", data->species, "Species to include (default: all)");
+    data_table->add_flag("--mesh", data->mesh, "Also write tree meshes");
+    add_common_flags(*data_table, *data_flags);
+    data_cmd->callback([data_flags, data, data_table, &global, &job] {
+        job = [data_flags, data, data_table, &global] { return run_dataset(*data_flags, *data, *data_table, global); };
+    });
 
     auto tile_flags = std::make_shared<SynthFlags>();
     auto tile = std::make_shared<TileFlags>();
     tile_flags->grow.max_leaves = 20000;  // hundreds of trees must fit in memory; leaf area is kept
     tile_flags->outliers = 0.0005;
     CLI::App* tile_cmd = synth->add_subcommand("tile", "A forest tile: LAS 1.4 with tree labels, truth.csv, skeletons");
-    tile_cmd->add_option("--trees", tile->tile.trees, "Number of trees");
-    tile_cmd->add_option("--size", tile->tile.size_m, "Tile side, m");
-    tile_cmd->add_option("--species", tile->tile.species, "Species to mix (default: all)");
-    tile_cmd->add_option("--slope", tile->tile.slope_deg, "Terrain slope, degrees");
-    tile_cmd->add_option("--roughness", tile->tile.roughness_m, "Terrain roughness amplitude, m");
-    tile_cmd->add_option("--understory", tile->tile.understory_per_100m2, "Bushes per 100 m^2 (0 = none)");
-    tile_cmd->add_option("--spacing", tile->tile.spacing, "Minimum stem distance as a fraction of the summed crown radii");
-    tile_cmd->add_option("--origin", tile->origin, "Coordinates of the tile corner: X Y Z")->expected(3);
-    tile_cmd->add_option("--station-spacing", tile->station_spacing, "TLS: distance between stations on the grid, m");
-    add_common_flags(tile_cmd, *tile_flags);
-    tile_cmd->callback([tile_flags, tile, &global, &job] { job = [tile_flags, tile, &global] { return run_tile(*tile_flags, *tile, global); }; });
+    auto tile_table = std::make_shared<OptionTable>(tile_cmd);
+    tile_table->add("--trees", tile->tile.trees, "Number of trees");
+    tile_table->add("--size", tile->tile.size_m, "Tile side, m");
+    tile_table->add("--species", tile->tile.species, "Species to mix (default: all)");
+    tile_table->add("--slope", tile->tile.slope_deg, "Terrain slope, degrees");
+    tile_table->add("--roughness", tile->tile.roughness_m, "Terrain roughness amplitude, m");
+    tile_table->add("--understory", tile->tile.understory_per_100m2, "Bushes per 100 m^2 (0 = none)");
+    tile_table->add("--spacing", tile->tile.spacing, "Minimum stem distance as a fraction of the summed crown radii");
+    tile_table->add("--origin", tile->origin, "Coordinates of the tile corner: X Y Z")->expected(3);
+    tile_table->add("--station-spacing", tile->station_spacing, "TLS: distance between stations on the grid, m");
+    add_common_flags(*tile_table, *tile_flags);
+    tile_cmd->callback([tile_flags, tile, tile_table, &global, &job] {
+        job = [tile_flags, tile, tile_table, &global] { return run_tile(*tile_flags, *tile, *tile_table, global); };
+    });
 }
 
 }  // namespace treelobes::cli

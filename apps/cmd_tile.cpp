@@ -7,6 +7,7 @@
 // buffer are read too, and the tile keeps the trees whose stem base lies in its core
 // (survey/buffered_tile.hpp); every tree gets a survey-wide id from its base (survey/tree_id.hpp).
 #include "apps/command.hpp"
+#include "apps/option_table.hpp"
 #include "apps/summary_values.hpp"
 #include "classify/jointboost.hpp"
 #include "core/atomic_file.hpp"
@@ -117,18 +118,13 @@ json tree_options_json(const TileCliOptions& o) {
             {"model", o.model}};
 }
 
-json options_json(const TileCliOptions& o, const TreeSegmentation& segmentation) {
-    return {{"mode", o.mode},
-            {"mode_used", o.use_input_segmentation ? "input" : scan_mode_name(segmentation.mode_used)},
-            {"mode_reason", o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason},
-            {"use_input_segmentation", o.use_input_segmentation},
-            {"dtm_cell", o.terrain.cell_size},
-            {"min_tree_height", o.segment.min_tree_height},
-            {"vote_radius", o.voting.radius_m},
-            {"vote_confidence", o.voting.confidence_factor},
-            {"buffer", o.buffer},
-            {"tile_size", o.tile_size},
-            {"trees", tree_options_json(o)}};
+// Every flag's value, the segmentation mode the tile got, and the per-tree options.
+json options_json(const OptionTable& table, const TileCliOptions& o, const TreeSegmentation& segmentation) {
+    json options = table.json();
+    options["mode_used"] = o.use_input_segmentation ? "input" : scan_mode_name(segmentation.mode_used);
+    options["mode_reason"] = o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason;
+    options["trees"] = tree_options_json(o);
+    return options;
 }
 
 // Per-point tree ids: the input's treeID (--use-input-segmentation) or a fresh segmentation, in
@@ -306,7 +302,7 @@ json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::
             {"neighbours_skipped", buffered.neighbours_skipped}};
 }
 
-int run_tile(TileCliOptions& o, const GlobalOptions& global) {
+int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const auto start = Clock::now();
     auto mark = start;
     json seconds = json::object();
@@ -356,7 +352,7 @@ int run_tile(TileCliOptions& o, const GlobalOptions& global) {
                                 " points are ground); the outputs list none");
 
     // Trees finished by an earlier run are read back; the others go through the pipeline.
-    const json options = options_json(o, segmentation);
+    const json options = options_json(table, o, segmentation);
     const std::string key = tree_options_json(o).dump();
     std::vector<forestry::TreeOutcome> outcomes(trees.size());
     std::vector<std::size_t> lobe_counts(trees.size(), 0);
@@ -501,36 +497,37 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand(
         "tile", "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
                 "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
+    auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, LAZ or COPC, PLY, PCD or XYZ/CSV")->required();
-    sub->add_option("--out", o->out, "Output folder")->required();
-    sub->add_option("--mode", o->mode, "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
-                                       "paths) or auto (from the point density)")
-        ->check(CLI::IsMember({"auto", "als", "tls"}))->capture_default_str();
-    sub->add_flag("--use-input-segmentation", o->use_input_segmentation,
-                  "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
-    sub->add_option("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");
-    sub->add_option("--vote-radius", o->voting.radius_m, "Spatial voting neighbourhood, metres")->check(NonNegativeNumber)->capture_default_str();
-    sub->add_option("--vote-confidence", o->voting.confidence_factor, "A tree is confident when h1 > factor * h2")
-        ->check(CLI::Range(1.0, 100.0))->capture_default_str();
-    sub->add_option("--dtm-cell", o->terrain.cell_size, "DTM cell size, metres")->check(PositiveNumber)->capture_default_str();
-    sub->add_option("--min-tree-height", o->segment.min_tree_height, "Lower tops are not trees, metres above ground")
-        ->check(PositiveNumber)->capture_default_str();
-    sub->add_option("--min-tree-points", o->trees.min_points, "Trees with fewer points fail (listed in failures.jsonl)")
-        ->check(CLI::Range(10, 100000000))->capture_default_str();
-    sub->add_option("--outlier-test", o->outlier_test, "Outlier test of the per-tree reconstruction: auto, global, local")
-        ->check(CLI::IsMember({"auto", "global", "local"}))->capture_default_str();
-    sub->add_option("--lobe-shape-points", o->trees.lobes.max_shape_points, "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
-        ->check(CLI::Range(100, 10000000))->capture_default_str();
-    sub->add_option("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")
-        ->check(CLI::Range(1.0, 64.0))->capture_default_str();
-    sub->add_option("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16))->capture_default_str();
-    sub->add_option("--map-size", o->map_px, "Longer side of top_view.png, pixels")->check(CLI::Range(200, 20000))->capture_default_str();
-    sub->add_option("--buffer", o->buffer, "Also read the neighbouring tiles' points within this many metres of the tile's core; the tile keeps the trees whose stem base lies in its core (docs/survey.md)")->check(NonNegativeNumber);
-    sub->add_option("--neighbours", o->neighbours, "With --buffer: the neighbouring tiles, a folder, a quoted pattern or a list file (default: the tile's folder)");
-    sub->add_option("--tile-size", o->tile_size, "With --buffer: the tile is a `retile` square of this side, its core [x, x+size) x [y, y+size) from its name <prefix>_<x>_<y> (default: the header's bounds)")->check(PositiveNumber);
-    sub->add_option("--max-memory", o->max_memory, "Refuse the tile before reading it when its header point count (buffer included) needs more memory than this (e.g. 8G; default: half of the RAM)");
-    sub->add_flag("--overwrite", o->overwrite, "Redo outputs and trees that exist from an earlier run");
-    sub->callback([o, &global, &job] { job = [o, &global] { return run_tile(*o, global); }; });
+    table->add("--out", o->out, "Output folder")->required();
+    table->add("--mode", o->mode, "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
+                                  "paths) or auto (from the point density)")
+        ->check(CLI::IsMember({"auto", "als", "tls"}));
+    table->add_flag("--use-input-segmentation", o->use_input_segmentation,
+                    "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
+    table->add("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");
+    table->add("--vote-radius", o->voting.radius_m, "Spatial voting neighbourhood, metres")->check(NonNegativeNumber);
+    table->add("--vote-confidence", o->voting.confidence_factor, "A tree is confident when h1 > factor * h2")
+        ->check(CLI::Range(1.0, 100.0));
+    table->add("--dtm-cell", o->terrain.cell_size, "DTM cell size, metres")->check(PositiveNumber);
+    table->add("--min-tree-height", o->segment.min_tree_height, "Lower tops are not trees, metres above ground")
+        ->check(PositiveNumber);
+    table->add("--min-tree-points", o->trees.min_points, "Trees with fewer points fail (listed in failures.jsonl)")
+        ->check(CLI::Range(10, 100000000));
+    table->add("--outlier-test", o->outlier_test, "Outlier test of the per-tree reconstruction: auto, global, local")
+        ->check(CLI::IsMember({"auto", "global", "local"}));
+    table->add("--lobe-shape-points", o->trees.lobes.max_shape_points, "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
+        ->check(CLI::Range(100, 10000000));
+    table->add("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")
+        ->check(CLI::Range(1.0, 64.0));
+    table->add("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16));
+    table->add("--map-size", o->map_px, "Longer side of top_view.png, pixels")->check(CLI::Range(200, 20000));
+    table->add("--buffer", o->buffer, "Also read the neighbouring tiles' points within this many metres of the tile's core; the tile keeps the trees whose stem base lies in its core (docs/survey.md)")->check(NonNegativeNumber);
+    table->add("--neighbours", o->neighbours, "With --buffer: the neighbouring tiles, a folder, a quoted pattern or a list file (default: the tile's folder)");
+    table->add("--tile-size", o->tile_size, "With --buffer: the tile is a `retile` square of this side, its core [x, x+size) x [y, y+size) from its name <prefix>_<x>_<y> (default: the header's bounds)")->check(PositiveNumber);
+    table->add("--max-memory", o->max_memory, "Refuse the tile before reading it when its header point count (buffer included) needs more memory than this (e.g. 8G; default: half of the RAM)");
+    table->add_flag("--overwrite", o->overwrite, "Redo outputs and trees that exist from an earlier run");
+    sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_tile(*o, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

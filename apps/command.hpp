@@ -62,6 +62,9 @@ inline Box3d parse_bounds(const std::string& text) {
     return box;
 }
 
+// Every subcommand above, in the order of `treelobes --help`.
+void add_commands(CLI::App& app, const GlobalOptions& global, Job& job);
+
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_convert_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job);

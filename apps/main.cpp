@@ -33,22 +33,7 @@ int run(int argc, char** argv) {
     add_global_flags(app, global);
 
     cli::Job job;
-    cli::add_info_command(app, global, job);
-    cli::add_convert_command(app, global, job);
-    cli::add_multires_command(app, global, job);
-    cli::add_reconstruct_command(app, global, job);
-    cli::add_eval_command(app, global, job);
-    cli::add_encode_commands(app, global, job);
-    cli::add_render_command(app, global, job);
-    cli::add_synth_command(app, global, job);
-    cli::add_classify_command(app, global, job);
-    cli::add_lobes_commands(app, global, job);
-    cli::add_export_command(app, global, job);
-    cli::add_rebuild_command(app, global, job);
-    cli::add_tile_command(app, global, job);
-    cli::add_batch_command(app, global, job);
-    cli::add_merge_command(app, global, job);
-    cli::add_retile_command(app, global, job);
+    cli::add_commands(app, global, job);
 
     try {
         app.parse(argc, argv);

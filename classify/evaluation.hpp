@@ -136,7 +136,8 @@ std::string genus_of(const std::string& scientific_name);
 // the set has groups), per_species.csv, confusion_<name>.csv and .png (row-normalised percentages
 // as seed 001 Fig. 7), per_tree_<name>.csv (how often each tree was tested, right, and its most
 // frequent wrong species), site_confusion_<name>.csv when a site split ran, report.md.
-void write_report(const EvaluationReport& report, const EvaluationOptions& options, const std::string& directory,
+// `extra_json` holds the summary.json fields the caller adds (the command and its options).
+void write_report(const EvaluationReport& report, const std::string& directory,
                   const std::string& extra_json = "{}");
 
 // The human summary printed by `classify evaluate`.

@@ -176,7 +176,7 @@ void write_per_tree_csv(const EvaluationReport& report, const Scores& scores, co
 
 }  // namespace
 
-void write_report(const EvaluationReport& report, const EvaluationOptions& options, const std::string& directory,
+void write_report(const EvaluationReport& report, const std::string& directory,
                   const std::string& extra_json) {
     const std::filesystem::path dir(directory);
     std::error_code ec;
@@ -184,11 +184,6 @@ void write_report(const EvaluationReport& report, const EvaluationOptions& optio
     if (ec) throw Error::input(directory, "cannot create the report folder (" + ec.message() + ")");
     json summary = json::parse(extra_json);
     summary["classes"] = report.classes;
-    summary["options"] = {{"splits", options.splits},
-                          {"train_fraction", options.train_fraction},
-                          {"seed", options.seed},
-                          {"confidence_factor", options.voting.confidence_factor},
-                          {"voting_radius_m", options.voting.radius_m}};
     summary["site_groups"] = report.site_groups;
     summary["mode"] = report.mode;
     if (!report.site_split_note.empty()) summary["site_split_note"] = report.site_split_note;

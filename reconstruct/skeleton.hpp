@@ -40,11 +40,11 @@ struct SkeletonOptions {
     int neighbours = 10;            // k of the neighbour graph
     double beta = 1.5;              // edge weight exponent (species library; 1.5 without species)
     float max_edge_length = 0.0f;   // metres; longer kNN edges are replaced by bridges (0 = 10 x spacing)
-    float bin_width = 0.0f;         // metres; geodesic bin width (0 = 2.5 x the sampling distance)
+    float bin_width = 0.0f;         // metres; geodesic bin width (0 = 2.5 x the sampling distance, kept within 0.02..0.5)
     float fine_bin_factor = 0.64f;  // thin branches are binned at this fraction of the bin width (1 = one width everywhere)
     float thick_slice = 0.55f;      // bin widths; a slice at least this thick (sqrt of its middle covariance
                                     // eigenvalue) keeps the full bin width, and so do the two slices above it
-    float internode_length = 0.0f;  // metres; output internode length (0 = from point spacing)
+    float internode_length = 0.0f;  // metres; output internode length (0 = the bin width)
     float min_twig_length = 0.0f;   // metres; leaf chains shorter than this are pruned (0 = 2 bins)
     float merge_distance = 0.0f;    // metres; sibling clusters of one bin closer than this merge (0 = 1 bin)
     int smoothing_iterations = 1;   // Laplacian passes over each chain (0 = none)

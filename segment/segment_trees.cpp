@@ -24,7 +24,7 @@ namespace {
 
 constexpr std::uint8_t kLowNoiseClass = 7, kHighNoiseClass = 18;
 
-void validate(const SegmentOptions& o) {
+void check_options(const SegmentOptions& o) {
     const auto positive = [](float v, const char* name) {
         if (!(v > 0.0f) || !std::isfinite(v)) throw Error::usage(std::string("segment: ") + name + " must be > 0");
     };
@@ -622,7 +622,7 @@ ScanMode parse_scan_mode(std::string_view text) {
 }
 
 TreeSegmentation segment_trees(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options) {
-    validate(options);
+    check_options(options);
     if (terrain.height_above_ground.size() != cloud.size() || terrain.is_ground.size() != cloud.size())
         throw Error(ExitCode::Internal, "segment: the terrain was computed for another cloud (" +
                                             std::to_string(terrain.height_above_ground.size()) + " heights for " +

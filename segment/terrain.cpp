@@ -27,7 +27,7 @@ namespace {
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr std::uint8_t kGroundClass = 2, kLowNoiseClass = 7, kHighNoiseClass = 18;
 
-void validate(const TerrainOptions& o) {
+void check_options(const TerrainOptions& o) {
     const auto positive = [](float v, const char* name) {
         if (!(v > 0.0f) || !std::isfinite(v)) throw Error::usage(std::string("terrain: ") + name + " must be > 0");
     };
@@ -348,7 +348,7 @@ float DtmGrid::height_at(float x, float y) const {
 }
 
 Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options) {
-    validate(options);
+    check_options(options);
     Terrain terrain;
     if (cloud.empty()) {
         terrain.ground_source = "none";

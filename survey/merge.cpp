@@ -31,6 +31,14 @@ std::string read_text(const fs::path& path) {
     return text.str();
 }
 
+// A tile's options without the flags that say where and whether to write (--out, --overwrite):
+// the ones that shape what the tile holds, alike across the tiles of one survey.
+json shaping_options(json options) {
+    options.erase("out");
+    options.erase("overwrite");
+    return options;
+}
+
 json read_json(const fs::path& path) {
     const json value = json::parse(read_text(path), nullptr, false);
     if (value.is_discarded() || !value.is_object()) throw Error::input(path.string(), "not a JSON object");
@@ -214,8 +222,9 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
         if (dbf6 && (tile_dbf6.encode.resolution != dbf6->encode.resolution || tile_dbf6.lods != dbf6->lods))
             throw Error::input((dir / "summary.json").string(), "made with other DBF6 options (--resolution, --lods) than the other tiles");
         dbf6 = tile_dbf6;
-        if (options.is_null()) options = summary.at("options");
-        else if (options != summary.at("options")) log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
+        const json tile_options = shaping_options(summary.at("options"));
+        if (options.is_null()) options = tile_options;
+        else if (options != tile_options) log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
         json tile_counts = summary.at("counts");
         tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
         add_counts(counts, tile_counts);

@@ -185,7 +185,7 @@ PointCloud to_cloud(const Scene& scene, const std::vector<Sample>& samples) {
     return cloud;
 }
 
-void validate(const BeamOptions& b, const std::string& scanner) {
+void check_options(const BeamOptions& b, const std::string& scanner) {
     const auto fail = [&](const std::string& what) { throw Error::usage(scanner + " beam: " + what); };
     if (!(b.divergence_mrad >= 0 && b.divergence_mrad <= 20)) fail("divergence must be in [0, 20] mrad");
     if (b.sub_rays != 1 && b.sub_rays != 7 && b.sub_rays != 19 && b.sub_rays != 37) fail("sub-rays must be 1, 7, 19 or 37");
@@ -250,7 +250,7 @@ std::vector<Eigen::Vector3d> tls_stations(const Scene& scene, const TlsOptions& 
 
 }  // namespace
 
-void validate(const TlsOptions& o) {
+void check_options(const TlsOptions& o) {
     if (o.station_xy.empty() && (o.stations < 1 || o.stations > 16)) throw Error::usage("TLS stations must be 1..16");
     if (!(o.station_distance_m >= 0 && o.station_distance_m <= 500)) throw Error::usage("TLS station distance must be in [0, 500] m");
     if (!(o.station_height_m >= 0 && o.station_height_m <= 50)) throw Error::usage("TLS station height must be in [0, 50] m");
@@ -258,20 +258,20 @@ void validate(const TlsOptions& o) {
     if (!(o.max_range_m > 0 && o.max_range_m <= 6000)) throw Error::usage("TLS max range must be in (0, 6000] m");
     if (!(o.min_elevation_deg >= -90 && o.min_elevation_deg < o.max_elevation_deg && o.max_elevation_deg <= 90))
         throw Error::usage("TLS elevation range must satisfy -90 <= min < max <= 90 degrees");
-    validate(o.beam, "TLS");
+    check_options(o.beam, "TLS");
 }
 
-void validate(const AlsOptions& o) {
+void check_options(const AlsOptions& o) {
     if (!(o.altitude_m >= 20 && o.altitude_m <= 6000)) throw Error::usage("ALS altitude must be in [20, 6000] m");
     if (!(o.pulse_density > 0 && o.pulse_density <= 2000)) throw Error::usage("ALS pulse density must be in (0, 2000] per m^2");
     if (!(o.max_scan_angle_deg > 0 && o.max_scan_angle_deg <= 60)) throw Error::usage("ALS scan angle must be in (0, 60] degrees");
     if (!(o.strip_overlap >= 0 && o.strip_overlap < 0.9)) throw Error::usage("ALS strip overlap must be in [0, 0.9)");
     if (!(o.jitter >= 0 && o.jitter <= 1)) throw Error::usage("ALS jitter must be in [0, 1]");
-    validate(o.beam, "ALS");
+    check_options(o.beam, "ALS");
 }
 
 PointCloud scan_tls(const Scene& scene, const TlsOptions& o, std::uint64_t seed, ScanSummary* summary) {
-    validate(o);
+    check_options(o);
     const auto [lo, hi] = scene.bounds();
     const RayScene rays(scene);
     const std::vector<Eigen::Vector3d> stations = tls_stations(scene, o, lo, hi, seed);
@@ -317,7 +317,7 @@ PointCloud scan_tls(const Scene& scene, const TlsOptions& o, std::uint64_t seed,
 }
 
 PointCloud scan_als(const Scene& scene, const AlsOptions& o, std::uint64_t seed, ScanSummary* summary) {
-    validate(o);
+    check_options(o);
     const auto bounds = scene.bounds();  // not a structured binding: clang 14 cannot capture those in lambdas
     const auto& lo = bounds.first;
     const auto& hi = bounds.second;

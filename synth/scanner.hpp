@@ -72,7 +72,7 @@ PointCloud scan_als(const Scene& scene, const AlsOptions& options, std::uint64_t
 void add_outliers(PointCloud& cloud, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double fraction, std::uint64_t seed);
 
 // Checks option ranges; throws Error(Usage) naming the option.
-void validate(const TlsOptions& options);
-void validate(const AlsOptions& options);
+void check_options(const TlsOptions& options);
+void check_options(const AlsOptions& options);
 
 }  // namespace treelobes::synth

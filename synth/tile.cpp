@@ -14,7 +14,7 @@ namespace {
 
 constexpr int kPlacementAttempts = 400;
 
-void validate(const TileOptions& o) {
+void check_options(const TileOptions& o) {
     if (o.trees < 0 || o.trees > 100000) throw Error::usage("tile trees must be in [0, 100000]");
     if (!(o.size_m >= 5 && o.size_m <= 2000)) throw Error::usage("tile size must be in [5, 2000] m");
     if (!(o.understory_per_100m2 >= 0 && o.understory_per_100m2 <= 100)) throw Error::usage("understory density must be in [0, 100] clumps per 100 m^2");
@@ -81,7 +81,7 @@ std::string truth_csv(const std::vector<TreeTruth>& rows) {
 std::uint64_t tree_seed(std::uint64_t seed, std::uint64_t key) { return stream_seed(seed ^ 0x7EEDULL, key); }
 
 Tile make_tile(const std::vector<SpeciesProfile>& library, std::uint64_t seed, const TileOptions& o) {
-    validate(o);
+    check_options(o);
     const std::vector<const SpeciesProfile*> species = chosen_species(library, o.species);
     Rng rng(stream_seed(seed, 0x711E));
     Tile tile;

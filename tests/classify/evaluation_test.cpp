@@ -270,7 +270,7 @@ TEST(ClassifyReport, WritesTablesHeatMapsAndJson) {
     options.splits = 4;
     const auto report = evaluate(set, {nearest_mean(), always_first()}, options);
     TempDir dir;
-    write_report(report, options, (dir / "report").string(), R"({"dataset": "test"})");
+    write_report(report, (dir / "report").string(), R"({"dataset": "test"})");
     for (const char* name : {"summary.json", "per_species.csv", "report.md", "confusion_nearest.csv", "confusion_nearest.png",
                              "confusion_first.csv", "site_confusion_first.csv"})
         EXPECT_TRUE(std::filesystem::exists(dir / "report" / name)) << name;
@@ -287,7 +287,7 @@ TEST(ClassifyReport, WritesTablesHeatMapsAndJson) {
     EXPECT_EQ(png.substr(1, 3), "PNG");
     // Same inputs, same report files (timings aside, which live in summary.json only).
     TempDir again;
-    write_report(report, options, (again / "report").string());
+    write_report(report, (again / "report").string());
     EXPECT_EQ(read_file(dir / "report" / "confusion_nearest.png"), read_file(again / "report" / "confusion_nearest.png"));
     EXPECT_EQ(read_file(dir / "report" / "per_species.csv"), read_file(again / "report" / "per_species.csv"));
 }
