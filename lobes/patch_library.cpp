@@ -129,8 +129,13 @@ Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLib
             }
         }
         // Transf(v, #Phototropism, #Gravitropism), with a little random bending.
-        const Eigen::Vector3f jitter(static_cast<float>(rng.normal(0, 0.05)), static_cast<float>(rng.normal(0, 0.05)),
-                                     static_cast<float>(rng.normal(0, 0.05)));
+        // Drawn last coordinate first, in statements of their own: C++ leaves the order in which function
+        // arguments are evaluated to the compiler (GCC right to left, Clang left to right), and this is the
+        // order GCC gave the committed outputs.
+        const auto jitter_z = static_cast<float>(rng.normal(0, 0.05));
+        const auto jitter_y = static_cast<float>(rng.normal(0, 0.05));
+        const auto jitter_x = static_cast<float>(rng.normal(0, 0.05));
+        const Eigen::Vector3f jitter(jitter_x, jitter_y, jitter_z);
         v = (v + static_cast<float>(pp.phototropism - pp.gravitropism) / n * up + jitter).normalized();
         // NewSeed(t', v'): #BranchDistr nodes place #NumTwigs seeds if thick enough.
         const float child = kChildThicknessRatio * static_cast<float>(pp.init_thickness) * t;

@@ -376,7 +376,13 @@ void add_outliers(PointCloud& cloud, const Eigen::Vector3d& lo, const Eigen::Vec
     Rng rng(stream_seed(seed, 0x0D7));
     const auto count = static_cast<std::size_t>(std::llround(fraction * static_cast<double>(cloud.size())));
     for (std::size_t i = 0; i < count; ++i) {
-        const Eigen::Vector3d p(rng.uniform(lo.x(), hi.x()), rng.uniform(lo.y(), hi.y()), rng.uniform(lo.z(), hi.z()));
+        // Drawn last coordinate first, in statements of their own: C++ leaves the order in which function
+        // arguments are evaluated to the compiler (GCC right to left, Clang left to right), and this is the
+        // order GCC gave the committed outputs.
+        const double noise_z = rng.uniform(lo.z(), hi.z());
+        const double noise_y = rng.uniform(lo.y(), hi.y());
+        const double noise_x = rng.uniform(lo.x(), hi.x());
+        const Eigen::Vector3d p(noise_x, noise_y, noise_z);
         cloud.positions.push_back(p.cast<float>());
         if (!cloud.intensity.empty()) cloud.intensity.push_back(static_cast<std::uint16_t>(rng.below(2000)));
         if (!cloud.return_number.empty()) cloud.return_number.push_back(1);

@@ -72,7 +72,12 @@ std::vector<Leaf> make_understory(const Heightfield& ground, int count, double m
     Rng rng(stream_seed(seed, 0x5AB));
     const double x1 = ground.x0 + (ground.nx - 1) * ground.cell, y1 = ground.y0 + (ground.ny - 1) * ground.cell;
     for (int c = 0; c < count; ++c) {
-        Eigen::Vector2d centre(rng.uniform(ground.x0, x1), rng.uniform(ground.y0, y1));
+        // Drawn last coordinate first, in statements of their own: C++ leaves the order in which function
+        // arguments are evaluated to the compiler (GCC right to left, Clang left to right), and this is the
+        // order GCC gave the committed outputs.
+        const double centre_y = rng.uniform(ground.y0, y1);
+        const double centre_x = rng.uniform(ground.x0, x1);
+        Eigen::Vector2d centre(centre_x, centre_y);
         const bool blocked = std::any_of(avoid.begin(), avoid.end(), [&](const Eigen::Vector2d& a) { return (a - centre).norm() < avoid_radius; });
         if (blocked) continue;  // no bush inside a trunk
         const double height = rng.uniform(0.15, max_height_m);

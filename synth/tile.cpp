@@ -50,7 +50,12 @@ bool place(Rng& rng, double size, const Footprint& f, double spacing, const std:
            const std::vector<Footprint>& placed, Eigen::Vector2d& out) {
     const double margin = std::min(0.25 * size, std::max(f.stem + 0.5, 0.5 * spacing * f.crown));
     for (int attempt = 0; attempt < kPlacementAttempts; ++attempt) {
-        const Eigen::Vector2d p(rng.uniform(margin, size - margin), rng.uniform(margin, size - margin));
+        // Drawn last coordinate first, in statements of their own: C++ leaves the order in which function
+        // arguments are evaluated to the compiler (GCC right to left, Clang left to right), and this is the
+        // order GCC gave the committed outputs.
+        const double stem_y = rng.uniform(margin, size - margin);
+        const double stem_x = rng.uniform(margin, size - margin);
+        const Eigen::Vector2d p(stem_x, stem_y);
         bool free = true;
         for (std::size_t i = 0; i < at.size() && free; ++i) {
             const double hard = f.stem + placed[i].stem + 0.3;
