@@ -1,7 +1,8 @@
 // `treelobes render INPUT... --out PREVIEW.png`: orthographic previews of point clouds, meshes
 // and skeletons, one panel per input, side by side, all panels in the same frame and scale.
 // --view front|side|top looks along +y, along -x or down; the panel takes the shape of the
-// subject seen that way, so it fills the frame. --color height|tree colours clouds by height or
+// subject seen that way, so it fills the frame. --view orbit writes an animated PNG of the
+// subject turning once around the vertical axis, at one scale in every frame. --color height|tree colours clouds by height or
 // by their treeID attribute, radius|order colours skeletons by radius or branch order (inputs
 // the colouring does not apply to keep their plain colour).
 #include "apps/command.hpp"
@@ -10,6 +11,7 @@
 #include "core/file_info.hpp"
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
+#include "render/apng.hpp"
 #include "render/colour_map.hpp"
 #include "render/rasterizer.hpp"
 
@@ -31,7 +33,9 @@ struct RenderOptions {
     int size = 800;             // panel height in pixels
     double azimuth = 0;         // degrees around the vertical axis
     double elevation = 10;      // degrees above the horizon
-    std::string view;           // front, side, top (overrides azimuth and elevation)
+    std::string view;           // front, side, top, orbit (the first three override azimuth and elevation)
+    int frames = 24;            // orbit: frames per turn
+    int frame_ms = 100;         // orbit: time each frame is shown
     std::string colour = "plain";
 };
 
@@ -44,24 +48,36 @@ Drawable load(const std::string& path) {
     return read_point_cloud(path);
 }
 
-void extend(Eigen::Vector3d& lo, Eigen::Vector3d& hi, const Eigen::Vector3d& origin, const Eigen::Vector3f& p) {
-    const Eigen::Vector3d q = origin + p.cast<double>();
-    lo = lo.cwiseMin(q);
-    hi = hi.cwiseMax(q);
-}
-
-void bounds_of(const Drawable& item, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+// Calls `visit` with the world position of every point, vertex or skeleton node of `item`.
+template <typename Visit>
+void for_each_point(const Drawable& item, Visit&& visit) {
     std::visit(
         [&](const auto& thing) {
             using T = std::decay_t<decltype(thing)>;
             if constexpr (std::is_same_v<T, PointCloud>)
-                for (const auto& p : thing.positions) extend(lo, hi, thing.origin, p);
+                for (const auto& p : thing.positions) visit(thing.origin + p.template cast<double>());
             else if constexpr (std::is_same_v<T, TriangleMesh>)
-                for (const auto& p : thing.vertices) extend(lo, hi, thing.origin, p);
+                for (const auto& p : thing.vertices) visit(thing.origin + p.template cast<double>());
             else
-                for (const auto& n : thing.nodes) extend(lo, hi, thing.origin, n.position);
+                for (const auto& n : thing.nodes) visit(thing.origin + n.position.template cast<double>());
         },
         item);
+}
+
+void bounds_of(const Drawable& item, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
+    for_each_point(item, [&](const Eigen::Vector3d& q) {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+    });
+}
+
+// Largest horizontal distance of any point of `items` from the vertical axis through `centre`:
+// the radius the subject sweeps while it turns.
+double swept_radius(const std::vector<Drawable>& items, const Eigen::Vector3d& centre) {
+    double radius = 1e-6;
+    for (const auto& item : items)
+        for_each_point(item, [&](const Eigen::Vector3d& q) { radius = std::max(radius, (q - centre).head<2>().norm()); });
+    return radius;
 }
 
 // Value of each point in [0, 1] (height) or a colour per tree id.
@@ -86,7 +102,7 @@ std::vector<render::Rgba> cloud_colours(const PointCloud& cloud, const std::stri
 std::vector<Eigen::Vector3d> world_points(const PointCloud& cloud) {
     std::vector<Eigen::Vector3d> points;
     points.reserve(cloud.size());
-    for (const auto& p : cloud.positions) points.push_back(cloud.origin + p.cast<double>());
+    for (const auto& p : cloud.positions) points.push_back(cloud.origin + p.template cast<double>());
     return points;
 }
 
@@ -129,20 +145,55 @@ render::View make_view(const RenderOptions& o, const Eigen::Vector3d& lo, const 
     return render::View::side(lo, hi, o.azimuth, o.elevation);
 }
 
+// The inputs side by side, all in `view`; each panel takes the subject's shape on the image
+// (`view.aspect()`), so it fills the frame.
+render::Image draw_panels(const std::vector<Drawable>& items, const RenderOptions& options, const render::View& view) {
+    const int width = std::clamp(static_cast<int>(std::lround(options.size * view.aspect())), 64, 4096);
+    std::vector<render::Image> panels;
+    for (std::size_t i = 0; i < items.size(); ++i) panels.push_back(draw(items[i], options.inputs[i], options, view, width, options.size));
+    return render::side_by_side(panels);
+}
+
+// One turn around the vertical axis through the centre of [lo, hi], starting at --azimuth. Every
+// frame frames the cylinder the subject sweeps (its swept radius across, its height seen at
+// --elevation up), so the scale is the same in all frames and the subject does not pulse.
+std::vector<render::Image> draw_orbit(const std::vector<Drawable>& items, const RenderOptions& options, const Eigen::Vector3d& lo,
+                                      const Eigen::Vector3d& hi) {
+    const double radius = swept_radius(items, 0.5 * (lo + hi));
+    const double elevation = options.elevation * M_PI / 180.0;
+    std::vector<render::Image> frames;
+    for (int k = 0; k < options.frames; ++k) {
+        render::View view = render::View::side(lo, hi, options.azimuth + 360.0 * k / options.frames, options.elevation);
+        view.half_width = radius;
+        view.half_height = 0.5 * (hi.z() - lo.z()) * std::cos(elevation) + radius * std::abs(std::sin(elevation));
+        frames.push_back(draw_panels(items, options, view));
+    }
+    return frames;
+}
+
 int run_render(const RenderOptions& options, const GlobalOptions& global) {
     std::vector<Drawable> items;
     for (const auto& input : options.inputs) items.push_back(load(input));
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max()), hi = -lo;
     for (const auto& item : items) bounds_of(item, lo, hi);
     if (!lo.allFinite() || (lo.array() > hi.array()).any()) throw Error::input(options.inputs.front(), "nothing to draw");
-    const render::View view = make_view(options, lo, hi);
-    // The panel takes the subject's shape on the image, so it fills the frame.
-    const int width = std::clamp(static_cast<int>(std::lround(options.size * view.aspect())), 64, 4096);
-    std::vector<render::Image> panels;
-    for (std::size_t i = 0; i < items.size(); ++i) panels.push_back(draw(items[i], options.inputs[i], options, view, width, options.size));
-    render::write_png(render::side_by_side(panels), options.out);
-    if (global.json) std::cout << nlohmann::json{{"out", options.out}, {"panels", panels.size()}}.dump(2) << "\n";
-    else std::cout << "wrote " << options.out << " (" << panels.size() << " panel(s))\n";
+    nlohmann::json summary{{"out", options.out}, {"panels", items.size()}};
+    if (options.view == "orbit") {
+        const std::vector<render::Image> frames = draw_orbit(items, options, lo, hi);
+        render::write_apng(frames, options.frame_ms, options.out);
+        summary["frames"] = frames.size();
+        summary["width"] = frames.front().width;
+        summary["height"] = frames.front().height;
+    } else {
+        const render::Image image = draw_panels(items, options, make_view(options, lo, hi));
+        render::write_png(image, options.out);
+        summary["width"] = image.width;
+        summary["height"] = image.height;
+    }
+    if (global.json) std::cout << summary.dump(2) << "\n";
+    else
+        std::cout << "wrote " << options.out << " (" << items.size() << " panel(s)"
+                  << (summary.contains("frames") ? ", " + summary["frames"].dump() + " frames" : std::string()) << ")\n";
     return 0;
 }
 
@@ -157,8 +208,10 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("--azimuth", options->azimuth, "View direction around the vertical axis, degrees")->capture_default_str();
     sub->add_option("--elevation", options->elevation, "View elevation above the horizon, degrees")
         ->check(CLI::Range(-90.0, 90.0))->capture_default_str();
-    sub->add_option("--view", options->view, "front (along +y), side (along -x) or top (down); overrides --azimuth/--elevation")
-        ->check(CLI::IsMember({"front", "side", "top"}));
+    sub->add_option("--view", options->view, "front (along +y), side (along -x) or top (down), overriding --azimuth/--elevation; orbit: an animated PNG turning once around the vertical axis from --azimuth at --elevation")
+        ->check(CLI::IsMember({"front", "side", "top", "orbit"}));
+    sub->add_option("--frames", options->frames, "--view orbit: frames per turn")->check(CLI::Range(2, 360))->capture_default_str();
+    sub->add_option("--frame-ms", options->frame_ms, "--view orbit: milliseconds each frame is shown")->check(CLI::Range(10, 10000))->capture_default_str();
     sub->add_option("--color", options->colour, "plain; clouds: height or tree (treeID); skeletons: radius or order (branch order)")
         ->check(CLI::IsMember({"plain", "height", "tree", "radius", "order"}))->capture_default_str();
     sub->callback([options, &global, &job] { job = [options, &global] { return run_render(*options, global); }; });
