@@ -37,6 +37,7 @@ struct ExportCliOptions {
     TreeGeometryOptions geometry;
     bool no_leaves = false;
     std::string crs;                 // overrides the inputs' sidecar CRS
+    CityJsonOptions cityjson;
 };
 
 struct TreeSummary {
@@ -117,13 +118,14 @@ nlohmann::json summary_json(const ExportCliOptions& o, const ExportInput& input,
 
 int run_export(ExportCliOptions o, const GlobalOptions& global) {
     o.geometry.leaves = !o.no_leaves;
+    if (o.cityjson.instances && o.format != "cityjson") throw Error::usage("--instances applies to --format cityjson only");
     const ExportInput input = read_export_input(o.input, o.lod);
     std::vector<TreeSummary> summaries;
     for (const auto& tree : input.trees) summaries.push_back({tree.name, measure_tree(tree)});
     std::vector<std::string> outputs{o.out};
     if (o.format == "qsm-txt" || o.format == "qsm-csv") outputs = write_qsm(input, o);
     else if (o.format == "glb") write_glb(input, summaries, o);
-    else if (o.format == "cityjson") write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs));
+    else if (o.format == "cityjson") write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs, o.cityjson));
     else write_mesh_file(input, o);
     if (global.json) {
         std::cout << summary_json(o, input, summaries, outputs).dump(2) << "\n";
@@ -156,6 +158,7 @@ void add_export_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_flag("--no-leaves", options->no_leaves, "glb: no leaf cards on skeletons without lobes");
     sub->add_option("--leaf-size", options->geometry.leaf_size, "glb: leaf card edge in metres")
         ->check(cli::PositiveNumber)->capture_default_str();
+    sub->add_flag("--instances", options->cityjson.instances, "cityjson: LoD 2 as GeometryInstances of one template per species (geometry-templates)");
     sub->add_option("--crs", options->crs, "CRS of the input (EPSG:25832 or WKT) when its georef sidecar has none");
     sub->callback([options, &global, &job] { job = [options, &global] { return run_export(*options, global); }; });
 }

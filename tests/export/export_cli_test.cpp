@@ -5,6 +5,7 @@
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
 #include "encode/tree_file.hpp"
+#include "export/cityjson.hpp"
 #include "lobes/tlobe_io.hpp"
 #include "sample_trees.hpp"
 #include "support/test_support.hpp"
@@ -152,6 +153,14 @@ TEST(ExportCli, TlobeDbf6ForestAndFolderInputs) {
     test::write_text(folder / "summary.json", "{}\n");
     ASSERT_EQ(export_to(folder, "cityjson", dir / "tile.city.json").exit_code, 0);
     EXPECT_EQ(info_of(dir / "tile.city.json")["city_objects"], 3);
+    // --instances: one template per species (the two skeletons have none, the .tlobe is an oak).
+    ASSERT_EQ(export_to(folder, "cityjson", dir / "instances.city.json", "--instances").exit_code, 0);
+    const test::ValidatorRun instances = test::validate_cityjson(dir / "instances.city.json");
+    EXPECT_EQ(instances.exit_code, 0) << instances.output;
+    const auto with_instances = nlohmann::json::parse(read_file(dir / "instances.city.json"));
+    EXPECT_EQ(with_instances["geometry-templates"]["templates"].size(), 2u);
+    EXPECT_TRUE(exporting::check_cityjson(read_file(dir / "instances.city.json")).empty());
+    EXPECT_EQ(export_to(folder, "glb", dir / "x.glb", "--instances").exit_code, 1);  // CityJSON only
 }
 
 TEST(ExportCli, BadInputsGiveOneLineAndExitCodes) {
