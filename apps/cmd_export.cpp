@@ -43,6 +43,7 @@ struct ExportCliOptions {
 struct TreeSummary {
     std::string name;
     TreeMeasures measures;
+    std::optional<double> confidence;
 };
 
 // QSM tables: one tree -> OUT is the cylinder file; several -> OUT is a folder of <name>.<ext>.
@@ -69,15 +70,19 @@ std::vector<std::string> write_qsm(const ExportInput& input, const ExportCliOpti
     return written;
 }
 
-std::vector<std::pair<std::string, double>> extras_of(const TreeMeasures& m) {
-    return {{"height", m.height}, {"trunkDiameter", m.dbh}, {"crownDiameter", m.crown_diameter}, {"woodVolume", m.wood_volume}};
+std::vector<std::pair<std::string, double>> extras_of(const TreeSummary& t) {
+    const TreeMeasures& m = t.measures;
+    std::vector<std::pair<std::string, double>> extras = {
+        {"height", m.height}, {"trunkDiameter", m.dbh}, {"crownDiameter", m.crown_diameter}, {"woodVolume", m.wood_volume}};
+    if (t.confidence) extras.emplace_back("confidence", *t.confidence);
+    return extras;
 }
 
 void write_glb(const ExportInput& input, const std::vector<TreeSummary>& summaries, const ExportCliOptions& o) {
     std::vector<GltfTree> trees;
     for (std::size_t i = 0; i < input.trees.size(); ++i) {
         const ExportTree& tree = input.trees[i];
-        trees.push_back({tree.name, tree.skeleton.origin, tree_lods(tree, o.geometry), extras_of(summaries[i].measures), tree.species});
+        trees.push_back({tree.name, tree.skeleton.origin, tree_lods(tree, o.geometry), extras_of(summaries[i]), tree.species});
     }
     const Eigen::Vector3d origin = input.trees.front().skeleton.origin;
     write_file_atomically(o.out, glb_bytes(trees, origin));
@@ -104,7 +109,8 @@ nlohmann::json summary_json(const ExportCliOptions& o, const ExportInput& input,
                         {"wood_volume", t.measures.wood_volume},
                         {"skeleton_length", t.measures.total_length},
                         {"branches", t.measures.branches},
-                        {"lobes", t.measures.lobes}});
+                        {"lobes", t.measures.lobes},
+                        {"confidence", t.confidence ? nlohmann::json(*t.confidence) : nlohmann::json()}});
     return {{"treelobes", kVersion},
             {"command", "export"},
             {"input", o.input},
@@ -121,7 +127,7 @@ int run_export(ExportCliOptions o, const GlobalOptions& global) {
     if (o.cityjson.instances && o.format != "cityjson") throw Error::usage("--instances applies to --format cityjson only");
     const ExportInput input = read_export_input(o.input, o.lod);
     std::vector<TreeSummary> summaries;
-    for (const auto& tree : input.trees) summaries.push_back({tree.name, measure_tree(tree)});
+    for (const auto& tree : input.trees) summaries.push_back({tree.name, measure_tree(tree), tree.confidence});
     std::vector<std::string> outputs{o.out};
     if (o.format == "qsm-txt" || o.format == "qsm-csv") outputs = write_qsm(input, o);
     else if (o.format == "glb") write_glb(input, summaries, o);

@@ -132,6 +132,7 @@ json tree_object(const ExportTree& tree, const TreeMeasures& m, VertexGrid& grid
                        {"branchCount", m.branches},
                        {"lobeCount", m.lobes}};
     if (!tree.species.empty()) attributes["species"] = tree.species;
+    if (tree.confidence) attributes["confidence"] = std::round(*tree.confidence * 1e4) / 1e4;
     json geometry = json::array();
     if (!m.crown_hull.faces.empty()) {
         const json shell = grid.surfaces(m.crown_hull);

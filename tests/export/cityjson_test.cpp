@@ -16,11 +16,11 @@ using namespace treelobes::exporting;
 namespace {
 
 std::vector<ExportTree> two_trees() {
-    ExportTree lobed{"oak", test::sample_tree({500000, 5400000, 300}), {}, "Quercus robur"};
+    ExportTree lobed{"oak", test::sample_tree({500000, 5400000, 300}), {}, "Quercus robur", {}};
     TriangleMesh lobe = test::octahedron({1.2f, 0.2f, 2.6f}, 0.4f);
     lobe.origin = lobed.skeleton.origin;
     lobed.lobes.push_back(lobe);
-    return {lobed, {"t2", test::sample_tree({500010.5, 5400004.25, 301}), {}, ""}};
+    return {lobed, {"t2", test::sample_tree({500010.5, 5400004.25, 301}), {}, "", {}}};
 }
 
 void expect_schema_valid(const std::string& text, const test::TempDir& dir) {
@@ -111,7 +111,7 @@ TreeGraph scaled_sample_tree(const Eigen::Vector3d& origin, float factor) {
 TEST(CityJson, InstancesOneTemplatePerSpeciesScaledToEachTree) {
     test::TempDir dir;
     std::vector<ExportTree> trees = two_trees();  // "oak" (Quercus robur, 3 m) and "t2" (no species)
-    trees.push_back({"oak_big", scaled_sample_tree({500020, 5400000, 302}, 1.5f), {}, "Quercus robur"});
+    trees.push_back({"oak_big", scaled_sample_tree({500020, 5400000, 302}, 1.5f), {}, "Quercus robur", {}});
     CityJsonOptions options;
     options.instances = true;
     const std::string text = cityjson_text(trees, "EPSG:25832", options);

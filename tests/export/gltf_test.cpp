@@ -30,7 +30,7 @@ GltfTree gltf_tree(const ExportTree& tree, int lods) {
 }
 
 ExportTree tree_with_lobes(const Eigen::Vector3d& origin) {
-    ExportTree tree{"oak", test::sample_tree(origin), {}, "Quercus robur"};
+    ExportTree tree{"oak", test::sample_tree(origin), {}, "Quercus robur", {}};
     for (const Eigen::Vector3f& centre : {Eigen::Vector3f(1.2f, 0.2f, 2.6f), Eigen::Vector3f(-0.6f, 0.3f, 2.9f)}) {
         TriangleMesh lobe = test::octahedron(centre, 0.4f);
         lobe.origin = origin;
@@ -50,7 +50,7 @@ void expect_valid(const std::filesystem::path& file) {
 
 TEST(Gltf, OneTreeWithThreeLodsIsValid) {
     test::TempDir dir;
-    const ExportTree tree{"t1", test::sample_tree(), {}, ""};
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
     const std::string glb = glb_bytes({gltf_tree(tree, 3)}, tree.skeleton.origin);
     EXPECT_EQ(glb, glb_bytes({gltf_tree(tree, 3)}, tree.skeleton.origin));  // deterministic
     write_file_atomically(dir / "t1.glb", glb);
@@ -86,7 +86,7 @@ TEST(Gltf, OneTreeWithThreeLodsIsValid) {
 TEST(Gltf, TwoTreesWithLobesAreValidAndPlacedRelativeToTheSceneOrigin) {
     test::TempDir dir;
     const Eigen::Vector3d a(500000, 5400000, 300), b(500010, 5400004, 301);
-    const std::string glb = glb_bytes({gltf_tree(tree_with_lobes(a), 2), gltf_tree({"t2", test::sample_tree(b), {}, ""}, 2)}, a);
+    const std::string glb = glb_bytes({gltf_tree(tree_with_lobes(a), 2), gltf_tree({"t2", test::sample_tree(b), {}, "", {}}, 2)}, a);
     write_file_atomically(dir / "two.glb", glb);
     expect_valid(dir / "two.glb");
     const auto doc = json_chunk(glb);
@@ -101,7 +101,7 @@ TEST(Gltf, TwoTreesWithLobesAreValidAndPlacedRelativeToTheSceneOrigin) {
 
 TEST(Gltf, TheValidatorRejectsABrokenFile) {
     test::TempDir dir;
-    const ExportTree tree{"t1", test::sample_tree(), {}, ""};
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
     std::string glb = glb_bytes({gltf_tree(tree, 1)}, tree.skeleton.origin);
     const std::size_t mode = glb.find("\"mode\":4");
     ASSERT_NE(mode, std::string::npos);
@@ -113,7 +113,7 @@ TEST(Gltf, TheValidatorRejectsABrokenFile) {
 }
 
 TEST(Gltf, LodOptionsOutOfRangeAreUsageErrors) {
-    const ExportTree tree{"t1", test::sample_tree(), {}, ""};
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
     TreeGeometryOptions options;
     options.lods = 0;
     EXPECT_EQ(test::error_code_of([&] { tree_lods(tree, options); }), ExitCode::Usage);
