@@ -116,10 +116,8 @@ std::vector<render::Rgba> species_colours(const PointCloud& cloud, const std::ve
     for (const auto& name : species.names) palette.push_back(legend[name] = species_colour(name));
     std::vector<render::Rgba> colours;
     colours.reserve(cloud.size());
-    for (int index : species.of_point) {
-        colours.push_back(index < 0 ? unknown_species_colour : palette[index]);
-        if (index < 0) legend["(none)"] = unknown_species_colour;
-    }
+    for (int index : species.of_point) colours.push_back(index < 0 ? unknown_species_colour : palette[index]);
+    if (std::find(species.of_point.begin(), species.of_point.end(), -1) != species.of_point.end()) legend["(none)"] = unknown_species_colour;
     return colours;
 }
 

@@ -76,6 +76,24 @@ const std::vector<SpeciesEntry>& species_library() {
     return entries;
 }
 
+// Sorted names and, per point, the index of its name (-1: none), from a name per key and the
+// key of each point.
+PointSpecies index_names(const std::map<long long, std::string>& name_of_key, const std::vector<double>& key_of_point) {
+    PointSpecies result;
+    for (const auto& [key, name] : name_of_key) result.names.push_back(name);
+    std::sort(result.names.begin(), result.names.end());
+    result.names.erase(std::unique(result.names.begin(), result.names.end()), result.names.end());
+    std::map<long long, int> index_of_key;
+    for (const auto& [key, name] : name_of_key)
+        index_of_key[key] = static_cast<int>(std::lower_bound(result.names.begin(), result.names.end(), name) - result.names.begin());
+    result.of_point.reserve(key_of_point.size());
+    for (double key : key_of_point) {
+        const auto it = index_of_key.find(std::llround(key));
+        result.of_point.push_back(it == index_of_key.end() ? -1 : it->second);
+    }
+    return result;
+}
+
 }  // namespace
 
 bool is_tile_output(const fs::path& path) {
@@ -100,43 +118,29 @@ const ExtraAttribute* tree_id_attribute(const PointCloud& cloud) {
 }
 
 PointSpecies point_species(const PointCloud& cloud, const std::vector<TileTree>* trees, const std::string& path) {
-    PointSpecies result;
-    std::vector<std::string> point_names(cloud.size());
-    if (trees) {
+    std::map<long long, std::string> name_of_key;
+    if (trees) {  // key: the tree id
         const ExtraAttribute* tree_id = tree_id_attribute(cloud);
-        std::map<long long, std::string> species_of_tree;
         for (const auto& tree : *trees)
-            if (!tree.species.empty()) species_of_tree[tree.id] = tree.species;
-        if (species_of_tree.empty() || !tree_id)
+            if (!tree.species.empty()) name_of_key[tree.id] = tree.species;
+        if (name_of_key.empty() || !tree_id)
             throw Error::input(path, "--color species: trees.csv names no species (run `treelobes tile` with --model)");
-        for (std::size_t i = 0; i < cloud.size(); ++i) {
-            const auto it = species_of_tree.find(std::llround(tree_id->values[i]));
-            if (it != species_of_tree.end()) point_names[i] = it->second;
-        }
-    } else {
-        const auto attribute = std::find_if(cloud.extras.begin(), cloud.extras.end(),
-                                            [](const ExtraAttribute& a) { return lower(a.name) == "species" || lower(a.name) == "scalar_species"; });
-        if (attribute == cloud.extras.end())
-            throw Error::input(path, "--color species needs a species attribute (LAS extra bytes or PLY scalar_species) or a tile output folder");
-        std::map<long long, std::string> name_of_id;
-        for (const auto& entry : species_library()) name_of_id[entry.id] = entry.name;
-        for (std::size_t i = 0; i < cloud.size(); ++i) {
-            const long long id = std::llround(attribute->values[i]);
-            if (id <= 0) continue;
-            const auto it = name_of_id.find(id);
-            point_names[i] = it != name_of_id.end() ? it->second : "species " + std::to_string(id);
-        }
+        return index_names(name_of_key, tree_id->values);
     }
-    result.names = point_names;
-    std::sort(result.names.begin(), result.names.end());
-    result.names.erase(std::unique(result.names.begin(), result.names.end()), result.names.end());
-    if (!result.names.empty() && result.names.front().empty()) result.names.erase(result.names.begin());
-    result.of_point.reserve(cloud.size());
-    for (const auto& name : point_names) {
-        const auto it = std::lower_bound(result.names.begin(), result.names.end(), name);
-        result.of_point.push_back(name.empty() ? -1 : static_cast<int>(it - result.names.begin()));
+    // key: the species id of config/species.yaml
+    const auto attribute = std::find_if(cloud.extras.begin(), cloud.extras.end(),
+                                        [](const ExtraAttribute& a) { return lower(a.name) == "species" || lower(a.name) == "scalar_species"; });
+    if (attribute == cloud.extras.end())
+        throw Error::input(path, "--color species needs a species attribute (LAS extra bytes or PLY scalar_species) or a tile output folder");
+    std::map<long long, std::string> library_names;
+    for (const auto& entry : species_library()) library_names[entry.id] = entry.name;
+    for (double value : attribute->values) {
+        const long long id = std::llround(value);
+        if (id <= 0 || name_of_key.count(id)) continue;
+        const auto it = library_names.find(id);
+        name_of_key[id] = it != library_names.end() ? it->second : "species " + std::to_string(id);
     }
-    return result;
+    return index_names(name_of_key, attribute->values);
 }
 
 render::Rgba species_colour(const std::string& name) {
