@@ -383,7 +383,7 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand(
         "tile", "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
                 "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
-    sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, PLY, PCD or XYZ/CSV (decompress LAZ first)")->required();
+    sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, LAZ or COPC, PLY, PCD or XYZ/CSV")->required();
     sub->add_option("--out", o->out, "Output folder")->required();
     sub->add_option("--mode", o->mode, "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
                                        "paths) or auto (from the point density)")

@@ -7,9 +7,13 @@
 #include "classify/jointboost.hpp"
 #include "core/cloud_io.hpp"
 #include "core/mesh_io.hpp"
+#include "core/qsm_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
 #include "encode/tree_file.hpp"
+#include "export/cityjson.hpp"
+#include "export/gltf.hpp"
+#include "export/qsm.hpp"
 #include "lobes/tlobe_io.hpp"
 
 #include <zlib.h>
@@ -68,18 +72,18 @@ void skeleton_and_mesh_seeds(const fs::path& source, const fs::path& out) {
     const TreeGraph small = first_nodes(palm, 40);
     write_skeleton_ply(small, out / "skeleton_ply/palm_binary.ply", true);
     write_skeleton_ply(small, out / "skeleton_ply/palm_ascii.ply", false);
-    const TriangleMesh palm = read_mesh(source / "data/synthetic/palm_1_mesh.ply");
+    const TriangleMesh palm_mesh = read_mesh(source / "data/synthetic/palm_1_mesh.ply");
     // The first 60 faces with the vertices they use, renumbered.
     TriangleMesh mesh;
-    mesh.origin = palm.origin;
-    std::vector<int> index(palm.vertices.size(), -1);
-    for (std::size_t f = 0; f < std::min<std::size_t>(palm.faces.size(), 60); ++f) {
+    mesh.origin = palm_mesh.origin;
+    std::vector<int> index(palm_mesh.vertices.size(), -1);
+    for (std::size_t f = 0; f < std::min<std::size_t>(palm_mesh.faces.size(), 60); ++f) {
         std::array<int, 3> face{};
         for (int k = 0; k < 3; ++k) {
-            int& i = index[static_cast<std::size_t>(palm.faces[f][k])];
+            int& i = index[static_cast<std::size_t>(palm_mesh.faces[f][k])];
             if (i < 0) {
                 i = static_cast<int>(mesh.vertices.size());
-                mesh.vertices.push_back(palm.vertices[static_cast<std::size_t>(palm.faces[f][k])]);
+                mesh.vertices.push_back(palm_mesh.vertices[static_cast<std::size_t>(palm_mesh.faces[f][k])]);
             }
             face[k] = i;
         }
@@ -130,9 +134,10 @@ void code_seeds(const fs::path& source, const fs::path& out) {
         write_bytes(out / "chain_code" / (std::string("birch_") + name + ".txt"), code.symbols + "\n" + radii);
     }
     std::vector<encode::ForestTree> trees;
+    const char* species[] = {"birch_3", "lagerstroemia_2", "palm_1"};
     for (int i : {1, 2, 3}) {
         encode::ForestTree t;
-        t.skeleton = first_nodes(read_skeleton_ply(source / ("data/synthetic/tile/skeletons/tree_" + std::to_string(i) + ".ply")), 30);
+        t.skeleton = first_nodes(read_skeleton_ply(source / "data/synthetic" / (std::string(species[i - 1]) + "_skeleton.ply")), 30);
         t.position = {100.0 * i, 50.0, 2.0};
         t.azimuth = 0.5f * i;
         t.name = "tree_" + std::to_string(i);
@@ -205,6 +210,31 @@ void jointboost_seeds(const fs::path& out) {
                               out / "jointboost/single.json");
 }
 
+// A file with the format-selecting first byte of qsm_fuzz.cpp / export_info_fuzz.cpp.
+void write_selected(const fs::path& path, char selector, const std::string& body) { write_bytes(path, std::string(1, selector) + body); }
+
+std::string file_text(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
+void export_seeds(const fs::path& source, const fs::path& out) {
+    exporting::ExportTree tree{"palm", first_nodes(read_skeleton_ply(source / "data/synthetic/palm_1_skeleton.ply"), 25), {}, "palm"};
+    const QsmModel qsm = exporting::qsm_from_tree(tree.skeleton, tree.name);
+    const fs::path scratch = out / "qsm/scratch";
+    write_treeqsm_cylinders(qsm, scratch);
+    write_selected(out / "qsm/palm_treeqsm.txt", 0, file_text(scratch));
+    write_qsm_csv(qsm, scratch);
+    write_selected(out / "qsm/palm_simpleforest.csv", 1, file_text(scratch));
+    fs::remove(scratch);
+    exporting::TreeGeometryOptions geometry;
+    geometry.lods = 2;
+    geometry.sides = 3;
+    const exporting::GltfTree gltf{tree.name, tree.skeleton.origin, exporting::tree_lods(tree, geometry), {{"height", 1.0}}, tree.species};
+    write_selected(out / "export_info/palm.glb", 0, exporting::glb_bytes({gltf}, tree.skeleton.origin));
+    write_selected(out / "export_info/palm.city.json", 1, exporting::cityjson_text({tree}, "EPSG:25832"));
+}
+
 void text_seeds(const fs::path& source, const fs::path& out) {
     fs::create_directories(out / "species_yaml");
     fs::copy_file(source / "config/species.yaml", out / "species_yaml/species.yaml", fs::copy_options::overwrite_existing);
@@ -222,13 +252,14 @@ int main(int argc, char** argv) {
     }
     const fs::path source = argv[1], out = argv[2];
     for (const char* target : {"las", "ply_cloud", "skeleton_ply", "text_cloud", "pcd", "mesh", "dbf6", "dbf6_record",
-                               "chain_code", "forest", "forest_record", "tlobe", "tlobe_payload", "jointboost"})
+                               "chain_code", "forest", "forest_record", "tlobe", "tlobe_payload", "jointboost", "qsm", "export_info"})
         fs::create_directories(out / target);
     cloud_seeds(source, out);
     skeleton_and_mesh_seeds(source, out);
     code_seeds(source, out);
     tlobe_seeds(source, out);
     jointboost_seeds(out);
+    export_seeds(source, out);
     text_seeds(source, out);
     return 0;
 }

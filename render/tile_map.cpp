@@ -48,7 +48,9 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
     if (cloud.empty()) throw Error(ExitCode::Internal, "draw_tile_map: empty cloud");
     if (tree_id.size() != cloud.size() || (!height_above_ground.empty() && height_above_ground.size() != cloud.size()))
         throw Error(ExitCode::Internal, "draw_tile_map: one tree id and height per point expected");
-    const auto [lo, hi] = cloud.bounds();
+    const auto bounds = cloud.bounds();  // not a structured binding: clang 14 cannot capture those in lambdas
+    const auto& lo = bounds.first;
+    const auto& hi = bounds.second;
     const double extent = std::max({static_cast<double>(hi.x() - lo.x()), static_cast<double>(hi.y() - lo.y()), 1e-3});
     const double pixel = std::max(options.min_pixel_m, extent / options.max_side_px);
     const int m = options.margin_px;

@@ -26,9 +26,12 @@ generate() {
     # the scan hits too few of its thin stems for a skeleton worth scoring.
     "$BIN" --log-level warn synth tree --species lagerstroemia --seed 2 --height 5 --angular-step 0.4 --ground-margin 0.5 --max-leaves 3000 --no-mesh --out "$out" >/dev/null
     "$BIN" --log-level warn synth tree --species birch --seed 3 --height 9 --scanner als --pulse-density 80 --max-leaves 4000 --no-mesh --out "$out" >/dev/null
-    # The demo's forest tile: an airborne scan (20 pulses/m^2) of 30 trees of five species on 40 x 40 m
-    # of sloping ground with understory and noise.
-    "$BIN" --log-level warn synth tile --trees 30 --size 40 --seed 4 --pulse-density 20 --max-leaves 3000 \
+    # The demo's forest tile: an airborne scan (20 pulses/m^2) of 30 trees of five species on 55 x 55 m
+    # of sloping ground with understory and noise; stems at least 0.9 x their summed crown radii
+    # apart, so neighbouring crowns touch as in a closed stand instead of growing through each
+    # other (the synthetic trees do not react to their neighbours; at the default 0.4 half of a
+    # crown can lie inside the next one, docs/segment.md).
+    "$BIN" --log-level warn synth tile --trees 30 --size 55 --spacing 0.9 --seed 4 --pulse-density 20 --max-leaves 3000 \
         --species pine birch palm lagerstroemia ailanthus_altissima --out "$out/tile" >/dev/null
     # summary.json holds timings and memory, which differ between runs: not part of the sample. The
     # true skeletons of the tile's trees (3 MB) are left out to keep the sample small; the single

@@ -318,7 +318,9 @@ PointCloud scan_tls(const Scene& scene, const TlsOptions& o, std::uint64_t seed,
 
 PointCloud scan_als(const Scene& scene, const AlsOptions& o, std::uint64_t seed, ScanSummary* summary) {
     validate(o);
-    const auto [lo, hi] = scene.bounds();
+    const auto bounds = scene.bounds();  // not a structured binding: clang 14 cannot capture those in lambdas
+    const auto& lo = bounds.first;
+    const auto& hi = bounds.second;
     const RayScene rays(scene);
     // Flight lines cover the ground (or the scene) plus a margin; returns outside are clipped.
     Eigen::Vector2d area_lo = lo.head<2>(), area_hi = hi.head<2>();
