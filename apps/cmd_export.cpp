@@ -38,11 +38,13 @@ struct ExportCliOptions {
     TreeGeometryOptions geometry;
     bool no_leaves = false;
     std::string crs;                 // overrides the inputs' sidecar CRS
+    CityJsonOptions cityjson;
 };
 
 struct TreeSummary {
     std::string name;
     TreeMeasures measures;
+    std::optional<double> confidence;
 };
 
 // QSM tables: one tree -> OUT is the cylinder file; several -> OUT is a folder of <name>.<ext>.
@@ -69,15 +71,19 @@ std::vector<std::string> write_qsm(const ExportInput& input, const ExportCliOpti
     return written;
 }
 
-std::vector<std::pair<std::string, double>> extras_of(const TreeMeasures& m) {
-    return {{"height", m.height}, {"trunkDiameter", m.dbh}, {"crownDiameter", m.crown_diameter}, {"woodVolume", m.wood_volume}};
+std::vector<std::pair<std::string, double>> extras_of(const TreeSummary& t) {
+    const TreeMeasures& m = t.measures;
+    std::vector<std::pair<std::string, double>> extras = {
+        {"height", m.height}, {"trunkDiameter", m.dbh}, {"crownDiameter", m.crown_diameter}, {"woodVolume", m.wood_volume}};
+    if (t.confidence) extras.emplace_back("confidence", *t.confidence);
+    return extras;
 }
 
 void write_glb(const ExportInput& input, const std::vector<TreeSummary>& summaries, const ExportCliOptions& o) {
     std::vector<GltfTree> trees;
     for (std::size_t i = 0; i < input.trees.size(); ++i) {
         const ExportTree& tree = input.trees[i];
-        trees.push_back({tree.name, tree.skeleton.origin, tree_lods(tree, o.geometry), extras_of(summaries[i].measures), tree.species});
+        trees.push_back({tree.name, tree.skeleton.origin, tree_lods(tree, o.geometry), extras_of(summaries[i]), tree.species});
     }
     const Eigen::Vector3d origin = input.trees.front().skeleton.origin;
     write_file_atomically(o.out, glb_bytes(trees, origin));
@@ -104,7 +110,8 @@ nlohmann::json summary_json(const ExportCliOptions& o, const OptionTable& table,
                         {"wood_volume", t.measures.wood_volume},
                         {"skeleton_length", t.measures.total_length},
                         {"branches", t.measures.branches},
-                        {"lobes", t.measures.lobes}});
+                        {"lobes", t.measures.lobes},
+                        {"confidence", t.confidence ? nlohmann::json(*t.confidence) : nlohmann::json()}});
     return {{"treelobes", kVersion},
             {"command", "export"},
             {"input", o.input},
@@ -117,13 +124,14 @@ nlohmann::json summary_json(const ExportCliOptions& o, const OptionTable& table,
 
 int run_export(ExportCliOptions o, const OptionTable& table, const GlobalOptions& global) {
     o.geometry.leaves = !o.no_leaves;
+    if (o.cityjson.instances && o.format != "cityjson") throw Error::usage("--instances applies to --format cityjson only");
     const ExportInput input = read_export_input(o.input, o.lod);
     std::vector<TreeSummary> summaries;
-    for (const auto& tree : input.trees) summaries.push_back({tree.name, measure_tree(tree)});
+    for (const auto& tree : input.trees) summaries.push_back({tree.name, measure_tree(tree), tree.confidence});
     std::vector<std::string> outputs{o.out};
     if (o.format == "qsm-txt" || o.format == "qsm-csv") outputs = write_qsm(input, o);
     else if (o.format == "glb") write_glb(input, summaries, o);
-    else if (o.format == "cityjson") write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs));
+    else if (o.format == "cityjson") write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs, o.cityjson));
     else write_mesh_file(input, o);
     if (global.json) {
         std::cout << summary_json(o, table, input, summaries, outputs).dump(2) << "\n";
@@ -157,6 +165,7 @@ void add_export_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add_flag("--no-leaves", options->no_leaves, "glb: no leaf cards on skeletons without lobes");
     table->add("--leaf-size", options->geometry.leaf_size, "glb: leaf card edge in metres")
         ->check(cli::PositiveNumber);
+    table->add_flag("--instances", options->cityjson.instances, "cityjson: LoD 2 as GeometryInstances of one template per species (geometry-templates)");
     table->add("--crs", options->crs, "CRS of the input (EPSG:25832 or WKT) when its georef sidecar has none");
     sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_export(*options, *table, global); }; });
 }

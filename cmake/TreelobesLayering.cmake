@@ -16,8 +16,9 @@ set(TREELOBES_DEPENDS_synth core geometry config)
 set(TREELOBES_DEPENDS_lobes core geometry config lsystem reconstruct/reconstruct_tree.hpp)
 set(TREELOBES_DEPENDS_classify core geometry render
     reconstruct/reconstruct_tree.hpp reconstruct/preprocess.hpp reconstruct/skeleton.hpp reconstruct/allometry.hpp)
-# export reads our tree files (encode, lobes) and writes them for other tools.
-set(TREELOBES_DEPENDS_export core geometry encode lobes)
+# export reads our tree files (encode, lobes) and writes them for other tools (render: PNG
+# textures embedded in glTF).
+set(TREELOBES_DEPENDS_export core geometry encode lobes render)
 # forestry runs every tree of a tile through the single-tree stages: their entry points.
 set(TREELOBES_DEPENDS_forestry core geometry encode lobes classify reconstruct/reconstruct_tree.hpp)
 # survey: many tiles (their list and shards, completion markers, memory estimate, retiling, merging).

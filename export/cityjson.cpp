@@ -50,6 +50,12 @@ public:
         for (const auto& v : vertices_) out.push_back(v);
         return out;
     }
+    // Real coordinates relative to the translate, in metres (the "vertices-templates" form).
+    json vertices_in_metres() const {
+        json out = json::array();
+        for (const auto& v : vertices_) out.push_back({millimetres(v[0] * kScale), millimetres(v[1] * kScale), millimetres(v[2] * kScale)});
+        return out;
+    }
     bool empty() const { return vertices_.empty(); }
 
 private:
@@ -70,7 +76,52 @@ Eigen::Vector3d minimum_corner(const std::vector<ExportTree>& trees) {
     return lo.array().floor().matrix();
 }
 
-json tree_object(const ExportTree& tree, const TreeMeasures& m, VertexGrid& grid, const CityJsonOptions& options) {
+// The LoD 2 geometry: branch tubes and lobes, origin = the tree's origin.
+TriangleMesh lod2_mesh(const ExportTree& tree, const CityJsonOptions& options) {
+    BranchMeshOptions tubes;
+    tubes.sides = options.branch_sides;
+    tubes.subdivisions = 1;
+    TriangleMesh branches = build_branch_mesh(tree.skeleton, tubes);
+    branches.origin = tree.skeleton.origin;
+    for (const auto& lobe : tree.lobes) branches.append(lobe);
+    return branches;
+}
+
+// One template per species: which tree it copies, its size, its index.
+struct SpeciesTemplate {
+    int index = 0;
+    double height = 0, crown_diameter = 0;
+};
+
+// "geometry-templates" (templates sorted by species name) and each species' template. The
+// template of a species is its tree of median height (the lower middle one for an even count).
+json geometry_templates(const std::vector<ExportTree>& trees, const std::vector<TreeMeasures>& measures, const CityJsonOptions& options,
+                        std::map<std::string, SpeciesTemplate>& of_species) {
+    std::map<std::string, std::vector<std::size_t>> trees_of_species;
+    for (std::size_t i = 0; i < trees.size(); ++i) trees_of_species[trees[i].species].push_back(i);
+    json templates = json::array();
+    VertexGrid grid(Eigen::Vector3d::Zero());
+    for (auto& [species, members] : trees_of_species) {
+        std::stable_sort(members.begin(), members.end(), [&](std::size_t a, std::size_t b) { return measures[a].height < measures[b].height; });
+        const std::size_t chosen = members[(members.size() - 1) / 2];
+        TriangleMesh mesh = lod2_mesh(trees[chosen], options);
+        mesh.origin -= measures[chosen].base;  // relative to the stem base
+        of_species[species] = {static_cast<int>(templates.size()), measures[chosen].height, measures[chosen].crown_diameter};
+        templates.push_back({{"type", "MultiSurface"}, {"lod", "2"}, {"boundaries", grid.surfaces(mesh)}});
+    }
+    return {{"templates", templates}, {"vertices-templates", grid.vertices_in_metres()}};
+}
+
+// Scales the template to the tree (row-major 4x4, no rotation; the reference point places it).
+json transformation_matrix(const TreeMeasures& tree, const SpeciesTemplate& t) {
+    const double across = t.crown_diameter > 0 && tree.crown_diameter > 0 ? tree.crown_diameter / t.crown_diameter : 1.0;
+    const double up = t.height > 0 && tree.height > 0 ? tree.height / t.height : 1.0;
+    const auto round6 = [](double v) { return std::round(v * 1e6) / 1e6; };
+    return {round6(across), 0, 0, 0, 0, round6(across), 0, 0, 0, 0, round6(up), 0, 0, 0, 0, 1};
+}
+
+json tree_object(const ExportTree& tree, const TreeMeasures& m, VertexGrid& grid, const CityJsonOptions& options,
+                 const SpeciesTemplate* instance_of) {
     json attributes = {{"height", millimetres(m.height)},
                        {"trunkDiameter", millimetres(m.dbh)},
                        {"crownDiameter", millimetres(m.crown_diameter)},
@@ -81,18 +132,20 @@ json tree_object(const ExportTree& tree, const TreeMeasures& m, VertexGrid& grid
                        {"branchCount", m.branches},
                        {"lobeCount", m.lobes}};
     if (!tree.species.empty()) attributes["species"] = tree.species;
+    if (tree.confidence) attributes["confidence"] = std::round(*tree.confidence * 1e4) / 1e4;
     json geometry = json::array();
     if (!m.crown_hull.faces.empty()) {
         const json shell = grid.surfaces(m.crown_hull);
         geometry.push_back({{"type", "Solid"}, {"lod", "1"}, {"boundaries", json::array({shell})}});
     }
-    BranchMeshOptions tubes;
-    tubes.sides = options.branch_sides;
-    tubes.subdivisions = 1;
-    TriangleMesh branches = build_branch_mesh(tree.skeleton, tubes);
-    branches.origin = tree.skeleton.origin;
-    for (const auto& lobe : tree.lobes) branches.append(lobe);
-    if (!branches.faces.empty()) geometry.push_back({{"type", "MultiSurface"}, {"lod", "2"}, {"boundaries", grid.surfaces(branches)}});
+    if (instance_of) {
+        geometry.push_back({{"type", "GeometryInstance"},
+                            {"template", instance_of->index},
+                            {"boundaries", json::array({grid.index(m.base)})},
+                            {"transformationMatrix", transformation_matrix(m, *instance_of)}});
+    } else if (const TriangleMesh branches = lod2_mesh(tree, options); !branches.faces.empty()) {
+        geometry.push_back({{"type", "MultiSurface"}, {"lod", "2"}, {"boundaries", grid.surfaces(branches)}});
+    }
     return {{"type", "SolitaryVegetationObject"}, {"attributes", attributes}, {"geometry", geometry}};
 }
 
@@ -140,6 +193,23 @@ void check_shell_closed(const json& shell, const std::string& where, std::vector
     }
 }
 
+void check_instance(const json& geometry, const std::string& id, long long vertex_count, long long template_count,
+                    std::vector<std::string>& problems) {
+    const std::string where = id + " GeometryInstance";
+    const json index = geometry.value("template", json());
+    if (!index.is_number_integer() || index.get<long long>() < 0 || index.get<long long>() >= template_count)
+        problems.push_back(where + ": template " + index.dump() + " not among the " + std::to_string(template_count) + " templates");
+    const json reference = geometry.value("boundaries", json::array());
+    if (reference.size() != 1 || !reference[0].is_number_integer() || reference[0].get<long long>() < 0 ||
+        reference[0].get<long long>() >= vertex_count)
+        problems.push_back(where + ": reference point " + reference.dump() + " is not one vertex index in range");
+    const json matrix = geometry.value("transformationMatrix", json::array());
+    bool affine = matrix.size() == 16;
+    for (std::size_t k = 0; affine && k < 16; ++k) affine = matrix[k].is_number() && std::isfinite(matrix[k].get<double>());
+    if (affine) affine = matrix[12] == 0 && matrix[13] == 0 && matrix[14] == 0 && matrix[15] == 1;
+    if (!affine) problems.push_back(where + ": transformationMatrix is not 16 finite numbers of an affine map");
+}
+
 void check_geometry(const json& geometry, const std::string& id, long long vertex_count, std::vector<std::string>& problems) {
     const std::string type = geometry.value("type", "?");
     const std::string where = id + " " + type + " lod " + geometry.value("lod", "?");
@@ -162,19 +232,26 @@ std::string cityjson_text(const std::vector<ExportTree>& trees, const std::strin
     if (trees.empty()) throw Error::input("", "CityJSON export: no trees");
     const Eigen::Vector3d translate = minimum_corner(trees);
     VertexGrid grid(translate);
+    std::vector<TreeMeasures> measures;
+    for (const auto& tree : trees) measures.push_back(measure_tree(tree));
+    std::map<std::string, SpeciesTemplate> templates;
+    json geometry_template_block;
+    if (options.instances) geometry_template_block = geometry_templates(trees, measures, options, templates);
     json objects = json::object();
-    for (const auto& tree : trees) objects[tree.name] = tree_object(tree, measure_tree(tree), grid, options);
+    for (std::size_t i = 0; i < trees.size(); ++i)
+        objects[trees[i].name] = tree_object(trees[i], measures[i], grid, options, options.instances ? &templates.at(trees[i].species) : nullptr);
     json vertices = grid.vertices();
     json metadata = {{"title", "trees exported by treelobes " + std::string(kVersion)}};
     if (!vertices.empty()) metadata["geographicalExtent"] = extent(vertices, translate);
     if (const std::string code = epsg_code(crs); !code.empty())
         metadata["referenceSystem"] = "https://www.opengis.net/def/crs/EPSG/0/" + code;
-    const json document = {{"type", "CityJSON"},
-                           {"version", "2.0"},
-                           {"transform", {{"scale", {kScale, kScale, kScale}}, {"translate", {translate.x(), translate.y(), translate.z()}}}},
-                           {"metadata", metadata},
-                           {"CityObjects", objects},
-                           {"vertices", vertices}};
+    json document = {{"type", "CityJSON"},
+                     {"version", "2.0"},
+                     {"transform", {{"scale", {kScale, kScale, kScale}}, {"translate", {translate.x(), translate.y(), translate.z()}}}},
+                     {"metadata", metadata},
+                     {"CityObjects", objects},
+                     {"vertices", vertices}};
+    if (options.instances) document["geometry-templates"] = geometry_template_block;
     return document.dump() + "\n";
 }
 
@@ -188,10 +265,18 @@ std::vector<std::string> check_cityjson(const std::string& text) {
     std::vector<std::string> problems;
     const long long vertex_count = static_cast<long long>(document.value("vertices", json::array()).size());
     const json objects = document.value("CityObjects", json::object());
+    const json templates = document.value("geometry-templates", json::object());
+    const long long template_count = static_cast<long long>(templates.value("templates", json::array()).size());
+    const long long template_vertex_count = static_cast<long long>(templates.value("vertices-templates", json::array()).size());
     for (const auto& [id, object] : objects.items()) {
         const json geometries = object.value("geometry", json::array());
-        for (const auto& geometry : geometries) check_geometry(geometry, id, vertex_count, problems);
+        for (const auto& geometry : geometries) {
+            if (geometry.value("type", "") == "GeometryInstance") check_instance(geometry, id, vertex_count, template_count, problems);
+            else check_geometry(geometry, id, vertex_count, problems);
+        }
     }
+    for (long long t = 0; t < template_count; ++t)
+        check_geometry(templates["templates"][t], "template " + std::to_string(t), template_vertex_count, problems);
     return problems;
 }
 

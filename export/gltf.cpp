@@ -2,6 +2,8 @@
 
 #include "core/error.hpp"
 #include "core/version.hpp"
+#include "render/image.hpp"
+#include "render/leaf_texture.hpp"
 
 #include <Eigen/Geometry>
 #include <nlohmann/json.hpp>
@@ -17,6 +19,8 @@ using nlohmann::json;
 
 constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 constexpr int kFloat = 5126, kUnsignedInt = 5125;
+constexpr int kLinear = 9729, kLinearMipmapLinear = 9987, kClampToEdge = 33071;
+constexpr int kLeafTextureSize = 64;
 constexpr std::uint32_t kGlbMagic = 0x46546C67, kJsonChunk = 0x4E4F534A, kBinChunk = 0x004E4942;
 
 // Our z-up frame to glTF's y-up frame.
@@ -39,8 +43,8 @@ std::vector<Eigen::Vector3f> vertex_normals(const TriangleMesh& mesh) {
 
 class GlbBuilder {
 public:
-    // A primitive of `mesh` (tree frame) with `material`.
-    json primitive(const TriangleMesh& mesh, int material) {
+    // A primitive of `mesh` (tree frame) with `material`; `uvs` (one per vertex) become TEXCOORD_0.
+    json primitive(const TriangleMesh& mesh, int material, const std::vector<Eigen::Vector2f>& uvs = {}) {
         std::vector<Eigen::Vector3f> positions;
         positions.reserve(mesh.vertices.size());
         for (const auto& v : mesh.vertices) positions.push_back(y_up(v));
@@ -48,21 +52,42 @@ public:
         indices.reserve(mesh.faces.size() * 3);
         for (const auto& f : mesh.faces)
             for (int v : f) indices.push_back(static_cast<std::uint32_t>(v));
-        return {{"attributes", {{"POSITION", vec3_accessor(positions, true)}, {"NORMAL", vec3_accessor(vertex_normals(mesh), false)}}},
-                {"indices", index_accessor(indices)},
-                {"material", material},
-                {"mode", 4}};
+        json attributes = {{"POSITION", vec3_accessor(positions, true)}, {"NORMAL", vec3_accessor(vertex_normals(mesh), false)}};
+        if (!uvs.empty()) {
+            if (uvs.size() != mesh.vertices.size()) throw Error(ExitCode::Internal, "glTF: texture coordinates do not match the vertices");
+            attributes["TEXCOORD_0"] = vec2_accessor(uvs);
+        }
+        return {{"attributes", attributes}, {"indices", index_accessor(indices)}, {"material", material}, {"mode", 4}};
     }
+
+    // An image stored in the BIN chunk (glTF 2.0 §3.8.4: bufferView + mimeType); its index.
+    int png_image(const std::string& png) {
+        const int view = add_view(png.data(), png.size(), 0);
+        while (bin.size() % 4) bin += '\0';  // the next view starts 4-aligned
+        images.push_back({{"bufferView", view}, {"mimeType", "image/png"}});
+        return static_cast<int>(images.size()) - 1;
+    }
+
+    json images = json::array();
 
     json buffer_views = json::array(), accessors = json::array();
     std::string bin;
 
 private:
+    // target 0: no target (images).
     int add_view(const void* data, std::size_t bytes, int target) {
-        const std::size_t offset = bin.size();  // always a multiple of 4: floats and uint32 only
+        const std::size_t offset = bin.size();  // always a multiple of 4: floats, uint32 and padded images
         bin.append(static_cast<const char*>(data), bytes);
-        buffer_views.push_back({{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}, {"target", target}});
+        json view = {{"buffer", 0}, {"byteOffset", offset}, {"byteLength", bytes}};
+        if (target) view["target"] = target;
+        buffer_views.push_back(view);
         return static_cast<int>(buffer_views.size()) - 1;
+    }
+
+    int vec2_accessor(const std::vector<Eigen::Vector2f>& values) {
+        const int view = add_view(values.data(), values.size() * sizeof(Eigen::Vector2f), kArrayBuffer);
+        accessors.push_back({{"bufferView", view}, {"componentType", kFloat}, {"count", values.size()}, {"type", "VEC2"}});
+        return static_cast<int>(accessors.size()) - 1;
     }
 
     int vec3_accessor(const std::vector<Eigen::Vector3f>& values, bool bounds) {
@@ -85,16 +110,33 @@ private:
     }
 };
 
-json materials() {
+// bark, foliage (lobes) and, when leaf cards are present, leaves: texture 0 with an alpha mask
+// (glTF 2.0 §3.9.4: MASK renders texels with alpha >= alphaCutoff opaque, drops the others).
+json materials(bool leaves) {
     const auto material = [](const char* name, std::array<double, 4> colour, double roughness, bool two_sided) {
         json m = {{"name", name},
                   {"pbrMetallicRoughness", {{"baseColorFactor", colour}, {"metallicFactor", 0.0}, {"roughnessFactor", roughness}}}};
         if (two_sided) m["doubleSided"] = true;
         return m;
     };
-    return json::array({material("bark", {0.36, 0.25, 0.16, 1.0}, 0.9, false), material("foliage", {0.22, 0.45, 0.14, 1.0}, 0.8, true)});
+    json list = json::array({material("bark", {0.36, 0.25, 0.16, 1.0}, 0.9, false), material("foliage", {0.22, 0.45, 0.14, 1.0}, 0.8, true)});
+    if (leaves) {
+        json leaf = material("leaves", {1.0, 1.0, 1.0, 1.0}, 0.8, true);
+        leaf["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
+        leaf["alphaMode"] = "MASK";
+        leaf["alphaCutoff"] = 0.5;
+        list.push_back(leaf);
+    }
+    return list;
 }
-constexpr int kBark = 0, kFoliage = 1;
+constexpr int kBark = 0, kFoliage = 1, kLeaves = 2;
+
+bool has_leaf_cards(const std::vector<GltfTree>& trees) {
+    for (const auto& tree : trees)
+        for (const auto& lod : tree.lods)
+            if (!lod.foliage_uvs.empty() && !lod.foliage.faces.empty()) return true;
+    return false;
+}
 
 void put_u32(std::string& out, std::uint32_t v) {
     for (int k = 0; k < 4; ++k) out += static_cast<char>((v >> (8 * k)) & 0xFF);
@@ -121,6 +163,7 @@ std::string assemble_glb(const json& document, std::string bin) {
 
 std::string glb_bytes(const std::vector<GltfTree>& trees, const Eigen::Vector3d& scene_origin) {
     GlbBuilder builder;
+    const bool leaves = has_leaf_cards(trees);
     json meshes = json::array(), nodes = json::array(), scene_nodes = json::array();
     for (const GltfTree& tree : trees) {
         if (tree.lods.empty() || (tree.lods.front().wood.faces.empty() && tree.lods.front().foliage.faces.empty())) continue;
@@ -129,7 +172,10 @@ std::string glb_bytes(const std::vector<GltfTree>& trees, const Eigen::Vector3d&
         for (std::size_t k = 0; k < tree.lods.size(); ++k) {
             json primitives = json::array();
             if (!tree.lods[k].wood.faces.empty()) primitives.push_back(builder.primitive(tree.lods[k].wood, kBark));
-            if (!tree.lods[k].foliage.faces.empty()) primitives.push_back(builder.primitive(tree.lods[k].foliage, kFoliage));
+            const TreeLod& lod = tree.lods[k];
+            if (!lod.foliage.faces.empty())
+                primitives.push_back(lod.foliage_uvs.empty() ? builder.primitive(lod.foliage, kFoliage)
+                                                             : builder.primitive(lod.foliage, kLeaves, lod.foliage_uvs));
             if (primitives.empty()) {  // nothing left at this LOD: show the previous one
                 lod_meshes.push_back(lod_meshes.back());
                 continue;
@@ -165,15 +211,21 @@ std::string glb_bytes(const std::vector<GltfTree>& trees, const Eigen::Vector3d&
         scene_nodes.push_back(main_index);
     }
     if (scene_nodes.empty()) throw Error::input("", "glTF export: no tree has any geometry");
+    if (leaves) builder.png_image(render::encode_png(render::leaf_texture(kLeafTextureSize)));  // once, after the geometry
     json document = {{"asset", {{"version", "2.0"}, {"generator", std::string("treelobes ") + kVersion}}},
                      {"scene", 0},
                      {"scenes", json::array({{{"name", "trees"}, {"nodes", scene_nodes}}})},
                      {"nodes", nodes},
                      {"meshes", meshes},
-                     {"materials", materials()},
+                     {"materials", materials(leaves)},
                      {"accessors", builder.accessors},
                      {"bufferViews", builder.buffer_views},
                      {"buffers", json::array({{{"byteLength", builder.bin.size()}}})}};
+    if (leaves) {
+        document["images"] = builder.images;
+        document["samplers"] = json::array({{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kClampToEdge}, {"wrapT", kClampToEdge}}});
+        document["textures"] = json::array({{{"sampler", 0}, {"source", 0}, {"name", "leaf"}}});
+    }
     if (nodes.size() > scene_nodes.size()) document["extensionsUsed"] = {"MSFT_lod"};
     return assemble_glb(document, std::move(builder.bin));
 }

@@ -28,8 +28,8 @@ float lod_threshold(const TreeGraph& tree, int k, int n) {
 }
 
 // Two crossed square cards per tip, along the tip's internode, beyond the tip; every
-// `stride`-th tip in pre-order.
-TriangleMesh leaf_cards(const TreeGraph& tree, int stride, float size) {
+// `stride`-th tip in pre-order. `uvs` gets the texture coordinates of the cards' corners.
+TriangleMesh leaf_cards(const TreeGraph& tree, int stride, float size, std::vector<Eigen::Vector2f>& uvs) {
     TriangleMesh cards;
     cards.origin = tree.origin;
     int tip = 0;
@@ -49,6 +49,7 @@ TriangleMesh leaf_cards(const TreeGraph& tree, int stride, float size) {
             cards.vertices.push_back(n.position + half);
             cards.vertices.push_back(n.position + half + along * size);
             cards.vertices.push_back(n.position - half + along * size);
+            uvs.insert(uvs.end(), {{0.0f, 1.0f}, {1.0f, 1.0f}, {1.0f, 0.0f}, {0.0f, 0.0f}});
             cards.faces.push_back({base, base + 1, base + 2});
             cards.faces.push_back({base, base + 2, base + 3});
         }
@@ -85,7 +86,7 @@ std::vector<TreeLod> tree_lods(const ExportTree& tree, const TreeGeometryOptions
         if (!tree.lobes.empty()) lod.foliage = lobes_mesh(tree);
         else if (options.leaves) {
             const int stride = 1 << k;
-            lod.foliage = leaf_cards(tree.skeleton, stride, static_cast<float>(options.leaf_size * std::sqrt(stride)));
+            lod.foliage = leaf_cards(tree.skeleton, stride, static_cast<float>(options.leaf_size * std::sqrt(stride)), lod.foliage_uvs);
         }
         lods.push_back(std::move(lod));
     }

@@ -26,6 +26,9 @@ struct TreeGeometryOptions {
 struct TreeLod {
     TriangleMesh wood;     // closed tubes, origin = the tree's origin
     TriangleMesh foliage;  // lobes (closed) or leaf cards (two crossed quads per tip, two-sided)
+    // Leaf cards only: texture coordinates per foliage vertex, glTF convention (v down): the
+    // card's base edge at v = 1, its outer edge at v = 0, so a leaf texture's stalk sits on the twig.
+    std::vector<Eigen::Vector2f> foliage_uvs;
 };
 
 // Throws Error(Usage) for options out of range.

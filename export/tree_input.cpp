@@ -1,5 +1,6 @@
 #include "export/tree_input.hpp"
 
+#include "core/atomic_file.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
@@ -8,6 +9,8 @@
 #include "encode/forest_file.hpp"
 #include "encode/tree_file.hpp"
 #include "lobes/tlobe_io.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <set>
@@ -31,6 +34,9 @@ ExportTree tree_from_tlobe(const fs::path& path) {
     tree.name = path.stem().string();
     tree.skeleton = std::move(lobe_tree.skeleton);
     tree.species = lobe_tree.species;
+    std::size_t lobe_points = 0;
+    for (const auto& lobe : lobe_tree.lobes) lobe_points += lobe.points;
+    tree.confidence = tree_confidence(path, lobe_points);
     for (auto& lobe : lobe_tree.lobes) {
         lobe.mesh.origin = tree.skeleton.origin;  // decoded lobes are in the skeleton's frame
         tree.lobes.push_back(std::move(lobe.mesh));
@@ -78,6 +84,27 @@ void make_names_unique(std::vector<ExportTree>& trees) {
 }
 
 }  // namespace
+
+std::optional<double> tree_confidence(const fs::path& tlobe, std::size_t lobe_points) {
+    const fs::path dir = tlobe.parent_path(), stem = tlobe.stem();
+    double tree_points = 0;
+    for (const fs::path& record : {dir / (stem.string() + ".json"), dir / (stem.string() + "_lobes.json")}) {
+        if (!fs::is_regular_file(record)) continue;
+        nlohmann::json json;
+        try {
+            json = nlohmann::json::parse(read_file(record));
+        } catch (const nlohmann::json::exception& e) {
+            throw Error::input(record.string(), std::string("not JSON: ") + e.what());
+        }
+        const nlohmann::json points = json.value("points", nlohmann::json());
+        if (points.is_number()) tree_points = points.get<double>();  // tile record: all points of the tree
+        else if (points.is_object() && points.value("main", nlohmann::json()).is_number() && points.value("lobes", nlohmann::json()).is_number())
+            tree_points = points["main"].get<double>() + points["lobes"].get<double>();  // lobes summary
+        if (tree_points > 0) break;
+    }
+    if (!(tree_points > 0)) return std::nullopt;
+    return std::clamp(1.0 - static_cast<double>(lobe_points) / tree_points, 0.0, 1.0);
+}
 
 bool is_tree_file(const fs::path& path) {
     const std::string ext = file_extension(path);

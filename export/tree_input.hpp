@@ -9,6 +9,7 @@
 #include "core/triangle_mesh.hpp"
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,12 @@ struct ExportTree {
     TreeGraph skeleton;               // world position = skeleton.origin + node position
     std::vector<TriangleMesh> lobes;  // closed crown lobes (.tlobe), origin = skeleton.origin
     std::string species;              // empty when unknown
+    // Reconstruction confidence in [0, 1]: the share of the tree's points on high-confidence
+    // skeleton edges (Livny et al. 2011, §4.2: an internode whose points lie on average within the
+    // lobe-confidence diameter d' = f_s d(u) of it); the rest formed the low-confidence clusters
+    // that became lobes. Known for a .tlobe with the record its pipeline wrote beside it (see
+    // tree_confidence); unset otherwise.
+    std::optional<double> confidence;
 };
 
 struct ExportInput {
@@ -31,6 +38,13 @@ struct ExportInput {
 // naming the file for unreadable or invalid input (a truncated file, a skeleton that is not one
 // rooted tree), also for a folder without any tree file; Error(Usage) for a LOD not stored.
 ExportInput read_export_input(const std::filesystem::path& path, int lod = 0);
+
+// The confidence of the tree in `tlobe` whose lobes hold `lobe_points` scan points, from the
+// record beside it: `<stem>.json` of `treelobes tile` (its "points": all points of the tree) or
+// `<stem>_lobes.json` of `treelobes lobes` ("points": {"main", "lobes"}): 1 - lobe points / tree
+// points. nullopt when neither record is there or it has no points; Error(InvalidInput) naming
+// the record when it is not JSON.
+std::optional<double> tree_confidence(const std::filesystem::path& tlobe, std::size_t lobe_points);
 
 // True for the file kinds read_export_input takes (by extension; PLY: a skeleton PLY).
 bool is_tree_file(const std::filesystem::path& path);

@@ -9,6 +9,7 @@
 #include <csetjmp>
 #include <cstring>
 #include <memory>
+#include <sstream>
 
 namespace treelobes::render {
 
@@ -64,7 +65,7 @@ void png_fail(png_structp png, png_const_charp message) {
 void png_warn(png_structp, png_const_charp) {}
 
 // Returns false (with io.error set) when libpng failed.
-bool encode_png(const Image& image, PngIo& io) {
+bool encode_png_into(const Image& image, PngIo& io) {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &io, png_fail, png_warn);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
     if (!png || !info) {
@@ -87,7 +88,7 @@ bool encode_png(const Image& image, PngIo& io) {
     return true;
 }
 
-bool decode_png(PngIo& io, Image& image) {
+bool decode_png_from(PngIo& io, Image& image) {
     png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &io, png_fail, png_warn);
     png_infop info = png ? png_create_info_struct(png) : nullptr;
     if (!png || !info) {
@@ -122,20 +123,29 @@ void write_png(const Image& image, const std::filesystem::path& path) {
     write_atomically(path, [&](std::ostream& out) {
         PngIo io;
         io.out = &out;
-        if (!encode_png(image, io)) throw Error::input(path.string(), "cannot encode PNG: " + io.error);
+        if (!encode_png_into(image, io)) throw Error::input(path.string(), "cannot encode PNG: " + io.error);
     });
 }
 
-Image read_png(const std::filesystem::path& path) {
-    const std::string bytes = read_file(path);
+std::string encode_png(const Image& image) {
+    std::ostringstream out;
+    PngIo io;
+    io.out = &out;
+    if (!encode_png_into(image, io)) throw Error(ExitCode::Internal, "cannot encode PNG: " + io.error);
+    return std::move(out).str();
+}
+
+Image decode_png(const std::string& bytes, const std::string& what) {
     if (bytes.size() < 8 || png_sig_cmp(reinterpret_cast<png_const_bytep>(bytes.data()), 0, 8) != 0)
-        throw Error::input(path.string(), "not a PNG file");
+        throw Error::input(what, "not a PNG file");
     PngIo io;
     io.bytes = &bytes;
     Image image;
-    if (!decode_png(io, image)) throw Error::input(path.string(), "cannot decode PNG: " + io.error);
+    if (!decode_png_from(io, image)) throw Error::input(what, "cannot decode PNG: " + io.error);
     return image;
 }
+
+Image read_png(const std::filesystem::path& path) { return decode_png(read_file(path), path.string()); }
 
 Image side_by_side(const std::vector<Image>& images, Rgba background) {
     int width = 0, height = 0;

@@ -4,6 +4,7 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace treelobes::render {
@@ -26,6 +27,10 @@ struct Image {
 void write_png(const Image& image, const std::filesystem::path& path);
 // Reads an 8-bit RGBA/RGB/grey PNG (converted to RGBA).
 Image read_png(const std::filesystem::path& path);
+// The bytes of an 8-bit RGBA PNG (for files that embed images, and APNG frames).
+std::string encode_png(const Image& image);
+// Decodes PNG bytes; `what` names the source in the error.
+Image decode_png(const std::string& bytes, const std::string& what);
 
 // Places images side by side (same height; shorter ones are padded at the bottom).
 Image side_by_side(const std::vector<Image>& images, Rgba background = {255, 255, 255, 255});

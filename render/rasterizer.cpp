@@ -49,6 +49,10 @@ ImageAxes image_axes(const View& view) {
         axes.half_width = std::max(axes.half_width, std::abs((p - centre).dot(axes.right)));
         axes.half_height = std::max(axes.half_height, std::abs((p - centre).dot(axes.up)));
     }
+    if (view.half_width > 0 && view.half_height > 0) {
+        axes.half_width = view.half_width;
+        axes.half_height = view.half_height;
+    }
     return axes;
 }
 

@@ -21,6 +21,9 @@ struct View {
     Eigen::Vector3d up{0, 0, 1};
     Eigen::Vector3d lo{-1, -1, -1}, hi{1, 1, 1};
     double margin = 0.05;  // fraction of the frame left empty on each side
+    // When > 0: the half extents (metres) framed on the image axes, around the box's centre,
+    // instead of the box's own; keeps one scale over the frames of an orbit.
+    double half_width = 0, half_height = 0;
 
     // A view from the side at `azimuth_deg` around the vertical axis (0 = looking along +y)
     // and `elevation_deg` above the horizon.

@@ -5,6 +5,8 @@
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
 #include "encode/tree_file.hpp"
+#include "export/cityjson.hpp"
+#include "export/tree_input.hpp"
 #include "lobes/tlobe_io.hpp"
 #include "sample_trees.hpp"
 #include "support/test_support.hpp"
@@ -14,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <filesystem>
 
 using namespace treelobes;
@@ -152,6 +155,14 @@ TEST(ExportCli, TlobeDbf6ForestAndFolderInputs) {
     test::write_text(folder / "summary.json", "{}\n");
     ASSERT_EQ(export_to(folder, "cityjson", dir / "tile.city.json").exit_code, 0);
     EXPECT_EQ(info_of(dir / "tile.city.json")["city_objects"], 3);
+    // --instances: one template per species (the two skeletons have none, the .tlobe is an oak).
+    ASSERT_EQ(export_to(folder, "cityjson", dir / "instances.city.json", "--instances").exit_code, 0);
+    const test::ValidatorRun instances = test::validate_cityjson(dir / "instances.city.json");
+    EXPECT_EQ(instances.exit_code, 0) << instances.output;
+    const auto with_instances = nlohmann::json::parse(read_file(dir / "instances.city.json"));
+    EXPECT_EQ(with_instances["geometry-templates"]["templates"].size(), 2u);
+    EXPECT_TRUE(exporting::check_cityjson(read_file(dir / "instances.city.json")).empty());
+    EXPECT_EQ(export_to(folder, "glb", dir / "x.glb", "--instances").exit_code, 1);  // CityJSON only
 }
 
 TEST(ExportCli, BadInputsGiveOneLineAndExitCodes) {
@@ -181,4 +192,47 @@ TEST(ExportCli, BadInputsGiveOneLineAndExitCodes) {
     EXPECT_EQ(lines(r.err), 1) << r.err;
     r = export_to(dir / "tree.ply", "glb", dir / "x.glb", "--lods 0");
     EXPECT_EQ(r.exit_code, 1);
+}
+
+TEST(ExportCli, ConfidenceFromTheRecordBesideTheTlobe) {
+    test::TempDir dir;
+    // A tile's record (tree_NNNN.json, "points": all the tree's points) beside its .tlobe whose
+    // one lobe holds 500 points: 1 - 500 / 2000.
+    lobes::write_tlobe(lobe_tree(), dir / "tree_0001.tlobe");
+    test::write_text(dir / "tree_0001.json", R"({"tree_id": 1, "points": 2000})");
+    EXPECT_NEAR(exporting::tree_confidence(dir / "tree_0001.tlobe", 500).value(), 0.75, 1e-12);
+    auto r = export_to(dir / "tree_0001.tlobe", "cityjson", dir / "t.city.json", "--json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NEAR(nlohmann::json::parse(r.out)["trees"][0]["confidence"].get<double>(), 0.75, 1e-9);
+    const auto city = nlohmann::json::parse(read_file(dir / "t.city.json"));
+    EXPECT_EQ(city["CityObjects"]["tree_0001"]["attributes"]["confidence"], 0.75);
+    const test::ValidatorRun valid_city = test::validate_cityjson(dir / "t.city.json");
+    EXPECT_EQ(valid_city.exit_code, 0) << valid_city.output;
+    // glb: in the tree node's extras.
+    ASSERT_EQ(export_to(dir / "tree_0001.tlobe", "glb", dir / "t.glb").exit_code, 0);
+    const std::string glb = read_file(dir / "t.glb");
+    std::uint32_t json_length = 0;
+    std::memcpy(&json_length, glb.data() + 12, 4);
+    const auto gltf = nlohmann::json::parse(glb.substr(20, json_length));
+    EXPECT_NEAR(gltf["nodes"][0]["extras"]["confidence"].get<double>(), 0.75, 1e-6);
+    const test::ValidatorRun valid_glb = test::validate_gltf(dir / "t.glb");
+    EXPECT_EQ(valid_glb.exit_code, 0) << valid_glb.output;
+
+    // `treelobes lobes` writes <stem>_lobes.json with the main and lobe points: the same ratio.
+    r = run_cli("lobes " + quoted(test::source_dir() / "data/synthetic/lagerstroemia_2.las") + " --out " + quoted(dir / "lobes"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto points = nlohmann::json::parse(read_file(dir / "lobes" / "lagerstroemia_2_lobes.json"))["points"];
+    const double expected = points["main"].get<double>() / (points["main"].get<double>() + points["lobes"].get<double>());
+    r = export_to(dir / "lobes" / "lagerstroemia_2.tlobe", "cityjson", dir / "l.city.json", "--json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NEAR(nlohmann::json::parse(r.out)["trees"][0]["confidence"].get<double>(), expected, 1e-9);
+
+    // No record: no confidence; a record that is not JSON: exit 2.
+    lobes::write_tlobe(lobe_tree(), dir / "alone.tlobe");
+    ASSERT_EQ(export_to(dir / "alone.tlobe", "cityjson", dir / "a.city.json").exit_code, 0);
+    EXPECT_FALSE(nlohmann::json::parse(read_file(dir / "a.city.json"))["CityObjects"]["alone"]["attributes"].contains("confidence"));
+    test::write_text(dir / "alone.json", "{points");
+    r = export_to(dir / "alone.tlobe", "cityjson", dir / "a.city.json");
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_EQ(lines(r.err), 1) << r.err;
 }

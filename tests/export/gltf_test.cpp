@@ -3,6 +3,7 @@
 #include "core/atomic_file.hpp"
 #include "export/gltf.hpp"
 #include "export/tree_geometry.hpp"
+#include "render/image.hpp"
 #include "sample_trees.hpp"
 #include "support/test_support.hpp"
 #include "validators.hpp"
@@ -23,6 +24,15 @@ nlohmann::json json_chunk(const std::string& glb) {
     return nlohmann::json::parse(glb.substr(20, length));
 }
 
+// The bytes of buffer view `view` (BIN chunk after the JSON chunk).
+std::string view_bytes(const std::string& glb, const nlohmann::json& doc, int view) {
+    std::uint32_t json_length = 0;
+    std::memcpy(&json_length, glb.data() + 12, 4);
+    const std::size_t bin = 20 + json_length + 8;
+    const auto& v = doc["bufferViews"][view];
+    return glb.substr(bin + v.value("byteOffset", 0), v["byteLength"].get<std::size_t>());
+}
+
 GltfTree gltf_tree(const ExportTree& tree, int lods) {
     TreeGeometryOptions options;
     options.lods = lods;
@@ -30,7 +40,7 @@ GltfTree gltf_tree(const ExportTree& tree, int lods) {
 }
 
 ExportTree tree_with_lobes(const Eigen::Vector3d& origin) {
-    ExportTree tree{"oak", test::sample_tree(origin), {}, "Quercus robur"};
+    ExportTree tree{"oak", test::sample_tree(origin), {}, "Quercus robur", {}};
     for (const Eigen::Vector3f& centre : {Eigen::Vector3f(1.2f, 0.2f, 2.6f), Eigen::Vector3f(-0.6f, 0.3f, 2.9f)}) {
         TriangleMesh lobe = test::octahedron(centre, 0.4f);
         lobe.origin = origin;
@@ -50,7 +60,7 @@ void expect_valid(const std::filesystem::path& file) {
 
 TEST(Gltf, OneTreeWithThreeLodsIsValid) {
     test::TempDir dir;
-    const ExportTree tree{"t1", test::sample_tree(), {}, ""};
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
     const std::string glb = glb_bytes({gltf_tree(tree, 3)}, tree.skeleton.origin);
     EXPECT_EQ(glb, glb_bytes({gltf_tree(tree, 3)}, tree.skeleton.origin));  // deterministic
     write_file_atomically(dir / "t1.glb", glb);
@@ -70,7 +80,7 @@ TEST(Gltf, OneTreeWithThreeLodsIsValid) {
     const auto& lod0 = doc["meshes"][main["mesh"].get<int>()]["primitives"];
     ASSERT_EQ(lod0.size(), 2u);
     EXPECT_EQ(doc["materials"][lod0[0]["material"].get<int>()]["name"], "bark");
-    EXPECT_EQ(doc["materials"][lod0[1]["material"].get<int>()]["name"], "foliage");
+    EXPECT_EQ(doc["materials"][lod0[1]["material"].get<int>()]["name"], "leaves");  // leaf cards of a bare skeleton
     const auto triangles = [&](int node) {
         const auto& p = doc["meshes"][doc["nodes"][node]["mesh"].get<int>()]["primitives"][0];
         return doc["accessors"][p["indices"].get<int>()]["count"].get<int>() / 3;
@@ -86,7 +96,7 @@ TEST(Gltf, OneTreeWithThreeLodsIsValid) {
 TEST(Gltf, TwoTreesWithLobesAreValidAndPlacedRelativeToTheSceneOrigin) {
     test::TempDir dir;
     const Eigen::Vector3d a(500000, 5400000, 300), b(500010, 5400004, 301);
-    const std::string glb = glb_bytes({gltf_tree(tree_with_lobes(a), 2), gltf_tree({"t2", test::sample_tree(b), {}, ""}, 2)}, a);
+    const std::string glb = glb_bytes({gltf_tree(tree_with_lobes(a), 2), gltf_tree({"t2", test::sample_tree(b), {}, "", {}}, 2)}, a);
     write_file_atomically(dir / "two.glb", glb);
     expect_valid(dir / "two.glb");
     const auto doc = json_chunk(glb);
@@ -101,7 +111,7 @@ TEST(Gltf, TwoTreesWithLobesAreValidAndPlacedRelativeToTheSceneOrigin) {
 
 TEST(Gltf, TheValidatorRejectsABrokenFile) {
     test::TempDir dir;
-    const ExportTree tree{"t1", test::sample_tree(), {}, ""};
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
     std::string glb = glb_bytes({gltf_tree(tree, 1)}, tree.skeleton.origin);
     const std::size_t mode = glb.find("\"mode\":4");
     ASSERT_NE(mode, std::string::npos);
@@ -113,11 +123,71 @@ TEST(Gltf, TheValidatorRejectsABrokenFile) {
 }
 
 TEST(Gltf, LodOptionsOutOfRangeAreUsageErrors) {
-    const ExportTree tree{"t1", test::sample_tree(), {}, ""};
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
     TreeGeometryOptions options;
     options.lods = 0;
     EXPECT_EQ(test::error_code_of([&] { tree_lods(tree, options); }), ExitCode::Usage);
     options.lods = 2;
     options.sides = 2;
     EXPECT_EQ(test::error_code_of([&] { tree_lods(tree, options); }), ExitCode::Usage);
+}
+
+TEST(Gltf, LeafCardsAreTexturedQuadsWithAnAlphaMask) {
+    test::TempDir dir;
+    const ExportTree tree{"t1", test::sample_tree(), {}, "", {}};
+    const std::string glb = glb_bytes({gltf_tree(tree, 2)}, tree.skeleton.origin);
+    write_file_atomically(dir / "leaves.glb", glb);
+    expect_valid(dir / "leaves.glb");  // the validator also decodes the embedded PNG
+    const auto doc = json_chunk(glb);
+
+    // One PNG in the BIN chunk, a texture with a sampler, and the alpha-masked leaf material.
+    ASSERT_EQ(doc["images"].size(), 1u);
+    EXPECT_EQ(doc["images"][0]["mimeType"], "image/png");
+    EXPECT_EQ(doc["textures"][0]["source"], 0);
+    EXPECT_EQ(doc["textures"][0]["sampler"], 0);
+    const auto& leaves = doc["materials"][2];
+    EXPECT_EQ(leaves["name"], "leaves");
+    EXPECT_EQ(leaves["alphaMode"], "MASK");
+    EXPECT_EQ(leaves["alphaCutoff"], 0.5);
+    EXPECT_EQ(leaves["doubleSided"], true);
+    EXPECT_EQ(leaves["pbrMetallicRoughness"]["baseColorTexture"]["index"], 0);
+    const render::Image leaf = render::decode_png(view_bytes(glb, doc, doc["images"][0]["bufferView"].get<int>()), "leaf");
+    EXPECT_EQ(leaf.width, 64);
+    EXPECT_EQ(leaf.height, 64);
+    std::size_t opaque = 0, green = 0;
+    for (int y = 0; y < leaf.height; ++y)
+        for (int x = 0; x < leaf.width; ++x) {
+            const render::Rgba c = leaf.at(x, y);
+            ASSERT_TRUE(c[3] == 0 || c[3] == 255) << "partial alpha at " << x << "," << y;
+            opaque += c[3] == 255;
+            green += c[3] == 255 && c[1] > c[0] && c[1] > c[2];
+        }
+    EXPECT_GT(opaque, 64u * 64 * 3 / 10);  // a leaf, not a dot...
+    EXPECT_LT(opaque, 64u * 64 * 8 / 10);  // ...nor a square
+    EXPECT_EQ(green, opaque);
+    // The stalk is at the bottom centre (v = 1, where the card meets the twig), the corners clear.
+    EXPECT_EQ(leaf.at(32, 62)[3], 255);
+    EXPECT_EQ(leaf.at(1, 1)[3], 0);
+    EXPECT_EQ(leaf.at(62, 62)[3], 0);
+
+    // Every LOD's leaf cards carry one UV per vertex, each card the unit square, base at v = 1.
+    for (int node = 0; node < 2; ++node) {
+        const auto& primitive = doc["meshes"][doc["nodes"][node]["mesh"].get<int>()]["primitives"][1];
+        EXPECT_EQ(primitive["material"], 2);
+        const auto& uv = doc["accessors"][primitive["attributes"]["TEXCOORD_0"].get<int>()];
+        const auto& position = doc["accessors"][primitive["attributes"]["POSITION"].get<int>()];
+        EXPECT_EQ(uv["type"], "VEC2");
+        ASSERT_EQ(uv["count"], position["count"]);
+        const std::string bytes = view_bytes(glb, doc, uv["bufferView"].get<int>());
+        std::vector<float> values(bytes.size() / 4);
+        std::memcpy(values.data(), bytes.data(), bytes.size());
+        ASSERT_EQ(values.size() % 8, 0u);
+        for (std::size_t quad = 0; quad < values.size(); quad += 8)
+            EXPECT_EQ(std::vector<float>(values.begin() + quad, values.begin() + quad + 8), (std::vector<float>{0, 1, 1, 1, 1, 0, 0, 0}));
+    }
+    // Lobes are not textured: no image, no texture coordinates.
+    const auto lobed = json_chunk(glb_bytes({gltf_tree(tree_with_lobes({0, 0, 0}), 1)}, {0, 0, 0}));
+    EXPECT_FALSE(lobed.contains("images"));
+    EXPECT_FALSE(lobed.contains("textures"));
+    EXPECT_EQ(lobed["materials"].size(), 2u);
 }
