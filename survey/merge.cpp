@@ -31,11 +31,12 @@ std::string read_text(const fs::path& path) {
     return text.str();
 }
 
-// A tile's options without the flags that say where and whether to write (--out, --overwrite):
-// the ones that shape what the tile holds, alike across the tiles of one survey.
+// A tile's options without the flags that say where to read and write, whether to overwrite and
+// how much memory a run may take (--out, --overwrite, --neighbours, --max-memory: they differ
+// between a single run and shards on a cluster): the ones that shape what the tile holds, alike
+// across the tiles of one survey.
 json shaping_options(json options) {
-    options.erase("out");
-    options.erase("overwrite");
+    for (const char* key : {"out", "overwrite", "neighbours", "max_memory"}) options.erase(key);
     return options;
 }
 

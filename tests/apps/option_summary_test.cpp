@@ -76,7 +76,7 @@ const Row kRows[] = {
      "rebuild {in}/palm/palm_3_mesh.obj --out {out} --species palm --samples 20000 --compare-samples 2000 --max-triangles 20000 "
      "--image-height 160",
      "report.json", "/options", R"({"samples": 20000, "image_height": 160, "species": "palm"})"},
-    {"tile", "tile {data}/tile/tile.las --out {out} --map-size 300", "summary.json", "/options", R"({"map_size": 300, "mode": "auto"})"},
+    {"tile", "tile {data}/tile/tile.las --out {out} --map-size 300 --min-tree-points 30", "summary.json", "/options", R"({"map_size": 300, "mode": "auto", "min_tree_points": 30})"},
     {"batch", "--json batch {in}/tiles --out {out} --max-memory 8G --map-size 300", "", "/options", R"({"max_memory": "8G"})"},
     {"merge", "--json merge {in}/tile --out {out}", "", "/merge_options", "{}"},
     {"retile", "--json retile {data}/palm_1.las --size 5 --prefix part --out {out}", "", "/options", R"({"size": 5, "prefix": "part"})"},
@@ -111,7 +111,7 @@ public:
             fs::create_directories(inputs.in() / "tiles");
             fs::copy_file(inputs.data() / "tile/tile.las", inputs.in() / "tiles" / "tile.las");
         }
-        if (wants("tile ")) inputs.run("tile " + quoted(inputs.data() / "tile/tile.las") + " --out " + quoted(inputs.in() / "tile"));
+        if (wants("tile ")) inputs.run("tile " + quoted(inputs.data() / "tile/tile.las") + " --min-tree-points 30 --out " + quoted(inputs.in() / "tile"));
         return inputs.in();
     }
 

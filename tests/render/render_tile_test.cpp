@@ -70,10 +70,11 @@ protected:
         csv = line + "\n";
         const auto header = split(line);
         const std::size_t species = std::find(header.begin(), header.end(), "species") - header.begin();
-        if (species >= header.size()) return false;
+        const std::size_t id = std::find(header.begin(), header.end(), "tree_id") - header.begin();
+        if (species >= header.size() || id >= header.size()) return false;
         while (std::getline(in, line)) {
             auto cells = split(line);
-            cells[species] = species_of(std::stoi(cells[0]));
+            cells[species] = species_of(std::stoi(cells[id]));
             for (std::size_t i = 0; i < cells.size(); ++i) csv += (i ? "," : "") + cells[i];
             csv += "\n";
         }
@@ -161,9 +162,11 @@ TEST_F(RenderTile, ContactSheetOnePanelPerTreeSortedAndLabelled) {
     std::getline(in, line);
     const auto header = split(line);
     const std::size_t height_column = std::find(header.begin(), header.end(), "height_m") - header.begin();
+    const std::size_t id_column = std::find(header.begin(), header.end(), "tree_id") - header.begin();
+    ASSERT_LT(id_column, header.size());
     for (int k = 0; std::getline(in, line); ++k) {
         const auto cells = split(line);
-        const int id = std::stoi(cells[0]);
+        const int id = std::stoi(cells[id_column]);
         ASSERT_EQ(id, k + 1) << "trees.csv of the fixture lists ids 1..N in order (every segment modelled)";
         const int x0 = gap + (k % columns) * (width + gap), y0 = gap + (k / columns) * (height + label + gap);
         // The label strip reads "ID <id>  <species>  <height> M", drawn with the project's font.
