@@ -1,8 +1,8 @@
 // `treelobes encode`, `lod`, `decode` and `decode-code`: F6/DBF6 chain codes of skeletons
-// (seed 000 §3.1-3.2) on the command line. Without --out, codes and radius lists travel as text
+// (Strnad et al. 2020, §3.1-3.2) on the command line. Without --out, codes and radius lists travel as text
 // (the code on one line, the comma-separated radii on the next); with --out they are compressed
 // into a .dbf6 file (one tree, LODs) or a .forest file (many trees), which `decode` reads back
-// (seed 000 §3.3, §4; docs/dbf6.md, docs/forest.md).
+// (Strnad et al. 2020, §3.3, §4; docs/dbf6.md, docs/forest.md).
 #include "apps/command.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -170,7 +170,7 @@ int run_encode_file(const EncodeCliOptions& options, const GlobalOptions& global
     const std::vector<std::uint8_t> bytes = write_tree_file_bytes(stored, &sizes);
     write_file_atomically(options.out, std::string(bytes.begin(), bytes.end()));
     const std::size_t internodes = stored.lods[0].radii.size();
-    const std::size_t raw = 16 * internodes;  // seed 000 Table 5: 16 bytes per internode
+    const std::size_t raw = 16 * internodes;  // Strnad et al. 2020, Table 5: 16 bytes per internode
     if (global.json) {
         nlohmann::json j = {{"treelobes", kVersion},
                             {"input", options.skeleton},
@@ -529,7 +529,7 @@ int run_decode_file(const DecodeFileCliOptions& options, const GlobalOptions& gl
 void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<EncodeCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (seed 000); with --out, compress it into "
+        "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (Strnad et al. 2020); with --out, compress it into "
                   "a .dbf6 file, or many trees (--forest) into a .forest file");
     auto* skeleton = sub->add_option("skeleton", options->skeleton, "Skeleton PLY (vertex 0 is the root) or .tlobe");
     auto* forest = sub->add_option("--forest", options->forest,
@@ -555,7 +555,7 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto* lods = sub->add_option("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
                      ->capture_default_str()
                      ->check(CLI::Range(1, kMaxLods));
-    auto* coder = sub->add_option("--coder", options->coder, "Compression: ic (seed 000 §3.3) or best")
+    auto* coder = sub->add_option("--coder", options->coder, "Compression: ic (Strnad et al. 2020, §3.3) or best")
                       ->capture_default_str()
                       ->check(CLI::IsMember({"ic", "best"}));
     sub->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");

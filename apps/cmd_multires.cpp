@@ -1,10 +1,10 @@
 // `treelobes multires INPUT|--string S --out DIR`: the hybrid multiresolution representation of
-// seed 003 for the branches. The input (an L-system file, a bracketed module string or a skeleton
+// Lluch et al. 2010 for the branches. The input (an L-system file, a bracketed module string or a skeleton
 // PLY, which is first converted into a bracketed string) becomes a tADT and a multiresolution
 // chain with SAVE/RESTORE entries; LOD k is the chain up to its (k+1)-th RESTORE. Writes the chain
 // (chain.txt), one skeleton PLY per requested LOD (optionally a tube mesh), the leaves of each LOD
 // when the L-system places any, and summary.json. When there are leaves, the foliage bounding-box
-// hierarchy (seed 003 §3.2) is built too: foliage.json, and the six diagonal-plane textures of every
+// hierarchy (Lluch et al. 2010, via Ong's seminar report, §3.2) is built too: foliage.json, and the six diagonal-plane textures of every
 // box above the volume threshold packed into atlas.png; each LOD then also says which boxes'
 // textures stand in for the branches its chain prefix has not reached (combined LOD, §3.3).
 #include "apps/command.hpp"
@@ -423,7 +423,7 @@ int run_multires(const MultiresCliOptions& o, const GlobalOptions& global) {
 void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<MultiresCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "multires", "Multiresolution chain (seed 003) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
+        "multires", "Multiresolution chain (Lluch et al. 2010) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
     sub->add_option("input", o->input, "L-system file (docs/lsystem.md) or skeleton PLY");
     sub->add_option("--string", o->string, "A bracketed module string instead of a file, e.g. 'C1[C2[C3][C4]][C5]'");
     sub->add_option("--out", o->out, "Output folder")->required();

@@ -1,5 +1,5 @@
-// Skeleton features from a first reconstruction (seed 001 §6.1: "an approximate first
-// reconstruction"): reconstruct_skeleton on the voxel points, allometric radii (seed 001 Eq. 1),
+// Skeleton features from a first reconstruction (Livny et al. 2011, §6.1: "an approximate first
+// reconstruction"): reconstruct_skeleton on the voxel points, allometric radii (Livny et al. 2011, Eq. 1),
 // then branch angles, lengths and radii by branch order, whorls, trunk form, crown asymmetry and
 // the skeleton's box-counting dimension.
 #include "classify/feature_groups.hpp"
@@ -156,7 +156,7 @@ void describe_skeleton(Catalogue& c) {
     for (const char* o : kOrderNames) {
         const std::string order = o[1] == '1' ? "first-order" : "second-order";
         c.add(std::string("skel_radius_") + o + "_mean", "1",
-              "mean allometric radius at the base of " + order + " branches / root radius (seed 001 Eq. 1, gamma 1.5)");
+              "mean allometric radius at the base of " + order + " branches / root radius (Livny et al. 2011, Eq. 1, gamma 1.5)");
         c.add(std::string("skel_radius_") + o + "_sd", "1", "standard deviation of those radius ratios");
     }
     c.add("skel_length_fraction_o0", "1", "fraction of the skeleton length on the trunk (order 0)");

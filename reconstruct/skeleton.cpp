@@ -102,7 +102,7 @@ std::vector<float> smoothed_lengths(const NeighbourGraph& graph, const std::vect
     return current;
 }
 
-// The parent of a cluster is where the weighted shortest-path tree (seed 001: weights
+// The parent of a cluster is where the weighted shortest-path tree (Livny et al. 2011: weights
 // ||u-v||^beta) mostly enters it from: every point whose tree parent lies in an earlier
 // cluster of a lower bin votes for that cluster. A majority is robust where single paths are
 // not (one path may arrive through a small fragment of bark). Clusters that receive no vote
