@@ -1,7 +1,7 @@
 // The full species profile of config/species.yaml: what config/species_library.hpp's
 // SpeciesEntry carries (name, id, Livny et al. 2011, Table 1 parameters) plus
-//   - a growth profile in the style of Weber & Penn ("Creation and rendering of realistic
-//     trees", SIGGRAPH 1995): crown shape, stem levels with branching angles, phyllotaxis
+//   - a growth profile in the style of Weber & Penn 1995 ("Creation and rendering of
+//     realistic trees"): crown shape, stem levels with branching angles, phyllotaxis
 //     (rotate / whorl), curvature, tropism, taper, splitting, leaves — read by synth::grow;
 //   - the branchlet patch profile of Livny et al. 2011, Appendix A (#ChainPts, #Phototropism, ...)
 //     read by the patch L-system;
