@@ -1,4 +1,4 @@
-// `treelobes classify features|train|predict|evaluate`: species classification (seed 001 §6.1).
+// `treelobes classify features|train|predict|evaluate`: species classification (Livny et al. 2011, §6.1).
 //   features  INPUT... --out features.csv      200+ shape features per tree (docs/features.md)
 //   train     features.csv --labels labels.csv --out model.jb      JointBoost model file
 //   predict   model.jb INPUT...|features.csv [--positions P.csv] [--vote]    species per tree
@@ -452,7 +452,7 @@ int run_evaluate(const EvaluateCommand& c, const OptionTable& option_table, cons
 }  // namespace
 
 void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) {
-    CLI::App* classify = app.add_subcommand("classify", "Species classification: features, JointBoost, evaluation (seed 001 §6.1)");
+    CLI::App* classify = app.add_subcommand("classify", "Species classification: features, JointBoost, evaluation (Livny et al. 2011, §6.1)");
     classify->require_subcommand(1);
 
     auto features = std::make_shared<FeaturesCommand>();

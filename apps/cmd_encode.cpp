@@ -1,8 +1,8 @@
 // `treelobes encode`, `lod`, `decode` and `decode-code`: F6/DBF6 chain codes of skeletons
-// (seed 000 §3.1-3.2) on the command line. Without --out, codes and radius lists travel as text
+// (Strnad et al. 2020, §3.1-3.2) on the command line. Without --out, codes and radius lists travel as text
 // (the code on one line, the comma-separated radii on the next); with --out they are compressed
 // into a .dbf6 file (one tree, LODs) or a .forest file (many trees), which `decode` reads back
-// (seed 000 §3.3, §4; docs/dbf6.md, docs/forest.md).
+// (Strnad et al. 2020, §3.3, §4; docs/dbf6.md, docs/forest.md).
 #include "apps/command.hpp"
 #include "apps/option_table.hpp"
 #include "core/error.hpp"
@@ -171,7 +171,7 @@ int run_encode_file(const EncodeCliOptions& options, const OptionTable& table, c
     const std::vector<std::uint8_t> bytes = write_tree_file_bytes(stored, &sizes);
     write_file_atomically(options.out, std::string(bytes.begin(), bytes.end()));
     const std::size_t internodes = stored.lods[0].radii.size();
-    const std::size_t raw = 16 * internodes;  // seed 000 Table 5: 16 bytes per internode
+    const std::size_t raw = 16 * internodes;  // Strnad et al. 2020, Table 5: 16 bytes per internode
     if (global.json) {
         nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
                             {"input", options.skeleton},
@@ -530,7 +530,7 @@ int run_decode_file(const DecodeFileCliOptions& options, const OptionTable& tabl
 void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<EncodeCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (seed 000); with --out, compress it into "
+        "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (Strnad et al. 2020); with --out, compress it into "
                   "a .dbf6 file, or many trees (--forest) into a .forest file");
     auto table = std::make_shared<OptionTable>(sub);
     auto* skeleton = sub->add_option("skeleton", options->skeleton, "Skeleton PLY (vertex 0 is the root) or .tlobe");
@@ -554,7 +554,7 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto* print = table->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
     auto* lods = table->add("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
                      ->check(CLI::Range(1, kMaxLods));
-    auto* coder = table->add("--coder", options->coder, "Compression: ic (seed 000 §3.3) or best")
+    auto* coder = table->add("--coder", options->coder, "Compression: ic (Strnad et al. 2020, §3.3) or best")
                       ->check(CLI::IsMember({"ic", "best"}));
     table->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");
     print->excludes(out);

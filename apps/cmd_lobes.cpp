@@ -1,4 +1,4 @@
-// The lobe stage's two subcommands (issue 5, seed 001 §4.2, §5, §6.2):
+// The lobe stage's two subcommands (Livny et al. 2011, §4.2, §5, §6.2):
 // `treelobes lobes INPUT... --out DIR`: skeleton reconstruction, edge confidence, lobe
 // clusters, alpha-shape lobes, and per tree DIR/<stem>.tlobe, DIR/<stem>_lobes.ply (all lobes),
 // DIR/<stem>_main.ply (main skeleton) and DIR/<stem>_lobes.json (summary). A failing input is
@@ -181,7 +181,7 @@ int run_lobes(LobesCliOptions& o, const OptionTable& table, const GlobalOptions&
 
 // ---- synthesize ----------------------------------------------------------------------------
 
-constexpr const char* kDefaultSynthesisSpecies = "lagerstroemia";  // the seed's Appendix A profile
+constexpr const char* kDefaultSynthesisSpecies = "lagerstroemia";  // the profile of Livny et al. 2011, Appendix A
 
 struct SynthesizeCliOptions {
     std::string input;

@@ -1,10 +1,10 @@
 // `treelobes multires INPUT|--string S --out DIR`: the hybrid multiresolution representation of
-// seed 003 for the branches. The input (an L-system file, a bracketed module string or a skeleton
+// Lluch et al. 2010 for the branches. The input (an L-system file, a bracketed module string or a skeleton
 // PLY, which is first converted into a bracketed string) becomes a tADT and a multiresolution
 // chain with SAVE/RESTORE entries; LOD k is the chain up to its (k+1)-th RESTORE. Writes the chain
 // (chain.txt), one skeleton PLY per requested LOD (optionally a tube mesh), the leaves of each LOD
 // when the L-system places any, and summary.json. When there are leaves, the foliage bounding-box
-// hierarchy (seed 003 §3.2) is built too: foliage.json, and the six diagonal-plane textures of every
+// hierarchy (Lluch et al. 2010, via Ong's seminar report, §3.2) is built too: foliage.json, and the six diagonal-plane textures of every
 // box above the volume threshold packed into atlas.png; each LOD then also says which boxes'
 // textures stand in for the branches its chain prefix has not reached (combined LOD, §3.3).
 #include "apps/command.hpp"
@@ -273,6 +273,99 @@ nlohmann::json write_foliage(const FoliageHierarchy& hierarchy, const std::vecto
     return summary;
 }
 
+// Foliage: hierarchy and textures from the leaves of the whole string (string order).
+struct Foliage {
+    std::optional<FoliageHierarchy> hierarchy;
+    std::vector<LeafPlacement> leaves;  // string order, as the hierarchy indexes them
+    nlohmann::json summary;
+};
+
+Foliage build_foliage(const Source& source, const MultiresChain& chain, const MultiresCliOptions& o, const fs::path& out) {
+    Foliage foliage;
+    foliage.leaves = interpret(source.string, source.turtle).leaves;
+    FoliageOptions foliage_options;
+    foliage_options.texture_threshold = o.texture_threshold;
+    foliage.hierarchy = build_foliage_hierarchy(chain.tadt, foliage.leaves, foliage_options);
+    foliage.summary = write_foliage(*foliage.hierarchy, foliage.leaves, source.origin, o, out);
+    return foliage;
+}
+
+// One level of detail: its skeleton (and leaves, mesh) written to `out`, its summary entry
+// returned; the extraction time is added to extract_seconds.
+nlohmann::json write_lod(const MultiresChain& chain, std::size_t k, const Source& source, const Foliage& foliage, float full_length,
+                         const MultiresCliOptions& o, const fs::path& out, double& extract_seconds) {
+    const auto t = std::chrono::steady_clock::now();
+    TurtleResult lod = extract_lod(chain, k, source.turtle);
+    extract_seconds += seconds_since(t);
+    std::optional<FoliageLod> lod_foliage;
+    if (foliage.hierarchy) {
+        // Leaves of the prefix's ornaments belong with their branches (foliage.hpp).
+        lod_foliage = foliage_for_prefix(chain.tadt, *foliage.hierarchy, visited_nodes(chain, chain.lod_end(k)));
+        for (std::size_t l : lod_foliage->attached_leaves) lod.leaves.push_back(foliage.leaves[l]);
+        if (o.small_foliage == "geometry")
+            for (int b : lod_foliage->small_boxes) {
+                const FoliageBox& box = foliage.hierarchy->boxes[static_cast<std::size_t>(b)];
+                lod.leaves.insert(lod.leaves.end(), foliage.leaves.begin() + static_cast<std::ptrdiff_t>(box.leaf_begin),
+                                  foliage.leaves.begin() + static_cast<std::ptrdiff_t>(box.leaf_end));
+            }
+    }
+    lod.tree.origin = source.origin;
+    const std::string base = lod_name(k, chain.lod_count());
+    write_skeleton_ply(lod.tree, out / (base + ".ply"));
+    nlohmann::json entry = {{"lod", k},
+                            {"entries", chain.lod_end(k)},
+                            {"nodes", lod.tree.size()},
+                            {"tips", lod.tree.tip_count()},
+                            {"length", lod.tree.total_length()},
+                            {"length_fraction", full_length > 0 ? lod.tree.total_length() / full_length : 1.0},
+                            {"leaves", lod.leaves.size()},
+                            {"skeleton", base + ".ply"}};
+    if (!lod.leaves.empty()) {
+        write_leaves_csv(lod.leaves, out / (base + ".leaves.csv"));
+        entry["leaves_csv"] = base + ".leaves.csv";
+    }
+    if (lod_foliage) {
+        const FoliageLod& f = *lod_foliage;
+        entry["foliage"] = {{"leaves_as_geometry", lod.leaves.size()},
+                            {"textured_boxes", f.textured_boxes},
+                            {"texture_quads", 6 * f.textured_boxes.size()},
+                            {"leaves_in_textures", f.leaves_in_textures},
+                            {"small_branches", f.small_boxes.size()},
+                            {"leaves_omitted", o.small_foliage == "omit" ? f.leaves_in_small_boxes : 0}};
+    }
+    if (o.mesh && lod.tree.size() > 1) {
+        write_mesh(build_branch_mesh(lod.tree), out / (base + ".mesh.ply"));
+        entry["mesh"] = base + ".mesh.ply";
+    }
+    return entry;
+}
+
+// The human-readable report of a run (without --json).
+void print_multires_report(const nlohmann::json& summary, const MultiresCliOptions& o, const fs::path& out) {
+    std::cout << "multires: " << summary["input"].get<std::string>() << " -> " << o.out << "\n"
+              << "  " << summary["modules"].get<std::size_t>() << " modules, tADT " << summary["tadt_nodes"].get<std::size_t>()
+              << " nodes, chain " << summary["chain_entries"].get<std::size_t>() << " entries (" << summary["saves"].get<std::size_t>()
+              << " SAVE, " << summary["restores"].get<std::size_t>() << " RESTORE), " << summary["lod_count"].get<std::size_t>()
+              << " LODs (" << summary["lods_adding_length"].get<std::size_t>() << " add branch length); metric "
+              << summary["metric"].get<std::string>() << ", order " << summary["order"].get<std::string>() << "\n";
+    for (const auto& entry : summary["lods"]) {
+        char line[200];
+        std::snprintf(line, sizeof line, "  LOD %zu: %zu nodes, %zu tips, length %.4g (%.1f %%) -> %s\n",
+                      entry["lod"].get<std::size_t>(), entry["nodes"].get<std::size_t>(), entry["tips"].get<std::size_t>(),
+                      entry["length"].get<double>(), 100.0 * entry["length_fraction"].get<double>(),
+                      entry["skeleton"].get<std::string>().c_str());
+        std::cout << line;
+    }
+    if (summary.contains("foliage")) {
+        const nlohmann::json& foliage = summary["foliage"];
+        std::cout << "  foliage: " << foliage["leaves"] << " leaves, " << foliage["boxes"] << " boxes (depth "
+                  << foliage["hierarchy_depth"] << "), " << foliage["textures"] << " textures of " << o.texture_size << "x"
+                  << o.texture_size << " (" << foliage["texture_bytes_rgba"] << " bytes RGBA) for boxes above volume ratio "
+                  << o.texture_threshold << "\n";
+    }
+    std::cout << "  chain: " << (out / "chain.txt").string() << ", summary: " << (out / "summary.json").string() << "\n";
+}
+
 int run_multires(const MultiresCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     if (o.input.empty() == o.string.empty()) throw Error::usage("multires: give either an INPUT file or --string");
     const auto metric = parse_chain_metric(o.metric);
@@ -300,67 +393,12 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
     const TurtleResult full = extract_lod(chain, chain.lod_count() - 1, source.turtle);
     const float full_length = full.tree.total_length();
 
-    // Foliage: hierarchy and textures from the leaves of the whole string (string order).
     const auto t2 = std::chrono::steady_clock::now();
-    std::optional<FoliageHierarchy> foliage;
-    std::vector<LeafPlacement> all_leaves;  // string order, as the hierarchy indexes them
-    nlohmann::json foliage_summary;
-    if (!full.leaves.empty()) {
-        all_leaves = interpret(source.string, source.turtle).leaves;
-        FoliageOptions foliage_options;
-        foliage_options.texture_threshold = o.texture_threshold;
-        foliage = build_foliage_hierarchy(chain.tadt, all_leaves, foliage_options);
-        foliage_summary = write_foliage(*foliage, all_leaves, source.origin, o, out);
-    }
+    const Foliage foliage = full.leaves.empty() ? Foliage{} : build_foliage(source, chain, o, out);
     const double foliage_seconds = seconds_since(t2);
     nlohmann::json lod_json = nlohmann::json::array();
     double extract_seconds = 0.0;
-    for (std::size_t k : lods) {
-        const auto t = std::chrono::steady_clock::now();
-        TurtleResult lod = extract_lod(chain, k, source.turtle);
-        extract_seconds += seconds_since(t);
-        std::optional<FoliageLod> lod_foliage;
-        if (foliage) {
-            // Leaves of the prefix's ornaments belong with their branches (foliage.hpp).
-            lod_foliage = foliage_for_prefix(chain.tadt, *foliage, visited_nodes(chain, chain.lod_end(k)));
-            for (std::size_t l : lod_foliage->attached_leaves) lod.leaves.push_back(all_leaves[l]);
-            if (o.small_foliage == "geometry")
-                for (int b : lod_foliage->small_boxes) {
-                    const FoliageBox& box = foliage->boxes[static_cast<std::size_t>(b)];
-                    lod.leaves.insert(lod.leaves.end(), all_leaves.begin() + static_cast<std::ptrdiff_t>(box.leaf_begin),
-                                      all_leaves.begin() + static_cast<std::ptrdiff_t>(box.leaf_end));
-                }
-        }
-        lod.tree.origin = source.origin;
-        const std::string base = lod_name(k, chain.lod_count());
-        write_skeleton_ply(lod.tree, out / (base + ".ply"));
-        nlohmann::json entry = {{"lod", k},
-                                {"entries", chain.lod_end(k)},
-                                {"nodes", lod.tree.size()},
-                                {"tips", lod.tree.tip_count()},
-                                {"length", lod.tree.total_length()},
-                                {"length_fraction", full_length > 0 ? lod.tree.total_length() / full_length : 1.0},
-                                {"leaves", lod.leaves.size()},
-                                {"skeleton", base + ".ply"}};
-        if (!lod.leaves.empty()) {
-            write_leaves_csv(lod.leaves, out / (base + ".leaves.csv"));
-            entry["leaves_csv"] = base + ".leaves.csv";
-        }
-        if (lod_foliage) {
-            const FoliageLod& f = *lod_foliage;
-            entry["foliage"] = {{"leaves_as_geometry", lod.leaves.size()},
-                                {"textured_boxes", f.textured_boxes},
-                                {"texture_quads", 6 * f.textured_boxes.size()},
-                                {"leaves_in_textures", f.leaves_in_textures},
-                                {"small_branches", f.small_boxes.size()},
-                                {"leaves_omitted", o.small_foliage == "omit" ? f.leaves_in_small_boxes : 0}};
-        }
-        if (o.mesh && lod.tree.size() > 1) {
-            write_mesh(build_branch_mesh(lod.tree), out / (base + ".mesh.ply"));
-            entry["mesh"] = base + ".mesh.ply";
-        }
-        lod_json.push_back(entry);
-    }
+    for (std::size_t k : lods) lod_json.push_back(write_lod(chain, k, source, foliage, full_length, o, out, extract_seconds));
 
     std::size_t saves = 0;
     for (const auto& e : chain.entries) saves += e.kind == ChainEntry::Kind::save;
@@ -390,7 +428,7 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
                                 {"chain", chain_seconds},
                                 {"foliage", foliage_seconds},
                                 {"extract", extract_seconds}}}};
-    if (foliage) summary["foliage"] = foliage_summary;
+    if (foliage.hierarchy) summary["foliage"] = foliage.summary;
     if (source.kind == "lsystem") summary["derived_modules"] = source.derived_modules;
     write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
 
@@ -398,25 +436,7 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
         std::cout << summary.dump(2) << "\n";
         return 0;
     }
-    std::cout << "multires: " << name << " -> " << o.out << "\n"
-              << "  " << source.string.size() << " modules, tADT " << chain.tadt.nodes.size() << " nodes, chain "
-              << chain.entries.size() << " entries (" << saves << " SAVE, " << chain.restores.size() << " RESTORE), "
-              << chain.lod_count() << " LODs (" << growing << " add branch length); metric " << to_string(*metric)
-              << ", order " << to_string(*order) << "\n";
-    for (const auto& entry : lod_json) {
-        char line[200];
-        std::snprintf(line, sizeof line, "  LOD %zu: %zu nodes, %zu tips, length %.4g (%.1f %%) -> %s\n",
-                      entry["lod"].get<std::size_t>(), entry["nodes"].get<std::size_t>(), entry["tips"].get<std::size_t>(),
-                      entry["length"].get<double>(), 100.0 * entry["length_fraction"].get<double>(),
-                      entry["skeleton"].get<std::string>().c_str());
-        std::cout << line;
-    }
-    if (foliage)
-        std::cout << "  foliage: " << foliage_summary["leaves"] << " leaves, " << foliage_summary["boxes"] << " boxes (depth "
-                  << foliage_summary["hierarchy_depth"] << "), " << foliage_summary["textures"] << " textures of "
-                  << o.texture_size << "x" << o.texture_size << " (" << foliage_summary["texture_bytes_rgba"]
-                  << " bytes RGBA) for boxes above volume ratio " << o.texture_threshold << "\n";
-    std::cout << "  chain: " << (out / "chain.txt").string() << ", summary: " << (out / "summary.json").string() << "\n";
+    print_multires_report(summary, o, out);
     return 0;
 }
 
@@ -425,7 +445,7 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
 void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<MultiresCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "multires", "Multiresolution chain (seed 003) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
+        "multires", "Multiresolution chain (Lluch et al. 2010) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", o->input, "L-system file (docs/lsystem.md) or skeleton PLY");
     table->add("--string", o->string, "A bracketed module string instead of a file, e.g. 'C1[C2[C3][C4]][C5]'");

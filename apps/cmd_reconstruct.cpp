@@ -1,5 +1,5 @@
 // `treelobes reconstruct INPUT... --out DIR`: one skeleton, branch mesh, labelled points and
-// summary per single-tree scan (issue 4, seed 001 §4.1). Trees are independent: a failing
+// summary per single-tree scan (Livny et al. 2011, §4.1). Trees are independent: a failing
 // input is listed in DIR/failures.jsonl and the others go on (exit 3). Finished trees are
 // skipped on a re-run unless --overwrite.
 #include "apps/command.hpp"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Species classification benchmark (issue 9): synthetic labelled scans of the 12 species (TLS and
+# Species classification benchmark: synthetic labelled scans of the 12 species (TLS and
 # ALS), shape features, the paper's protocol (100 random 50/50 splits per species), JointBoost
 # against XGBoost on the same features and splits, the site split (TLS trees vs ALS trees), and
 # spatial voting in grouped and mixed plantings. Prints the figures; reports go to OUT/report_*.

@@ -1,4 +1,4 @@
-// Feature extraction time per tree (issue 9 target: <= 0.2 s per tree of 50k points): grows
+// Feature extraction time per tree (target: <= 0.2 s per tree of 50k points): grows
 // trees of several species, scans them (TLS), thins each scan evenly to 50,000 points and times
 // classify::compute_features: wall time, process CPU time (all threads; on a loaded machine the
 // CPU time is the steadier figure) and the wall time per feature group.

@@ -1,4 +1,4 @@
-// Trees of the compression experiments (seed 000 Experiments 2 and 3), shared by the report
+// Trees of the compression experiments (Strnad et al. 2020, §4, Experiments 2 and 3), shared by the report
 // program and the Google Benchmark: 12 synthetic trees, one per species of config/species.yaml
 // (synth::grow, leafless, seed 1), and a synthetic forest of ~400 trees of all species with
 // random heights, positions and orientations. Everything is deterministic.

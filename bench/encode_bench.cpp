@@ -1,5 +1,5 @@
-// Throughput of DBF6 encoding, decoding and LOD reduction (seed 000 §3.1-3.2), and of the range
-// decoder's binary decisions (issue 7), on a
+// Throughput of DBF6 encoding, decoding and LOD reduction (Strnad et al. 2020, §3.1-3.2), and of the range
+// decoder's binary decisions, on a
 // deterministic random tree (about 1,000 internodes) from tests/encode/random_tree.hpp (switch to synth/
 // species trees once they land). Run: bench_encode [--benchmark_filter=...]
 #include "encode/lod.hpp"

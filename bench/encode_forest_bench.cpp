@@ -1,4 +1,4 @@
-// Decoding a compressed forest (seed 000 Experiment 3: "decompression and decoding of the forest
+// Decoding a compressed forest (Strnad et al. 2020, §4, Experiment 3: "decompression and decoding of the forest
 // to maximum detail takes approximately 130 ms at r = 5"): LOD 0 of every tree of an in-memory
 // .forest file to placed skeletons on one thread, for growing numbers of trees (linear scaling),
 // and the two halves of the work separately (entropy decoding of the streams; chain code to

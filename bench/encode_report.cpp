@@ -1,4 +1,4 @@
-// Seed 000 Experiment 1 (Tables 3 and 4) and the Fig. 5 error figures for our trees:
+// Strnad et al. 2020, §4, Experiment 1 (Tables 3 and 4) and the Fig. 5 error figures for our trees:
 //   encode_report [--quick] [SKELETON.ply ...]
 // For every tree and r = 3, 5, 10: DBF6 code lengths at LOD 0..3 (thresholds at uniform
 // positions of the sorted unique radii), the DBF6 length relative to F6 at each LOD, and the
@@ -190,7 +190,7 @@ int main(int argc, char** argv) {
                 all_within_bound = all_within_bound && rows.back().back().bound.within_bound;
             }
         }
-        std::printf("# Chain coding of tree skeletons (seed 000 Experiment 1)\n");
+        std::printf("# Chain coding of tree skeletons (Strnad et al. 2020, §4, Experiment 1)\n");
         std::printf("Synthetic trees: tests/encode/random_tree.hpp profiles (seeds 1..%zu), l = 0.1 m, radius unit 1 mm.\n",
                     species_profiles(quick).size());
         print_properties(subjects);

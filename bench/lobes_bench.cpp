@@ -1,6 +1,6 @@
-// Lobes (issue 5): time of the lobe stage after reconstruction (confidence, clusters, alpha
+// Lobes: time of the lobe stage after reconstruction (confidence, clusters, alpha
 // shapes, simplification), of .tlobe coding, of lobe texturing and of LOD extraction
-// (seed 001 Table 2: reconstruction 3-18 ms, LOD 0.5-4 ms per tree on a GPU), on a real scan
+// (Livny et al. 2011, Table 2: reconstruction 3-18 ms, LOD 0.5-4 ms per tree on a GPU), on a real scan
 // (archi/tree1_points.las from TREELOBES_REAL_DATA or ../shared/data).
 // Whole-tree figures for every scan: bench/lobes_bench.sh and bench/lobes_species_bench.sh.
 #include "config/species_profile.hpp"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Lobes (issue 5): Table-2-style figures for every single-tree scan of ../shared/data -
+# Lobes: Table-2-style figures for every single-tree scan of ../shared/data -
 # lobe count, .tlobe size (target < 40 kB), reconstruction and lobe times - then synthesis of
 # each .tlobe: texturing time, triangles, LOD extraction time, input point -> mesh distances.
 # Usage: bench/lobes_bench.sh [BUILD_DIR] [OUT_DIR]   (defaults: build, /tmp/treelobes_lobes_bench)

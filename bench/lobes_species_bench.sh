@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Lobes (issue 5) on synthetic trees of every species of config/species.yaml: a simulated TLS
+# Lobes on synthetic trees of every species of config/species.yaml: a simulated TLS
 # scan per species (`treelobes synth tree`, 0.3 deg steps), then `lobes --species` and
 # `synthesize --points` on it. Prints lobe count, .tlobe size and occupancy cell, times (reconstruction,
 # lobes, .tlobe encode, texturing), triangles and fidelity.

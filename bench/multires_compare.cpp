@@ -1,5 +1,4 @@
-// Multiresolution chain (seed 003) against the DBF6 LOD of seed 000 on the same trees (issue 8
-// item 6): size of the LOD hierarchy and the Hausdorff error of each level against the full tree.
+// Multiresolution chain (Lluch et al. 2010) against the DBF6 LOD of Strnad et al. 2020 on the same trees: size of the LOD hierarchy and the Hausdorff error of each level against the full tree.
 //   bench_multires_compare [--quick]        (prints Markdown; docs/multires_comparison.md holds a run)
 //
 // Trees: three ABOP L-systems and one real tree (the TreeQSM cylinder model of aRchi's tree1 in

@@ -1,6 +1,6 @@
-// LOD extraction from multiresolution chains (seed 003 §3.3; issue 8 item 3): the time to turn
+// LOD extraction from multiresolution chains (Lluch et al. 2010, via Ong's seminar report, §3.3): the time to turn
 // the chain prefix of every tree of a forest into skeletons, for 100 and 2,000 trees, against
-// interpreting the full strings (the "geometric model"). The seed reports 69 fps (hybrid) against
+// interpreting the full strings (the "geometric model"). Lluch et al. 2010 report 69 fps (hybrid) against
 // 3 fps (full geometry) for 100 trees and 6 against 0.1 fps for 2,000 trees, rendering included;
 // here only the branch geometry is produced (no rendering, no foliage).
 //

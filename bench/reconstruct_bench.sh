@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Skeleton reconstruction figures (issue 4), all from whole-process runs of the CLI:
+# Skeleton reconstruction figures (docs/reconstruct.md), all from whole-process runs of the CLI:
 #   1. accuracy on the real scans with references (WoodSKE HS/OR/SW, aRchi tree1 + TreeQSM):
 #      skeleton -> reference and reference -> skeleton median/p95 (1 cm samples), total-length
 #      ratio, trunk-radius error, connected components (`treelobes eval skeleton`);

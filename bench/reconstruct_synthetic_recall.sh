@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Branch recall on synthetic TLS trees with ground truth (issue 4 target: mean recall >= 0.9 for
+# Branch recall on synthetic TLS trees with ground truth (target: mean recall >= 0.9 for
 # branches thicker than 2 cm). For each of the 12 species of config/species.yaml: one TLS scan
 # (`treelobes synth tree --scanner tls`, modest height and angular step so scans stay at a few
 # 100k points), `treelobes reconstruct --species`, then `treelobes eval skeleton` against the

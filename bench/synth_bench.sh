@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Synthetic-data benchmark (issue 3): a 12-species dataset with 40 trees per species (TLS scans,
+# Synthetic-data benchmark: a 12-species dataset with 40 trees per species (TLS scans,
 # true skeletons, labels.csv) and a 100 x 100 m ALS forest tile; prints wall time, peak memory,
 # points and sizes. Usage: bench/synth_bench.sh [OUT_DIR] (default /tmp/treelobes_synth_bench).
 set -euo pipefail

@@ -343,11 +343,12 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
         report.site_groups = groups;
         Progress site_progress("classify evaluate: site split", groups.size());
         for (std::size_t g = 0; g < groups.size(); ++g) {
-            std::vector<std::size_t> train, test;
-            for (std::size_t r = 0; r < set.labels.size(); ++r) (set.groups[r] == groups[g] ? test : train).push_back(r);
+            std::vector<std::size_t> site_train, site_test;
+            for (std::size_t r = 0; r < set.labels.size(); ++r) (set.groups[r] == groups[g] ? site_test : site_train).push_back(r);
             const std::uint64_t seed = stream_seed(options.seed, 1000000 + g);
             for (std::size_t k = 0; k < classifiers.size(); ++k)
-                score_experiment(set, test, run_experiment(set, classifiers[k].run, train, test, seed), options, site_acc[k]);
+                score_experiment(set, site_test, run_experiment(set, classifiers[k].run, site_train, site_test, seed), options,
+                                 site_acc[k]);
             site_progress.advance();
         }
         site_progress.finish();

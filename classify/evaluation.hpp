@@ -1,4 +1,4 @@
-// The evaluation protocol of seed 001 §6.1 and the comparisons of issue 9:
+// The evaluation protocol of Livny et al. 2011, §6.1, and the comparisons a user needs to trust it:
 //   - random splits: per species half the trees train, the other half test, `splits` times with
 //     different seeds; per-species recognition rate = its test accuracy averaged over the splits,
 //     overall = the mean of the per-species rates (the paper's "average recognition rate"); the
@@ -37,7 +37,7 @@ struct LabelledSet {
 LabelledSet make_labelled_set(const FeatureTable& features, const std::vector<TreeLabel>& labels, const std::string& labels_file);
 
 // Planting layouts for sets of single-tree scans that have no positions, so spatial voting can
-// be evaluated (issue 9 item 4): `grouped` plants each species in its own street (a row of trees
+// be evaluated: `grouped` plants each species in its own street (a row of trees
 // `spacing_m` apart, streets 250 m apart: beyond any voting radius up to 125 m), as in towns;
 // otherwise the trees fill a square grid of the same spacing in a seeded random order (a mixed
 // planting). Deterministic for (labels, seed).
@@ -134,7 +134,7 @@ std::string genus_of(const std::string& scientific_name);
 
 // Writes report/: summary.json (with the random-split accuracy per group, e.g. per scanner, when
 // the set has groups), per_species.csv, confusion_<name>.csv and .png (row-normalised percentages
-// as seed 001 Fig. 7), per_tree_<name>.csv (how often each tree was tested, right, and its most
+// as Livny et al. 2011, Fig. 7), per_tree_<name>.csv (how often each tree was tested, right, and its most
 // frequent wrong species), site_confusion_<name>.csv when a site split ran, report.md.
 // `extra_json` holds the summary.json fields the caller adds (the command and its options).
 void write_report(const EvaluationReport& report, const std::string& directory,

@@ -338,7 +338,7 @@ std::string features_markdown() {
     md << "# Shape features for species classification\n\n"
        << "Generated from `classify::feature_catalogue()` (classify/features.cpp and the group files); a unit test\n"
        << "fails when this file and the code disagree. Regenerate with `treelobes classify features --list > docs/features.md`.\n\n"
-       << catalogue.size() << " features per tree, computed by `treelobes classify features` (seed 001 §6.1).\n\n"
+       << catalogue.size() << " features per tree, computed by `treelobes classify features` (Livny et al. 2011, §6.1).\n\n"
        << "## Crown, frame and density\n\n"
        << "- The crown is extracted first (classify/crown.hpp): noise (classes 7, 18) and ground returns (class 2) are removed,\n"
        << "  the lowest ground return is the ground level z = 0, points separated from the rest by a vertical gap of more than\n"

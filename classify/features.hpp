@@ -1,4 +1,4 @@
-// Shape features of one tree for species classification (seed 001 §6.1): more than 200 numbers
+// Shape features of one tree for species classification (Livny et al. 2011, §6.1): more than 200 numbers
 // from the points and from a first skeleton reconstruction. docs/features.md lists every feature
 // with its unit and how it is computed; `feature_catalogue()` is the same list in code, and the
 // extractor checks each value it emits against it.

@@ -1,5 +1,5 @@
-// JointBoost (Torralba, Murphy & Freeman, "Sharing visual features for multiclass and
-// multiview object detection", PAMI 2007): multiclass boosting whose weak learners are
+// JointBoost (Torralba et al. 2007, "Sharing visual features for multiclass and multiview
+// object detection"; docs/references.md): multiclass boosting whose weak learners are
 // regression stumps shared by a subset S of the classes.
 //
 // Round m fits, by weighted least squares on the one-vs-all targets z_i^c in {+1,-1},

@@ -1,5 +1,5 @@
-// Skeleton features from a first reconstruction (seed 001 §6.1: "an approximate first
-// reconstruction"): reconstruct_skeleton on the voxel points, allometric radii (seed 001 Eq. 1),
+// Skeleton features from a first reconstruction (Livny et al. 2011, §6.1: "an approximate first
+// reconstruction"): reconstruct_skeleton on the voxel points, allometric radii (Livny et al. 2011, Eq. 1),
 // then branch angles, lengths and radii by branch order, whorls, trunk form, crown asymmetry and
 // the skeleton's box-counting dimension.
 #include "classify/feature_groups.hpp"
@@ -156,7 +156,7 @@ void describe_skeleton(Catalogue& c) {
     for (const char* o : kOrderNames) {
         const std::string order = o[1] == '1' ? "first-order" : "second-order";
         c.add(std::string("skel_radius_") + o + "_mean", "1",
-              "mean allometric radius at the base of " + order + " branches / root radius (seed 001 Eq. 1, gamma 1.5)");
+              "mean allometric radius at the base of " + order + " branches / root radius (Livny et al. 2011, Eq. 1, gamma 1.5)");
         c.add(std::string("skel_radius_") + o + "_sd", "1", "standard deviation of those radius ratios");
     }
     c.add("skel_length_fraction_o0", "1", "fraction of the skeleton length on the trunk (order 0)");
@@ -188,35 +188,19 @@ void skip_skeleton(FeatureSink& out) {
     for (std::size_t i = out.size(); i < catalogue.size() && catalogue[i].group == "skeleton"; ++i) out.add(catalogue[i].name, 0.0);
 }
 
-void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
-    // Bins and internodes tied to the voxel size (not to the measured spacing) so that a thinned
-    // scan yields the same coarse skeleton: main branches are what tells species apart.
-    SkeletonOptions options;
-    options.bin_width = std::clamp(0.25f * f.crown_radius, 2 * f.voxel, 4 * f.voxel);  // narrow crowns need finer bins
-    options.internode_length = options.bin_width;
-    SkeletonResult result = reconstruct_skeleton(f.points, options, "", f.index.get(), f.neighbours.get());
-    TreeGraph& t = result.tree;
-    if (t.size() < 2) {
-        skip_skeleton(out);
-        return;
-    }
-    const float root_diameter = f.trunk_diameter > 0 ? f.trunk_diameter : f.height / 50;
-    apply_allometry(t, root_diameter);
-    std::vector<float> radius;
-    for (const auto& n : t.nodes) radius.push_back(n.radius);
-    const auto orders = t.branch_orders();
-    const auto axes = axes_of(t, orders, radius, f.height);
-    const double h = f.height, total = t.total_length();
+namespace {
 
+// Per branch order: counts, angles, elevations, lengths and radii of the axes, the share of the
+// skeleton's length at each order.
+void add_axis_features(const TreeGraph& t, const std::vector<Axis>& axes, double h, FeatureSink& out) {
+    const double total = t.total_length();
     std::vector<float> angle[2], elevation[2], length[2], rad[2];
     double by_order[4] = {0, 0, 0, 0};
     int count[3] = {0, 0, 0}, max_order = 0;
-    std::vector<float> trunk_forks;
     for (const auto& a : axes) {
         by_order[std::min(a.order, 3)] += a.length;
         max_order = std::max(max_order, a.order);
         if (a.order >= 1) ++count[std::min(a.order, 3) - 1];
-        if (a.order == 1 && orders[a.fork] == 0) trunk_forks.push_back(t.nodes[a.fork].position.z());
         if (a.order < 1 || a.order > 2) continue;
         const int o = a.order - 1;
         angle[o].push_back(static_cast<float>(a.angle));
@@ -255,8 +239,15 @@ void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
     out.add("skel_length_fraction_o2", total > 0 ? by_order[2] / total : 0.0);
     out.add("skel_length_fraction_o3plus", total > 0 ? by_order[3] / total : 0.0);
     out.add("skel_max_order", max_order);
+}
 
-    // Whorls along the trunk.
+// Whorls along the trunk: first-order branches leaving the trunk at about the same height.
+void add_whorl_features(const TreeFrame& f, const TreeGraph& t, const std::vector<Axis>& axes, const std::vector<int>& orders,
+                        FeatureSink& out) {
+    const double h = f.height;
+    std::vector<float> trunk_forks;
+    for (const auto& a : axes)
+        if (a.order == 1 && orders[a.fork] == 0) trunk_forks.push_back(t.nodes[a.fork].position.z());
     std::sort(trunk_forks.begin(), trunk_forks.end());
     std::vector<float> whorls;  // mean height of each whorl
     std::vector<int> members;
@@ -274,17 +265,22 @@ void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
     out.add("skel_whorl_spacing_mean", ms.mean / h);
     out.add("skel_whorl_spacing_cv", ms.mean > 0 ? ms.sd / ms.mean : 0.0);
     out.add("skel_branches_per_whorl", whorls.empty() ? 0.0 : static_cast<double>(trunk_forks.size()) / whorls.size());
+}
 
-    // Trunk form: the axis starting at the root.
-    const Axis& trunk = axes.front();
+// Trunk form: the axis starting at the root.
+void add_trunk_features(const TreeGraph& t, const Axis& trunk, double h, FeatureSink& out) {
     const Eigen::Vector3f root = t.nodes[0].position;
     const double chord = (t.nodes[trunk.nodes.back()].position - root).norm();
     const Eigen::Vector3f third = along(t, trunk, trunk.length / 3) - root;
     out.add("skel_trunk_length_ratio", trunk.length / h);
     out.add("skel_trunk_tortuosity", chord > 0 ? trunk.length / chord : 1.0);
     out.add("skel_trunk_lean", angle_deg(third, Eigen::Vector3f(0, 0, 1)));
+}
 
-    // Tips: asymmetry, heights, paths.
+// Tips: asymmetry, heights, paths.
+void add_tip_features(const TreeFrame& f, const TreeGraph& t, FeatureSink& out) {
+    const double h = f.height;
+    const Eigen::Vector3f root = t.nodes[0].position;
     std::vector<double> path(t.size(), 0.0);
     for (int n : t.preorder())
         if (t.nodes[n].parent >= 0) path[n] = path[t.nodes[n].parent] + t.edge_length(n);
@@ -314,7 +310,10 @@ void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
             std::count_if(tip_height.begin(), tip_height.end(), [](float v) { return v < 0.5f; }) / static_cast<double>(tips.size()));
     out.add("skel_path_ratio_mean", moments(path_ratio).mean);
     out.add("skel_path_length_mean", moments(path_length).mean);
+}
 
+// Box-counting dimension of the skeleton, sampled every half voxel along its internodes.
+void add_boxcount_feature(const TreeFrame& f, const TreeGraph& t, FeatureSink& out) {
     std::vector<Eigen::Vector3f> samples;
     for (int n = 1; n < static_cast<int>(t.size()); ++n) {
         const Eigen::Vector3f a = t.nodes[t.nodes[n].parent].position, b = t.nodes[n].position;
@@ -322,6 +321,33 @@ void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
         for (int s = 0; s < steps; ++s) samples.push_back(a + (b - a) * (static_cast<float>(s) / steps));
     }
     out.add("skel_boxcount_dimension", box_dimension(samples, f.height));
+}
+
+}  // namespace
+
+void compute_skeleton(const TreeFrame& f, FeatureSink& out) {
+    // Bins and internodes tied to the voxel size (not to the measured spacing) so that a thinned
+    // scan yields the same coarse skeleton: main branches are what tells species apart.
+    SkeletonOptions options;
+    options.bin_width = std::clamp(0.25f * f.crown_radius, 2 * f.voxel, 4 * f.voxel);  // narrow crowns need finer bins
+    options.internode_length = options.bin_width;
+    SkeletonResult result = reconstruct_skeleton(f.points, options, "", f.index.get(), f.neighbours.get());
+    TreeGraph& t = result.tree;
+    if (t.size() < 2) {
+        skip_skeleton(out);
+        return;
+    }
+    const float root_diameter = f.trunk_diameter > 0 ? f.trunk_diameter : f.height / 50;
+    apply_allometry(t, root_diameter);
+    std::vector<float> radius;
+    for (const auto& n : t.nodes) radius.push_back(n.radius);
+    const auto orders = t.branch_orders();
+    const auto axes = axes_of(t, orders, radius, f.height);
+    add_axis_features(t, axes, f.height, out);
+    add_whorl_features(f, t, axes, orders, out);
+    add_trunk_features(t, axes.front(), f.height, out);
+    add_tip_features(f, t, out);
+    add_boxcount_feature(f, t, out);
 }
 
 }  // namespace treelobes::classify::detail

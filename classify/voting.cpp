@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <set>
 
@@ -23,9 +24,16 @@ std::pair<long, long> cell_of(const Eigen::Vector2d& p, double size) {
 
 bool is_confident(const std::vector<double>& p, double factor) {
     if (p.size() < 2) return true;
-    std::vector<double> top(2);
-    std::partial_sort_copy(p.begin(), p.end(), top.begin(), top.end(), std::greater<>());
-    return top[0] > factor * top[1];
+    double first = -std::numeric_limits<double>::infinity(), second = first;  // the two largest
+    for (double v : p) {
+        if (v > first) {
+            second = first;
+            first = v;
+        } else if (v > second) {
+            second = v;
+        }
+    }
+    return first > factor * second;
 }
 
 VotingResult spatial_vote(const std::vector<std::vector<double>>& probabilities, const std::vector<Eigen::Vector2d>& positions,

@@ -1,4 +1,4 @@
-// Spatial voting (seed 001 §6.1): trees in towns are planted in same-species groups, so an
+// Spatial voting (Livny et al. 2011, §6.1): trees in towns are planted in same-species groups, so an
 // uncertain tree borrows the opinion of its confident neighbours.
 //   - A tree is confident when h1 > factor * h2 (h1, h2: its two highest class probabilities).
 //   - A confident tree keeps its most probable species.

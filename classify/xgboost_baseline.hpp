@@ -1,4 +1,4 @@
-// The baseline of the issue: XGBoost (Debian libxgboost-dev, C API, objective multi:softprob) on
+// The baseline classifier: XGBoost (Chen & Guestrin 2016; Debian libxgboost-dev, C API, objective multi:softprob) on
 // the same features and splits as JointBoost, with the same early stopping (the same held-out
 // trees, the same criterion: fewest errors, then lowest mean log-loss; then a refit on all
 // training trees for the chosen number of rounds).

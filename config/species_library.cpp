@@ -148,7 +148,7 @@ ValueRange read_range(StrictMap& map, const std::string& key, double min, double
 std::array<int, 2> read_ratio(StrictMap& map, const std::string& key) {
     const YAML::Node node = map.get(key);
     const Where where = map.where(key);
-    if (!node.IsSequence() || node.size() != 2) where.fail(node, "expected [a, b] (the 'a : b' of seed 001)");
+    if (!node.IsSequence() || node.size() != 2) where.fail(node, "expected [a, b] (the 'a : b' of Livny et al. 2011, Appendix A)");
     return {read_int(node[0], where.element(0), 1, 16), read_int(node[1], where.element(1), 1, 16)};
 }
 

@@ -1,6 +1,6 @@
 // The species library (config/species.yaml): per-species reconstruction parameters of
-// seed 001 Table 1 (beta, gamma, f_s), growth profiles for synthesis, branchlet patch
-// profiles (seed 001 Appendix A) and ranges of natural variation. Loaded and validated by
+// Livny et al. 2011, Table 1 (beta, gamma, f_s), growth profiles for synthesis, branchlet patch
+// profiles (Livny et al. 2011, Appendix A) and ranges of natural variation. Loaded and validated by
 // config/species_library.cpp with yaml-cpp; unknown keys and out-of-range values throw
 // Error(Usage) naming the file, the species and the key.
 #pragma once
@@ -11,7 +11,7 @@
 
 namespace treelobes {
 
-// Seed 001 §4.1-4.2: edge weight ||u-v||^beta, allometry d(u) = d_root (l(u)/l(root))^gamma,
+// Livny et al. 2011, §4.1-4.2: edge weight ||u-v||^beta, allometry d(u) = d_root (l(u)/l(root))^gamma,
 // lobe-confidence diameter d'(u) = f_s d(u).
 struct ReconstructionParameters {
     double beta = 1.0;

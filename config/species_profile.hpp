@@ -1,9 +1,9 @@
 // The full species profile of config/species.yaml: what config/species_library.hpp's
-// SpeciesEntry carries (name, id, seed 001 Table 1 parameters) plus
-//   - a growth profile in the style of Weber & Penn ("Creation and rendering of realistic
-//     trees", SIGGRAPH 1995): crown shape, stem levels with branching angles, phyllotaxis
+// SpeciesEntry carries (name, id, Livny et al. 2011, Table 1 parameters) plus
+//   - a growth profile in the style of Weber & Penn 1995 ("Creation and rendering of
+//     realistic trees"): crown shape, stem levels with branching angles, phyllotaxis
 //     (rotate / whorl), curvature, tropism, taper, splitting, leaves — read by synth::grow;
-//   - the branchlet patch profile of seed 001 Appendix A (#ChainPts, #Phototropism, ...)
+//   - the branchlet patch profile of Livny et al. 2011, Appendix A (#ChainPts, #Phototropism, ...)
 //     read by the patch L-system;
 //   - ranges of natural variation (height, age, DBH) that synth samples per tree.
 // docs/species.md (and the comments in species.yaml) explain every key; the loader in
@@ -74,7 +74,7 @@ struct LeafProfile {
     double size_v = 0.2;       // relative size variation
     double down_angle = 45;    // angle between twig and leaf
     double down_angle_v = 10;
-    double face_up = 0.5;      // 0..1: how far the blade turns to face the sky (seed 001 #FaceUp)
+    double face_up = 0.5;      // 0..1: how far the blade turns to face the sky (Livny et al. 2011, Appendix A: #FaceUp)
     double start = 0.3;        // leaves cover the stem from this fraction of its length to the tip
     int levels = 1;            // how many of the deepest stem levels carry leaves (pine shoots: 2)
     double lai = 0;            // leaf area index over the crown projection; 0 = as many leaves as per_branch says
@@ -96,7 +96,7 @@ struct GrowthProfile {
     double leaf_reflectance = 0.55;
 };
 
-// Seed 001 Appendix A: the branchlet patch L-system's species profile.
+// Livny et al. 2011, Appendix A: the branchlet patch L-system's species profile.
 struct PatchProfile {
     // Branch modeling
     int chain_pts = 15;

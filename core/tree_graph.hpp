@@ -62,7 +62,7 @@ public:
 
     // Length of the edge from node to its parent (0 for the root).
     float edge_length(int node) const;
-    // Total length of all edges below each node (l(u) of seed 001 Eq. 1), indexed by node.
+    // Total length of all edges below each node (l(u) of Livny et al. 2011, Eq. 1), indexed by node.
     std::vector<float> subtree_lengths() const;
     // Branch order per node: 0 on the trunk, +1 each time a lateral (non-first) child is taken.
     std::vector<int> branch_orders() const;

@@ -1,4 +1,4 @@
-// The F6 / DBF6 chain code of seed 000 §3.1 as a string of symbols (Table 1):
+// The F6 / DBF6 chain code of Strnad et al. 2020, §3.1 as a string of symbols (Table 1):
 //   0..5  moves +x +y +z -x -y -z (one voxel each)
 //   6     fork: the internode ends at a fork; the main child follows, the first lateral is queued
 //   7     branch tip: the internode ends the branch; the next queued lateral follows

@@ -1,4 +1,4 @@
-// The two entropy coders of chain codes and radii (seed 000 §3.3 and the project's own), behind
+// The two entropy coders of chain codes and radii (Strnad et al. 2020, §3.3 and the project's own), behind
 // one interface used by the .dbf6 and .forest containers. Each coder turns a ChainCode into two
 // byte streams — the symbols and the radii — so their sizes can be reported separately; the
 // radii stream is decoded after the symbols because both coders use the code's structure.

@@ -1,4 +1,4 @@
-// The `ic` coder: seed 000 §3.3 as printed, with the refinements of §2.3.
+// The `ic` coder: Strnad et al. 2020, §3.3 as printed, with the refinements of §2.3.
 //   symbols: C -> BWT (primary index kept) -> MTF -> cumulative sum -> interpolative coding with
 //            the known maximum gap 8 (the largest MTF position of a 9-symbol alphabet). The MTF
 //            step is either the printed move-to-front or MTF-2 (transforms.hpp), whichever codes

@@ -1,5 +1,5 @@
 // The .forest file: many chain-coded trees with their placements and an index for random access
-// (docs/forest.md). Seed 000 Experiment 3 stores a forest scene as compressed trees plus tree
+// (docs/forest.md). Strnad et al. 2020, §4, Experiment 3 stores a forest scene as compressed trees plus tree
 // locations and orientations; here every tree is a .dbf6 tree record (tree_file.hpp).
 //
 //   header  "DBFF" | version u8 | tree count u32 | index bytes u32 | forest origin f64 x3

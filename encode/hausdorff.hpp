@@ -1,4 +1,4 @@
-// Error metrics between an original skeleton and a decoded (or LOD-reduced) one (seed 000
+// Error metrics between an original skeleton and a decoded (or LOD-reduced) one (Strnad et al. 2020
 // Fig. 5 and 8): Hausdorff distances between the skeletons as polylines, sampled along the
 // edges and normalised by the original's bounding-box diagonal, and the per-vertex bound
 // √3·d/2 of voxel-centre decoding (§3.1).

@@ -1,5 +1,5 @@
 // Binary interpolative coding (Moffat & Stuiver 2000) of non-decreasing integer sequences, as
-// used by seed 000 §2.3/§3.3: the middle element of a run whose two end values are known lies in
+// used by Strnad et al. 2020, §2.3/§3.3: the middle element of a run whose two end values are known lies in
 // [left end, right end]; it is coded in that range and both halves are coded recursively.
 // With a known maximum gap g between neighbours the range shrinks further to
 // [right - (b - m)·g, left + (m - a)·g] ∩ [left, right]. Middle values are coded with the

@@ -1,4 +1,4 @@
-// Level of detail directly on the chain code (seed 000 §3.2, Pseudocode 2, Fig. 7).
+// Level of detail directly on the chain code (Strnad et al. 2020, §3.2, Pseudocode 2, Fig. 7).
 //
 // Every lateral branch whose first internode has a radius below the threshold T is removed
 // with everything that grows on it; the fork symbol of its surviving parent becomes 8. The

@@ -1,4 +1,4 @@
-// Small reversible transforms of the interpolative pipeline (seed 000 §3.3): move-to-front
+// Small reversible transforms of the interpolative pipeline (Strnad et al. 2020, §3.3): move-to-front
 // (Ryabko 1980) and the cumulative sum that turns small non-negative values into the
 // non-decreasing sequence binary interpolative coding needs.
 #pragma once
@@ -12,7 +12,7 @@ namespace treelobes::encode {
 
 // How a coded symbol moves in the table.
 enum class MtfRule : std::uint8_t {
-    ToFront,  // move-to-front (Ryabko 1980), as seed 000 §3.3 prints it
+    ToFront,  // move-to-front (Ryabko 1980), as Strnad et al. 2020, §3.3 prints it
     // MTF-2 (Balkenhol, Kurtz & Shtarkov 1999): a symbol found at position 1 goes to the front only
     // when the previous position was not 0, and a symbol found further back goes to position 1.
     // A symbol that interrupts a run of the front symbol once then no longer displaces it, so the

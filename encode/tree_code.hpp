@@ -1,4 +1,4 @@
-// Tree skeleton <-> F6/DBF6 chain code (seed 000 §3.1, Eq. 1-2, Pseudocode 1).
+// Tree skeleton <-> F6/DBF6 chain code (Strnad et al. 2020, §3.1, Eq. 1-2, Pseudocode 1).
 //
 // Internodes are the edges of the TreeGraph (parent -> child vertex). Positions are voxelized
 // relative to the root vertex with voxel size d = l / r and v = rtz(p/d + sgn(p)/2) per axis;

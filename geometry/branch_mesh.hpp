@@ -1,4 +1,4 @@
-// Branch meshes: generalized cylinders [Bloomenthal 1985] along a TreeGraph (seed 001 §5).
+// Branch meshes: generalized cylinders [Bloomenthal 1985] along a TreeGraph (Livny et al. 2011, §5).
 //
 // The tree is split into axes: an axis starts at the root (or at a fork, for a lateral child)
 // and follows the main child (children[0]) to a tip, so the main continuation through a fork is

@@ -1,4 +1,4 @@
-// The neighbour graph of seed 001 §4.1: every point is joined to its k nearest neighbours
+// The neighbour graph of Livny et al. 2011, §4.1: every point is joined to its k nearest neighbours
 // (symmetrised), each edge (u, v) weighted ||u - v||^beta. Separate pieces of the cloud (gaps
 // in the scan) are joined by bridging edges, so every point reaches every other: the shortest
 // ones, or (direction_weight > 0) for an elongated piece the one its end axis points along.
@@ -16,7 +16,7 @@ class KdTree;
 
 struct NeighbourGraphOptions {
     int neighbours = 10;          // k of the kNN graph (2..64)
-    double beta = 1.0;            // edge weight exponent (species parameter, seed 001 Table 1)
+    double beta = 1.0;            // edge weight exponent (species parameter, Livny et al. 2011, Table 1)
     float max_edge_length = 0.0f; // metres; longer kNN edges are dropped before bridging (0 = gap_factor x spacing)
     bool join_components = true;  // add bridging edges until the graph is connected
     float gap_factor = 10.0f;     // automatic max_edge_length in median nearest-neighbour distances: a clump

@@ -19,7 +19,7 @@ struct ShortestPaths {
 };
 
 // What a path costs: the sum of the graph's weights ||u-v||^beta (the shortest-path tree of
-// seed 001 §4.1) or of the Euclidean edge lengths (true geodesic distances on the graph).
+// Livny et al. 2011, §4.1) or of the Euclidean edge lengths (true geodesic distances on the graph).
 enum class EdgeCost { Weight, Length };
 
 // Ties are broken by vertex index, so the result is deterministic. Duplicate or out-of-range

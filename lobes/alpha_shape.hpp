@@ -1,5 +1,5 @@
 // Lobe geometry from a point cluster: CGAL's 3D alpha shapes [Edelsbrunner and Mücke 1994]
-// as in seed 001 §4.2, and edge-collapse simplification of the resulting closed surface.
+// as in Livny et al. 2011, §4.2, and edge-collapse simplification of the resulting closed surface.
 // Implemented in lobes/cgal_geometry.cpp, the only file that includes CGAL.
 //
 // alpha_min is CGAL's optimal alpha for one solid component (Alpha_shape_3::find_optimal_alpha(1)):
@@ -19,7 +19,7 @@
 namespace treelobes::lobes {
 
 struct AlphaShapeOptions {
-    double alpha_factor = 5.0;  // alpha = alpha_factor * alpha_min (ball radii), seed 001 §4.2
+    double alpha_factor = 5.0;  // alpha = alpha_factor * alpha_min (ball radii), Livny et al. 2011, §4.2
 };
 
 struct AlphaShapeResult {

@@ -1,4 +1,4 @@
-// Closed, consistently oriented triangle surfaces: the form every lobe takes (seed 001 §4.2).
+// Closed, consistently oriented triangle surfaces: the form every lobe takes (Livny et al. 2011, §4.2).
 //
 // The boundary of a union of solid cells (the regular facets of an alpha shape) is an oriented
 // triangle soup in which each edge is used as often in one direction as in the other. Where two

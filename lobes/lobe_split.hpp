@@ -1,5 +1,5 @@
 // Confidence of skeleton edges and the split of a tree into its main branching structure and
-// lobe clusters (seed 001 §4.2).
+// lobe clusters (Livny et al. 2011, §4.2).
 //
 // Every internode (the edge from a node's parent to the node) has the points the skeleton
 // assigned to it. Its confidence measure is the average distance of those points to the edge
@@ -11,7 +11,7 @@
 // Walking from the root, the first low-confidence edge on a path (from node p_i to its child)
 // ends the main branching structure there; the points of that edge and of everything above it
 // form cluster C_i, seeded at p_i. Larger f_s -> larger d' -> fewer low-confidence edges, so
-// clusters start further out: more, smaller lobes (seed 001 Fig. 3/11).
+// clusters start further out: more, smaller lobes (Livny et al. 2011, Fig. 3/11).
 #pragma once
 
 #include "core/tree_graph.hpp"

@@ -1,4 +1,4 @@
-// The lobe-based tree representation of seed 001 §4-5: the main branching structure (a
+// The lobe-based tree representation of Livny et al. 2011, §4-5: the main branching structure (a
 // skeletal graph with allometric diameters), one closed lobe surface per low-confidence
 // cluster with its seed point, and the species parameters needed to synthesize the tree again.
 // build_lobe_tree() derives it from a skeleton reconstruction (reconstruct/reconstruct_tree.hpp);
@@ -34,9 +34,9 @@ struct Lobe {
 };
 
 struct LobeTree {
-    TreeGraph skeleton;                 // main branching structure; radius = d(u)/2 (seed 001 Eq. 1)
+    TreeGraph skeleton;                 // main branching structure; radius = d(u)/2 (Livny et al. 2011, Eq. 1)
     std::string species;                // may be empty (no species given)
-    double beta = 1.5, gamma = 1.5, fs = 1.0;  // seed 001 Table 1 parameters used
+    double beta = 1.5, gamma = 1.5, fs = 1.0;  // Livny et al. 2011, Table 1 parameters used
     double alpha_factor = 5.0;
     double root_diameter = 0.0;         // d_root (metres)
     std::vector<Lobe> lobes;

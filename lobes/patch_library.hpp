@@ -1,4 +1,4 @@
-// Branchlet patch library of a species (seed 001 §5, Fig. 4, Appendix A).
+// Branchlet patch library of a species (Livny et al. 2011, §5, Fig. 4, Appendix A).
 //
 // 20-30 complete branchlets per species are grown by the Appendix A patch L-system, applied
 // directly (the rules are fixed; only the profile's parameters vary per species):
@@ -54,7 +54,7 @@ struct Patch {
 };
 
 struct PatchLibraryOptions {
-    int branchlets = 24;               // seed 001: 20-30 per species
+    int branchlets = 24;               // Livny et al. 2011: 20-30 per species
     double min_root_thickness = 0.004; // metres
     double max_root_thickness = 0.08;
     double min_twig_thickness = 0.002; // no seeds (docking points) thinner than this

@@ -1,4 +1,4 @@
-// Full-tree synthesis from a lobe-based representation (seed 001 §5) and its level of detail
+// Full-tree synthesis from a lobe-based representation (Livny et al. 2011, §5) and its level of detail
 // (§6.2).
 //
 // texture_tree() builds the species' patch library and textures every lobe from its seed
@@ -36,7 +36,7 @@ namespace treelobes::lobes {
 struct SynthesisOptions {
     PatchLibraryOptions library;
     TexturingOptions texturing;
-    std::size_t max_triangles = 2000000;  // triangles of the whole synthesized mesh at most (seed 001: 0.5-3 M
+    std::size_t max_triangles = 2000000;  // triangles of the whole synthesized mesh at most (Livny et al. 2011: 0.5-3 M
                                           // per tree): the main skeleton's, the rest shared by the lobes by volume
     BranchMeshOptions main_branches{8, 2, 0.002f, 1.0f, 0.0f, true};
     int twig_sides = 3;  // prism sides of patch twigs

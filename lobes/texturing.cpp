@@ -175,44 +175,32 @@ Eigen::Vector3f LobeVolume::cell_centre(int c) const {
     return lo_ + size_ * Eigen::Vector3f(i + 0.5f, j + 0.5f, k + 0.5f);
 }
 
-LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library,
-                         const TexturingOptions& o, std::uint64_t stream, const Occupancy* occupancy) {
+namespace {
+
+void check_texturing(const PatchLibrary& library, const TexturingOptions& o) {
     if (library.patches.empty()) throw Error::usage("lobe texturing: the patch library is empty");
     if (o.candidates < 1) throw Error::usage("lobe texturing: candidates must be >= 1");
     if (!(o.fill_cell > 0) || !(o.max_fill_cells >= 1)) throw Error::usage("lobe texturing: fill cell and cell count must be positive");
-    LobeTexture texture;
-    const LobeVolume volume(lobe, 40);
-    const bool occupied_only = occupancy != nullptr && !occupancy->empty();
-    // The volume to fill: the occupied cells' (at most the lobe's) with an occupancy.
+}
+
+// Edge of the fill cells: the volume to fill (the occupied cells', at most the lobe's, with an
+// occupancy) in at most max_fill_cells cells, never smaller than fill_cell.
+double fill_cell_size(const TriangleMesh& lobe, const TexturingOptions& o, const Occupancy* occupancy) {
     double fill_volume = std::max(lobe.signed_volume(), 0.0);
-    if (occupied_only)
+    if (occupancy != nullptr)
         fill_volume = std::min(fill_volume, static_cast<double>(occupancy->occupied_count()) * std::pow(static_cast<double>(occupancy->cell), 3));
-    const double cell = std::max(o.fill_cell, std::cbrt(fill_volume / o.max_fill_cells));
-    const LobeVolume fill_grid = LobeVolume::with_cell_size(lobe, static_cast<float>(cell));
-    const std::vector<char> target = fill_targets(fill_grid, occupied_only ? occupancy : nullptr);
-    std::vector<int> filled(fill_grid.cell_count(), 0);  // patches reaching each cell
-    int filled_count = 0;
-    const int fill_total = std::max(1, static_cast<int>(std::count(target.begin(), target.end(), 1)));
-    texture.target_cells = static_cast<std::size_t>(fill_total);
-    Rng rng(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17);
+    return std::max(o.fill_cell, std::cbrt(fill_volume / o.max_fill_cells));
+}
 
-    std::vector<std::vector<Sample>> samples(library.patches.size()), fit_samples(library.patches.size());
-    for (std::size_t i = 0; i < library.patches.size(); ++i) {
-        samples[i] = patch_samples(library.patches[i], library.patches[i].leaves.size());
-        fit_samples[i] = patch_samples(library.patches[i], kFitLeaves);
-    }
-    // Twig points of every placed patch: re-seeding grows from the nearest one to an empty cell
-    // (a scan over all placed points made re-seeding quadratic in big lobes).
-    GrowingKdTree twigs;
-
-    // Empty lobe cells in a fixed random order: the order in which empty regions are re-seeded.
+// Target cells in a fixed random order, the order in which empty regions are re-seeded. Cells on
+// the lobe's surface first: the hull runs through the cluster's outermost points (alpha-shape
+// vertices are input points), where a scan sees the foliage, while much of a large hull's inside
+// is empty space.
+std::vector<int> reseed_order(const LobeVolume& fill_grid, const std::vector<char>& target, double cell, Rng& rng) {
     std::vector<int> fill_order;
     for (int c = 0; c < fill_grid.cell_count(); ++c)
         if (target[c]) fill_order.push_back(c);
     for (std::size_t i = fill_order.size(); i > 1; --i) std::swap(fill_order[i - 1], fill_order[rng.next() % i]);
-    // Cells on the lobe's surface first: the hull runs through the cluster's outermost points
-    // (alpha-shape vertices are input points), where a scan sees the foliage, while much of a
-    // large hull's inside is empty space.
     auto on_surface = [&](int c) {
         const Eigen::Vector3f centre = fill_grid.cell_centre(c);
         for (int axis = 0; axis < 3; ++axis)
@@ -223,116 +211,210 @@ LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, con
         return false;
     };
     std::stable_partition(fill_order.begin(), fill_order.end(), on_surface);
-    std::size_t fill_cursor = 0;
+    return fill_order;
+}
 
-    // Docking points, thickest first (the large structure is laid before the twigs fill in);
-    // ties in order of creation. Forced docks (the seed and re-seeds) are used even where
-    // they sit outside the lobe or add nothing new.
-    struct Pending {
-        DockingPoint dock;
-        bool forced;
-        std::size_t order;
-    };
-    auto later = [](const Pending& a, const Pending& b) {
+// A docking point waiting for a patch. Forced docks (the seed and re-seeds) are used even where
+// they sit outside the lobe or add nothing new.
+struct Pending {
+    DockingPoint dock;
+    bool forced;
+    std::size_t order;
+};
+
+// Docking points, thickest first (the large structure is laid before the twigs fill in); ties in
+// order of creation.
+struct Later {
+    bool operator()(const Pending& a, const Pending& b) const {
         return a.dock.thickness != b.dock.thickness ? a.dock.thickness < b.dock.thickness : a.order > b.order;
-    };
-    std::priority_queue<Pending, std::vector<Pending>, decltype(later)> queue(later);
-    std::size_t created = 0;
-    queue.push({seed, true, created++});
-    std::vector<int> order;
-    order.reserve(library.patches.size());
-    int layer = 1;                                    // patches a cell takes in the current pass
-    std::vector<Pending> deferred;                    // docks dropped as redundant in an earlier pass
-    auto reaches = [&](int cell) { return cell >= 0 && target[cell] && filled[cell] < layer; };
-    // Triangles each patch adds to the mesh: the budget is a hard bound on their sum.
-    std::vector<std::size_t> cost(library.patches.size());
-    for (std::size_t i = 0; i < library.patches.size(); ++i) cost[i] = patch_triangles(library.patches[i], o.twig_sides, o.leaf_share);
-    const std::size_t min_cost = *std::min_element(cost.begin(), cost.end());
-    auto affordable = [&] { return texture.instances.size() < o.max_patches_per_lobe && texture.triangles + min_cost <= o.max_triangles; };
-    while (affordable()) {
-        if (queue.empty()) {
-            // Spread first: cells take one patch until the lobe is filled (or cannot be filled
-            // further); then the docks that were dropped for it are taken up again, for a second
-            // patch per cell. With a tight budget (big crowns) the patches reach more of the
-            // lobe before it runs out; with a loose one the lobe ends as dense as before.
-            const bool filled_enough = static_cast<double>(filled_count) / fill_total >= o.fill_target ||
-                                       texture.reseeds >= static_cast<std::size_t>(o.max_reseeds_per_cell * fill_total) || twigs.empty();
-            while (!filled_enough && fill_cursor < fill_order.size() && filled[fill_order[fill_cursor]]) ++fill_cursor;
-            if (filled_enough || fill_cursor == fill_order.size()) {
-                if (layer >= kPatchesPerCell || deferred.empty()) break;
-                ++layer;
-                for (auto& pending : deferred) queue.push(std::move(pending));
-                deferred.clear();
+    }
+};
+
+// The best of the fitted candidates: its placement and the fill cells it newly reaches.
+struct Fit {
+    PatchInstance instance;
+    int reached = 0;
+};
+
+// One lobe being textured: the fill plan, the docking-point queue and the patches placed so far.
+// The steps are those of the loop in run(): re-seed an empty region when the queue runs dry,
+// select candidate patches for a dock, fit them, place the best.
+class LobeTexturer {
+public:
+    LobeTexturer(const TriangleMesh& lobe, const PatchLibrary& library, const TexturingOptions& o, std::uint64_t stream,
+                 const Occupancy* occupancy)
+        : library_(library), o_(o), volume_(lobe, 40), cell_(fill_cell_size(lobe, o, occupied_or_null(occupancy))),
+          fill_grid_(LobeVolume::with_cell_size(lobe, static_cast<float>(cell_))),
+          target_(fill_targets(fill_grid_, occupied_or_null(occupancy))), filled_(fill_grid_.cell_count(), 0),
+          fill_total_(std::max(1, static_cast<int>(std::count(target_.begin(), target_.end(), 1)))),
+          rng_(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17) {
+        texture_.target_cells = static_cast<std::size_t>(fill_total_);
+        samples_.resize(library.patches.size());
+        fit_samples_.resize(library.patches.size());
+        for (std::size_t i = 0; i < library.patches.size(); ++i) {
+            samples_[i] = patch_samples(library.patches[i], library.patches[i].leaves.size());
+            fit_samples_[i] = patch_samples(library.patches[i], kFitLeaves);
+        }
+        fill_order_ = reseed_order(fill_grid_, target_, cell_, rng_);
+        // Triangles each patch adds to the mesh: the budget is a hard bound on their sum.
+        cost_.resize(library.patches.size());
+        for (std::size_t i = 0; i < library.patches.size(); ++i) cost_[i] = patch_triangles(library.patches[i], o.twig_sides, o.leaf_share);
+        min_cost_ = *std::min_element(cost_.begin(), cost_.end());
+        order_.reserve(library.patches.size());
+    }
+
+    LobeTexture run(const DockingPoint& seed) {
+        queue_.push({seed, true, created_++});
+        while (affordable()) {
+            if (queue_.empty()) {
+                const Refill refill = refill_queue(seed);
+                if (refill == Refill::Done) break;
+                if (refill == Refill::Again) continue;
+            }
+            const Pending pending = queue_.top();
+            queue_.pop();
+            const DockingPoint& d = pending.dock;
+            if (!pending.forced && !volume_.inside(d.position)) {
+                ++texture_.docks_outside;
                 continue;
             }
-            const Eigen::Vector3f target = fill_grid.cell_centre(fill_order[fill_cursor++]);
-            const Eigen::Vector3f from = twigs.point(twigs.nearest(target));
-            const Eigen::Vector3f dir = target - from;
-            if (dir.norm() < 1e-5f) continue;
-            // As thick as a twig must be to reach the empty cell, never thicker than the seed.
-            const float thickness = std::clamp(dir.norm() / kPatchReach, 0.002f, std::max(seed.thickness, 0.002f));
-            queue.push({{from, dir.normalized(), thickness}, true, created++});
-            ++texture.reseeds;
+            const Fit best = fit_best(d, select_candidates(d));
+            if (!pending.forced && best.reached == 0) {  // this part of the lobe is filled already
+                ++texture_.docks_redundant;
+                if (layer_ < kPatchesPerCell) deferred_.push_back(pending);
+                continue;
+            }
+            add(best.instance);
         }
-        const Pending pending = queue.top();
-        queue.pop();
-        const DockingPoint& d = pending.dock;
-        if (!pending.forced && !volume.inside(d.position)) {
-            ++texture.docks_outside;
-            continue;
+        texture_.filled = static_cast<double>(filled_count_) / fill_total_;
+        texture_.budget_spent = !affordable();
+        return texture_;
+    }
+
+private:
+    enum class Refill { Done, Again, Reseeded };
+
+    static const Occupancy* occupied_or_null(const Occupancy* occupancy) {
+        return occupancy != nullptr && !occupancy->empty() ? occupancy : nullptr;
+    }
+
+    bool affordable() const {
+        return texture_.instances.size() < o_.max_patches_per_lobe && texture_.triangles + min_cost_ <= o_.max_triangles;
+    }
+
+    bool reaches(int cell) const { return cell >= 0 && target_[cell] && filled_[cell] < layer_; }
+
+    // Spread first: cells take one patch until the lobe is filled (or cannot be filled further);
+    // then the docks that were dropped for it are taken up again, for a second patch per cell.
+    // With a tight budget (big crowns) the patches reach more of the lobe before it runs out;
+    // with a loose one the lobe ends as dense as before.
+    Refill refill_queue(const DockingPoint& seed) {
+        const bool filled_enough = static_cast<double>(filled_count_) / fill_total_ >= o_.fill_target ||
+                                   texture_.reseeds >= static_cast<std::size_t>(o_.max_reseeds_per_cell * fill_total_) || twigs_.empty();
+        while (!filled_enough && fill_cursor_ < fill_order_.size() && filled_[fill_order_[fill_cursor_]]) ++fill_cursor_;
+        if (filled_enough || fill_cursor_ == fill_order_.size()) {
+            if (layer_ >= kPatchesPerCell || deferred_.empty()) return Refill::Done;
+            ++layer_;
+            for (auto& pending : deferred_) queue_.push(std::move(pending));
+            deferred_.clear();
+            return Refill::Again;
         }
-        // Patch selection: of the patches that fit the remaining budget, the candidates with the
-        // smallest thickness/orientation mismatch.
-        order.clear();
-        for (std::size_t i = 0; i < library.patches.size(); ++i)
-            if (texture.triangles + cost[i] <= o.max_triangles) order.push_back(static_cast<int>(i));
-        const std::size_t k = std::min<std::size_t>(static_cast<std::size_t>(o.candidates), order.size());
-        std::partial_sort(order.begin(), order.begin() + static_cast<std::ptrdiff_t>(k), order.end(), [&](int a, int b) {
-            const float ca = mismatch(library.patches[a], d), cb = mismatch(library.patches[b], d);
+        // Re-seeding grows from the placed twig point nearest to the empty cell.
+        const Eigen::Vector3f empty_cell = fill_grid_.cell_centre(fill_order_[fill_cursor_++]);
+        const Eigen::Vector3f from = twigs_.point(twigs_.nearest(empty_cell));
+        const Eigen::Vector3f dir = empty_cell - from;
+        if (dir.norm() < 1e-5f) return Refill::Again;
+        // As thick as a twig must be to reach the empty cell, never thicker than the seed.
+        const float thickness = std::clamp(dir.norm() / kPatchReach, 0.002f, std::max(seed.thickness, 0.002f));
+        queue_.push({{from, dir.normalized(), thickness}, true, created_++});
+        ++texture_.reseeds;
+        return Refill::Reseeded;
+    }
+
+    // Patch selection: of the patches that fit the remaining budget, the candidates with the
+    // smallest thickness/orientation mismatch, first in order_; returns their count.
+    std::size_t select_candidates(const DockingPoint& d) {
+        order_.clear();
+        for (std::size_t i = 0; i < library_.patches.size(); ++i)
+            if (texture_.triangles + cost_[i] <= o_.max_triangles) order_.push_back(static_cast<int>(i));
+        const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(o_.candidates), order_.size());
+        std::partial_sort(order_.begin(), order_.begin() + static_cast<std::ptrdiff_t>(count), order_.end(), [&](int a, int b) {
+            const float ca = mismatch(library_.patches[a], d), cb = mismatch(library_.patches[b], d);
             return ca != cb ? ca < cb : a < b;
         });
-        // Patch fitting: geometry inside the lobe, plus lobe cells it newly reaches.
+        return count;
+    }
+
+    // Patch fitting: geometry inside the lobe, plus lobe cells it newly reaches.
+    Fit fit_best(const DockingPoint& d, std::size_t count) {
         double best_score = -1;
-        int best_reached = 0;
-        PatchInstance best;
-        for (std::size_t c = 0; c < k; ++c) {
-            PatchInstance inst = place(library.patches[order[c]], d, static_cast<float>(rng.uniform(0, 2 * std::numbers::pi)));
-            inst.patch = order[c];
-            const auto& s = fit_samples[order[c]];
+        Fit best;
+        for (std::size_t c = 0; c < count; ++c) {
+            PatchInstance inst = place(library_.patches[order_[c]], d, static_cast<float>(rng_.uniform(0, 2 * std::numbers::pi)));
+            inst.patch = order_[c];
+            const auto& s = fit_samples_[order_[c]];
             int inside = 0, reached = 0;
             for (const auto& sample : s) {
                 const Eigen::Vector3f p = inst.apply(sample.position);
-                inside += volume.inside(p) ? 1 : 0;
-                reached += reaches(fill_grid.cell(p)) ? 1 : 0;
+                inside += volume_.inside(p) ? 1 : 0;
+                reached += reaches(fill_grid_.cell(p)) ? 1 : 0;
             }
             const double score = s.empty() ? 0.0 : (inside + 0.5 * reached) / static_cast<double>(s.size());
             if (score > best_score) {
                 best_score = score;
-                best_reached = reached;
-                best = inst;
+                best = {inst, reached};
             }
         }
-        if (!pending.forced && best_reached == 0) {  // this part of the lobe is filled already
-            ++texture.docks_redundant;
-            if (layer < kPatchesPerCell) deferred.push_back(pending);
-            continue;
-        }
-        texture.instances.push_back(best);
-        texture.triangles += cost[best.patch];
-        ++texture.docks_used;
-        const Patch& patch = library.patches[best.patch];
-        for (const auto& sample : samples[best.patch]) {
+        return best;
+    }
+
+    // The chosen patch joins the texture: its cells count as reached, its twig points can
+    // re-seed, its docking points wait in the queue.
+    void add(const PatchInstance& best) {
+        texture_.instances.push_back(best);
+        texture_.triangles += cost_[best.patch];
+        ++texture_.docks_used;
+        const Patch& patch = library_.patches[best.patch];
+        for (const auto& sample : samples_[best.patch]) {
             const Eigen::Vector3f p = best.apply(sample.position);
-            const int cell = fill_grid.cell(p);
-            if (reaches(cell) && filled[cell]++ == 0) ++filled_count;
-            if (sample.thickness > 0) twigs.add(p);
+            const int c = fill_grid_.cell(p);
+            if (reaches(c) && filled_[c]++ == 0) ++filled_count_;
+            if (sample.thickness > 0) twigs_.add(p);
         }
         for (const auto& dock : patch.docks)
-            queue.push({{best.apply(dock.position), best.rotation * dock.direction, dock.thickness * best.scale}, false, created++});
+            queue_.push({{best.apply(dock.position), best.rotation * dock.direction, dock.thickness * best.scale}, false, created_++});
     }
-    texture.filled = static_cast<double>(filled_count) / fill_total;
-    texture.budget_spent = !affordable();
-    return texture;
+
+    const PatchLibrary& library_;
+    const TexturingOptions& o_;
+    const LobeVolume volume_;
+    const double cell_;
+    const LobeVolume fill_grid_;
+    const std::vector<char> target_;
+    std::vector<int> filled_;  // patches reaching each cell
+    int filled_count_ = 0;
+    const int fill_total_;
+    Rng rng_;
+    std::vector<std::vector<Sample>> samples_, fit_samples_;
+    GrowingKdTree twigs_;  // twig points of every placed patch (a scan over all of them made re-seeding quadratic)
+    std::vector<int> fill_order_;
+    std::size_t fill_cursor_ = 0;
+    std::priority_queue<Pending, std::vector<Pending>, Later> queue_;
+    std::size_t created_ = 0;
+    std::vector<int> order_;
+    int layer_ = 1;                  // patches a cell takes in the current pass
+    std::vector<Pending> deferred_;  // docks dropped as redundant in an earlier pass
+    std::vector<std::size_t> cost_;
+    std::size_t min_cost_ = 0;
+    LobeTexture texture_;
+};
+
+}  // namespace
+
+LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library,
+                         const TexturingOptions& o, std::uint64_t stream, const Occupancy* occupancy) {
+    check_texturing(library, o);
+    return LobeTexturer(lobe, library, o, stream, occupancy).run(seed);
 }
 
 }  // namespace treelobes::lobes

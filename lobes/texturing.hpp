@@ -1,4 +1,4 @@
-// Lobe texturing (seed 001 §5, Fig. 5/6): filling each lobe with branchlet patches from the
+// Lobe texturing (Livny et al. 2011, §5, Fig. 5/6): filling each lobe with branchlet patches from the
 // species' patch library, starting at the lobe's seed point.
 //
 // A queue of docking points starts with the seed (p_i, its thickness and direction). For each

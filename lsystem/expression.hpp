@@ -5,7 +5,7 @@
 // Syntax (C-like, as in cpfg; `and or not` as in L-Py):
 //   numbers 1  0.5  .5  2e-3 · names (rule parameters, #define constants, `step`, `steps`, `pi`)
 //   unary - + !/not · ^ (power, right-assoc., binds tighter than unary minus: -2^2 = -4)
-//   * / % · + - · < <= > >= · == != (and = as equality, the notation of seed 003) · &&/and · ||/or
+//   * / % · + - · < <= > >= · == != (and = as equality, the notation of Lluch et al. 2010) · &&/and · ||/or
 //   functions: sin cos tan asin acos atan (radians), atan2(y,x), sqrt exp log abs floor ceil
 //   round sign min(a,b) max(a,b) pow(a,b) · random: ran(x) in [0,x), uniform(a,b), normal(m,s)
 // Comparisons and logic give 1 or 0; a condition holds when it is non-zero.

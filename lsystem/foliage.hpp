@@ -1,4 +1,4 @@
-// Foliage of the hybrid multiresolution representation (seed 003 §3.2, Lluch et al. 2010): leaf
+// Foliage of the hybrid multiresolution representation (Lluch et al. 2010, via Ong's seminar report, §3.2): leaf
 // blades as triangles, and the bounding-box hierarchy of the foliage that follows the branching.
 //
 // The hierarchy has one box per tADT node whose subtree carries foliage: the root box bounds all
@@ -12,7 +12,7 @@
 //
 // Boxes bound the leaf blades (not just their bases). Each side is at least min_side_fraction of
 // the root box's largest side, so a single flat leaf still has a volume and six usable planes.
-// A box is textured when volume / root volume > texture_threshold (issue 8 item 4; the root,
+// A box is textured when volume / root volume > texture_threshold (the root,
 // ratio 1, is textured for every threshold < 1): small boxes are left to their ancestors' textures.
 #pragma once
 
@@ -80,7 +80,7 @@ struct FoliageHierarchy {
 FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafPlacement> leaves,
                                          const FoliageOptions& options = {});
 
-// Foliage of a combined level (seed 003 §3.3): the chain prefix draws its own leaves as geometry,
+// Foliage of a combined level (Lluch et al. 2010, via Ong's seminar report, §3.3): the chain prefix draws its own leaves as geometry,
 // and so are the ornaments of its nodes (the greedy chain reaches those zero-length nodes last, but
 // a leaf belongs with its branch). Every sub-branch the prefix has not reached yet is drawn with the
 // textures of its box when that box is textured; a sub-branch below the texture threshold has no
@@ -96,7 +96,7 @@ struct FoliageLod {
 // `visited` holds one flag per tADT node (1 = in the chain prefix), e.g. from visited_nodes().
 FoliageLod foliage_for_prefix(const Tadt& tadt, const FoliageHierarchy& hierarchy, const std::vector<char>& visited);
 
-// The foliage-only level of detail (seed 003 §3.3: "each further level in the bounding box hierarchy
+// The foliage-only level of detail (Lluch et al. 2010, via Ong's seminar report, §3.3: "each further level in the bounding box hierarchy
 // represents the next LOD"): the textured boxes that stand for the whole crown at hierarchy depth
 // `depth`. Starting from the root box, a box is replaced by its children while it is shallower than
 // `depth`, has no own leaves and all its children are textured, so every cut covers every leaf

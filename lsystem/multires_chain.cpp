@@ -256,7 +256,7 @@ std::string format_chain(const MultiresChain& chain, ChainLabels labels, std::si
 }
 
 std::string chain_file_text(const MultiresChain& chain) {
-    std::string text = "# treelobes multiresolution chain (seed 003): metric " + std::string(to_string(chain.metric)) +
+    std::string text = "# treelobes multiresolution chain (Lluch et al. 2010): metric " + std::string(to_string(chain.metric)) +
                        ", order " + std::string(to_string(chain.order)) + "\n# tadt_nodes " +
                        std::to_string(chain.tadt.nodes.size()) + ", entries " + std::to_string(chain.entries.size()) +
                        ", lods " + std::to_string(chain.lod_count()) +

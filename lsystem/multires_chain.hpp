@@ -1,4 +1,4 @@
-// Multiresolution chain of seed 003 §3.1 / §3.3 (Lluch et al. 2010): the tADT linearised so
+// Multiresolution chain of Lluch et al. 2010 (via Ong's seminar report, §3.1 and §3.3): the tADT linearised so
 // that every prefix is a coarser tree, with SAVE(n) / RESTORE(n) entries instead of brackets.
 //
 // Traversal: from the root, always continue into the child with the highest metric (ties, within
@@ -11,7 +11,7 @@
 //       remaining metric, so each RESTORE adds the most important remaining branch (coarse to fine).
 //   depth_first: restore the most recently saved node with unvisited children (a stack); the
 //       metric then only orders the children of each node.
-// Both give the seed's chain `C1 SAVE(C1) C2 SAVE(C2) C3 RESTORE(C2) C4 RESTORE(C1) C5`.
+// Both give the chain of Ong's seminar report on Lluch et al. 2010, §3.1, `C1 SAVE(C1) C2 SAVE(C2) C3 RESTORE(C2) C4 RESTORE(C1) C5`.
 //
 // Metrics, evaluated on the unvisited part of a node's subtree (the node itself included):
 //   branching_length  sum of the tADT lengths (the paper's choice)
@@ -83,8 +83,8 @@ MultiresChain build_multires_chain(Tadt tadt, const MultiresOptions& options = {
 MultiresChain build_multires_chain(const ModuleString& string, const MultiresOptions& options = {},
                                    const std::string& source = "module string");
 
-// The seed's notation: entries separated by spaces, a node as its modules, SAVE(x)/RESTORE(x)
-// labelled by the node's modules (`content`, as in the seed) or by `n<id>`. Empty nodes print as
+// The notation of Ong's seminar report on Lluch et al. 2010, §3.1: entries separated by spaces, a node as its modules, SAVE(x)/RESTORE(x)
+// labelled by the node's modules (`content`, as in the report) or by `n<id>`. Empty nodes print as
 // `<empty>`. Only the first `end` entries (default: all).
 enum class ChainLabels { content, node_id };
 std::string format_chain(const MultiresChain& chain, ChainLabels labels = ChainLabels::content,

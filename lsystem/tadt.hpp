@@ -1,9 +1,9 @@
-// Tree abstract data type (tADT) of seed 003 §3.1 (Lluch et al. 2010): the branching structure of
+// Tree abstract data type (tADT) of Lluch et al. 2010 (via Ong's seminar report, §3.1): the branching structure of
 // a bracketed module string, one node per run of modules between brackets.
 //
 // Reading the string left to right: modules are added to the current node; '[' adds a lateral
 // child and makes it current; ']' returns to the parent. A module that follows ']' starts a new
-// *continuation* child of the node the bracket returned to (seed 003 appends it to the parent's
+// *continuation* child of the node the bracket returned to (Lluch et al. 2010 appends it to the parent's
 // list; splitting keeps every node one contiguous run, so the branches keep their position along
 // the axis and the chain reproduces the geometry exactly). For `C1[C2[C3][C4]][C5]` both readings
 // give the same five nodes. Children are in string order.

@@ -1,5 +1,5 @@
 // TreeGraph -> bracketed module string, so that reconstructed trees (skeleton PLY) get the same
-// tADT and multiresolution chain as L-system trees (issue 8 item 5).
+// tADT and multiresolution chain as L-system trees, and both representations can be compared on the same trees.
 //
 // Each internode parent -> child becomes `!(w)SetHead(dx,dy,dz)F(l)`: the child's width
 // (2 * radius), its absolute direction and its length. Lateral children come first, each in

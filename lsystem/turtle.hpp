@@ -49,7 +49,7 @@ struct TurtleOptions {
     double leaf_size = 1.0;                   // leaf module without parameter
 };
 
-// A leaf recorded by the turtle (for foliage meshes and the foliage box hierarchy, seed 003 §3.2).
+// A leaf recorded by the turtle (for foliage meshes and the foliage box hierarchy, Lluch et al. 2010, via Ong's seminar report, §3.2).
 struct LeafPlacement {
     Eigen::Vector3f position{0, 0, 0};
     Eigen::Vector3f heading{0, 0, 1};  // H at the leaf: the blade's direction

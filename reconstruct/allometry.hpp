@@ -1,4 +1,4 @@
-// Allometric branch diameters of seed 001 §4.1:
+// Allometric branch diameters of Livny et al. 2011, §4.1:
 //   d(u)  = d_root * (l(u) / l(root))^gamma     (Eq. 1; l(u) = total edge length below u)
 //   d'(u) = f_s * d(u)                           (Eq. 2; the lobe stage's confidence diameter)
 // gamma and f_s come from the species library (config/species.yaml).
@@ -11,8 +11,8 @@
 namespace treelobes {
 
 struct AllometryOptions {
-    double gamma = 1.5;  // seed 001: about 1.5 for many species (Table 1: 1.2..1.9)
-    double fs = 1.0;     // seed 001 Table 1: 0.8..0.986; 1.0 for trees without leaves
+    double gamma = 1.5;  // Livny et al. 2011: about 1.5 for many species (Table 1: 1.2..1.9)
+    double fs = 1.0;     // Livny et al. 2011, Table 1: 0.8..0.986; 1.0 for trees without leaves
 };
 
 struct AllometricDiameters {

@@ -43,7 +43,7 @@ struct TreeSummary {
     float height = 0.0f;           // metres from the stem foot to the highest point
     bool dbh_fitted = false;
     float dbh = 0.0f;              // metres (diameter at 1.3 m), when fitted
-    float root_diameter = 0.0f;    // d_root of seed 001 Eq. 1 (metres)
+    float root_diameter = 0.0f;    // d_root of Livny et al. 2011, Eq. 1 (metres)
     std::string root_diameter_source;  // "base fit", "breast height fit", "given", "height / 50"
     float crown_width = 0.0f;      // mean of the two principal horizontal extents (metres)
     float total_length = 0.0f;     // sum of skeleton internode lengths (metres)

@@ -102,7 +102,7 @@ std::vector<float> smoothed_lengths(const NeighbourGraph& graph, const std::vect
     return current;
 }
 
-// The parent of a cluster is where the weighted shortest-path tree (seed 001: weights
+// The parent of a cluster is where the weighted shortest-path tree (Livny et al. 2011: weights
 // ||u-v||^beta) mostly enters it from: every point whose tree parent lies in an earlier
 // cluster of a lower bin votes for that cluster. A majority is robust where single paths are
 // not (one path may arrive through a small fragment of bark). Clusters that receive no vote
@@ -695,14 +695,96 @@ TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old,
     return out;
 }
 
+void check_points(std::span<const Eigen::Vector3f> points, const std::string& name) {
+    if (points.size() < 10) throw Error::input(name, "too few points for a skeleton (" + std::to_string(points.size()) + ")");
+    for (const auto& p : points)
+        if (!p.allFinite()) throw Error::input(name, "a point has a non-finite coordinate");
+}
+
+// The geodesic slicing: the tree's points, their graph and both shortest-path runs.
+struct Slicing {
+    std::span<const Eigen::Vector3f> points;
+    const NeighbourGraph& graph;
+    const KnnTable& near;
+    const ShortestPaths& sp;
+    const ShortestPaths& weighted;
+    float bin_width, merge, root_spread;
+    int geodesic_smoothing;
+
+    Clusters clusters(const std::vector<float>& point_width) const {
+        return merge_fragments(points, cluster_bins(points, graph, near, sp, weighted, bin_width, point_width, bin_width, geodesic_smoothing),
+                               merge, root_spread);
+    }
+};
+
+// Bin width of every point. A first slicing at the full width measures how thick the branch is
+// around every point; thin branches are then sliced again at a finer width (their axis bends
+// within a wide bin, and nearby twigs share one), thick stems keep the wide bins that hold their
+// rings together. Empty: every point at the full width.
+std::vector<float> point_bin_widths(const Slicing& slicing, const SkeletonOptions& o) {
+    std::vector<float> point_width;
+    if (!(o.fine_bin_factor < 1.0f)) return point_width;
+    const float full = slicing.bin_width;
+    const float fine = o.fine_bin_factor * full;
+    const Clusters coarse = slicing.clusters({});
+    const std::vector<float> thickness = slice_thickness(slicing.points, coarse);
+    point_width.resize(slicing.points.size());
+    const float thick = o.thick_slice * full;
+    // A slice counts as thin only above two thin slices: a ring cut at two widths falls
+    // apart, so the first slices of a branch leaving a thick stem keep the stem's width, and
+    // so do crumbs at the ragged edge of a one-sided ring.
+    auto thin = [&](int k) { return k >= 0 && thickness[k] < thick; };
+    for (std::size_t i = 0; i < slicing.points.size(); ++i) {
+        const int k = coarse.of_point[i], up = coarse.parent[k];
+        point_width[i] = thin(k) && thin(up) && thin(coarse.parent[up]) ? fine : full;
+    }
+    log_debug("skeleton: " + std::to_string(std::count(point_width.begin(), point_width.end(), full)) + " of " +
+              std::to_string(slicing.points.size()) + " points on thick slices (full bin width)");
+    return point_width;
+}
+
+// Clusters beyond gaps (max_gap, max_gap_points) leave the skeleton; returns the points they held.
+std::size_t leave_out_detached(const Clusters& clusters, const NeighbourGraph& graph, const ShortestPaths& sp, const SkeletonOptions& o,
+                               TreeGraph& tree, std::vector<int>& node_of_point, std::vector<char>& on_axis) {
+    const std::vector<bool> detached = detached_clusters(clusters, graph, sp, o.max_gap, o.max_gap_points);
+    if (std::find(detached.begin(), detached.end(), true) == detached.end()) return 0;
+    std::vector<bool> keep(tree.size(), true);
+    for (std::size_t k = 0; k < detached.size(); ++k) keep[k + 1] = !detached[k];
+    std::size_t detached_points = 0;
+    for (std::size_t i = 0; i < node_of_point.size(); ++i) detached_points += detached[clusters.of_point[i]];
+    log_debug("skeleton: " + std::to_string(detached_points) + " points in " +
+              std::to_string(std::count(detached.begin(), detached.end(), true)) + " clusters beyond gaps left out of the skeleton");
+    std::vector<int> new_index;
+    tree = keep_nodes(tree, keep, new_index);
+    for (int& node : node_of_point) node = new_index[node];
+    on_axis = kept_flags(on_axis, keep, new_index, tree.size());
+    return detached_points;
+}
+
+// Internodes of equal length, children ordered by subtree length, nodes renumbered; the root's
+// points go to the first internode above it (the root has no internode of its own).
+void resample_internodes(TreeGraph& tree, float internode_length, std::vector<int>& node_of_point, std::vector<char>& on_axis) {
+    for (auto& node : tree.nodes) node.radius = 0.0f;  // spreads served their purpose
+    std::vector<int> map;
+    std::vector<char> resampled_on_axis;
+    tree = resample(tree, internode_length, map, on_axis, resampled_on_axis);
+    for (int& node : node_of_point) node = map[node];
+    tree.order_children_by_subtree_length();
+    const std::vector<bool> all(tree.size(), true);
+    tree = keep_nodes(tree, all, map);
+    for (int& node : node_of_point) node = map[node];
+    on_axis = kept_flags(resampled_on_axis, all, map, tree.size());
+    const int first = tree.nodes[0].children.empty() ? 0 : tree.nodes[0].children.front();
+    for (int& node : node_of_point)
+        if (node == 0) node = first;
+}
+
 }  // namespace
 
 SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, const SkeletonOptions& o, const std::string& name,
                                     const KdTree* given_index, const KnnTable* given_near) {
     check_options(o);
-    if (points.size() < 10) throw Error::input(name, "too few points for a skeleton (" + std::to_string(points.size()) + ")");
-    for (const auto& p : points)
-        if (!p.allFinite()) throw Error::input(name, "a point has a non-finite coordinate");
+    check_points(points, name);
 
     SkeletonResult r;
     auto clock = std::chrono::steady_clock::now();
@@ -743,31 +825,8 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
                          [&] { sp = shortest_paths(graph, r.base.sources, EdgeCost::Length); });
     lap("base and shortest paths");
     const float root_spread = r.base.circle_fitted ? r.base.foot_radius : 0.0f;
-    // First slicing at the full width measures how thick the branch is around every point; thin
-    // branches are then sliced again at a finer width (their axis bends within a wide bin, and
-    // nearby twigs share one), thick stems keep the wide bins that hold their rings together.
-    std::vector<float> point_width;
-    if (o.fine_bin_factor < 1.0f) {
-        const float fine = o.fine_bin_factor * r.bin_width;
-        const Clusters coarse = merge_fragments(
-            points, cluster_bins(points, graph, near, sp, weighted, r.bin_width, {}, r.bin_width, o.geodesic_smoothing), merge, root_spread);
-        const std::vector<float> thickness = slice_thickness(points, coarse);
-        point_width.resize(points.size());
-        const float thick = o.thick_slice * r.bin_width;
-        // A slice counts as thin only above two thin slices: a ring cut at two widths falls
-        // apart, so the first slices of a branch leaving a thick stem keep the stem's width, and
-        // so do crumbs at the ragged edge of a one-sided ring.
-        auto thin = [&](int k) { return k >= 0 && thickness[k] < thick; };
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            const int k = coarse.of_point[i], up = coarse.parent[k];
-            point_width[i] = thin(k) && thin(up) && thin(coarse.parent[up]) ? fine : r.bin_width;
-        }
-        log_debug("skeleton: " + std::to_string(std::count(point_width.begin(), point_width.end(), r.bin_width)) + " of " +
-                  std::to_string(points.size()) + " points on thick slices (full bin width)");
-    }
-    const Clusters clusters = merge_fragments(
-        points, cluster_bins(points, graph, near, sp, weighted, r.bin_width, point_width, r.bin_width, o.geodesic_smoothing), merge,
-        root_spread);
+    const Slicing slicing{points, graph, near, sp, weighted, r.bin_width, merge, root_spread, o.geodesic_smoothing};
+    const Clusters clusters = slicing.clusters(point_bin_widths(slicing, o));
     r.clusters = clusters.size();
     lap("bins");
 
@@ -781,36 +840,11 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     lap("axis fits");
     std::vector<int> node_of_point(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) node_of_point[i] = clusters.of_point[i] + 1;
-    const std::vector<bool> detached = detached_clusters(clusters, graph, sp, o.max_gap, o.max_gap_points);
-    if (std::find(detached.begin(), detached.end(), true) != detached.end()) {
-        std::vector<bool> keep(tree.size(), true);
-        for (std::size_t k = 0; k < detached.size(); ++k) keep[k + 1] = !detached[k];
-        for (std::size_t i = 0; i < points.size(); ++i) r.detached_points += detached[clusters.of_point[i]];
-        log_debug("skeleton: " + std::to_string(r.detached_points) + " points in " +
-                  std::to_string(std::count(detached.begin(), detached.end(), true)) + " clusters beyond gaps left out of the skeleton");
-        std::vector<int> new_index;
-        tree = keep_nodes(tree, keep, new_index);
-        for (int& node : node_of_point) node = new_index[node];
-        on_axis = kept_flags(on_axis, keep, new_index, tree.size());
-    }
+    r.detached_points = leave_out_detached(clusters, graph, sp, o, tree, node_of_point, on_axis);
     r.pruned_nodes = prune_twigs(tree, twig, node_of_point, on_axis);
     smooth_chains(tree, o.smoothing_iterations);
 
-    for (auto& node : tree.nodes) node.radius = 0.0f;  // spreads served their purpose
-    std::vector<int> map;
-    std::vector<char> resampled_on_axis;
-    tree = resample(tree, r.internode_length, map, on_axis, resampled_on_axis);
-    for (int& node : node_of_point) node = map[node];
-    tree.order_children_by_subtree_length();
-    const std::vector<bool> all(tree.size(), true);
-    tree = keep_nodes(tree, all, map);
-    for (int& node : node_of_point) node = map[node];
-    on_axis = kept_flags(resampled_on_axis, all, map, tree.size());
-    // The root has no internode of its own: its points belong to the first internode above it.
-    const int first = tree.nodes[0].children.empty() ? 0 : tree.nodes[0].children.front();
-    for (int& node : node_of_point)
-        if (node == 0) node = first;
-
+    resample_internodes(tree, r.internode_length, node_of_point, on_axis);
     lap("prune, smooth, resample");
     r.tree = std::move(tree);
     r.point_internode = std::move(node_of_point);

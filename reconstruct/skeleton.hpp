@@ -1,4 +1,4 @@
-// Skeleton extraction from a single-tree point cloud (seed 001 §4.1, after Xu et al. 2007 and
+// Skeleton extraction from a single-tree point cloud (Livny et al. 2011, §4.1, after Xu et al. 2007 and
 // Livny et al. 2010):
 //   1. neighbour graph with edge weights ||u-v||^beta (geometry/neighbour_graph.hpp); a
 //      piece cut off by an occlusion gap is bridged where its own axis leads, not sideways to

@@ -1,7 +1,7 @@
 // Stem measurements along the skeleton's main axis: circles fitted to thin slices of the stem
 // (points assigned to trunk internodes, projected on the plane across the local stem
 // direction, so leaning stems and low branches do not bias them). Gives the DBH at 1.3 m and
-// the diameter at the tree base (d_root of seed 001 Eq. 1).
+// the diameter at the tree base (d_root of Livny et al. 2011, Eq. 1).
 #pragma once
 
 #include "core/tree_graph.hpp"

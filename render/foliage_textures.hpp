@@ -1,4 +1,4 @@
-// Foliage impostor textures of seed 003 §3.2 (Lluch et al. 2010): the foliage inside a box,
+// Foliage impostor textures of Lluch et al. 2010 (via Ong's seminar report, §3.2): the foliage inside a box,
 // projected orthographically on each of the box's six diagonal planes and rendered offscreen with
 // the project's rasteriser into size x size RGBA images (transparent where there is no leaf).
 //

@@ -1,8 +1,7 @@
 // Synthetic trees with known answers: synth::grow turns a species profile (config/species.yaml)
 // and a seed into a tree with its true skeleton, radii and leaves.
 //
-// The growth model follows Weber & Penn, "Creation and rendering of realistic trees"
-// (SIGGRAPH 1995): a trunk and up to three levels of branches, each stem a chain of curved
+// The growth model follows Weber & Penn 1995, "Creation and rendering of realistic trees": a trunk and up to three levels of branches, each stem a chain of curved
 // segments; first-order branch lengths follow the crown shape (ShapeRatio), deeper ones the
 // remaining length of their parent; phyllotaxis by `rotate` (spiral) or alternate sprays, whorls;
 // dichotomous forks (`seg_splits`) for decurrent crowns; tropism toward or away from the sky;

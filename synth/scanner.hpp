@@ -3,7 +3,7 @@
 // A pulse is a cone of `sub_rays` rays (hexagonal rings inside the beam divergence, Gaussian
 // energy profile). Each sub-ray stops at the first surface it meets, so leaves and branches
 // occlude what lies behind them; the far side and the inner crown get fewer points, as in real
-// scans (seed 001 §7). Sub-ray hits along the beam are grouped into returns: hits closer than
+// scans (Livny et al. 2011, §7). Sub-ray hits along the beam are grouped into returns: hits closer than
 // `min_separation_m` merge (range = energy-weighted mean), groups whose energy (weight x
 // reflectance x cos incidence) is below `detection_threshold` are not detected, at most
 // `max_returns` are recorded. Each return is placed on the beam axis at its range plus Gaussian

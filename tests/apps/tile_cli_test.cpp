@@ -116,7 +116,9 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
     std::size_t ground = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         ground += points.classification[i] == 2;
-        if (points.classification[i] == 2) EXPECT_LT(std::abs(points.extra("HeightAboveGround")->values[i]), 0.5);
+        if (points.classification[i] == 2) {
+            EXPECT_LT(std::abs(points.extra("HeightAboveGround")->values[i]), 0.5);
+        }
     }
     EXPECT_GT(ground, points.size() / 10);
     EXPECT_EQ(points.georef.crs_wkt, kWkt);

@@ -135,7 +135,7 @@ TEST(ClassifyFeatures, CatalogueHasMoreThan200DocumentedUniqueFeatures) {
         EXPECT_FALSE(f.group.empty()) << f.name;
         EXPECT_EQ(f.name.find(','), std::string::npos) << "a CSV column name cannot hold a comma: " << f.name;
     }
-    // The paper's list (seed 001 §6.1) and the skeleton features of issue 9 are all there.
+    // The paper's list (Livny et al. 2011, §6.1) and the skeleton features from a first reconstruction are all there.
     for (const char* required :
          {"trunk_diameter", "height", "crown_width_major", "crown_width_minor", "width_height_ratio", "normal_elevation_00",
           "normal_axis_angle_00", "z_moment2", "z_moment3", "z_moment4", "z_decile_05", "count_cv_20", "stems_at_05",

@@ -41,7 +41,7 @@ Error load_variant(const TempDir& dir, const std::string& from, const std::strin
 TEST(SpeciesLibrary, ShipsTwelveSpeciesWithTableOneParameters) {
     const auto entries = load_species_entries(shipped());
     ASSERT_EQ(entries.size(), 12u);
-    // Seed 001 Table 1, verbatim.
+    // Livny et al. 2011, Table 1, verbatim.
     const std::map<std::string, std::array<double, 3>> table1 = {
         {"mahogany", {1.7, 1.3, 0.975}},   {"bischofia_polycarpa", {1.8, 1.5, 0.986}}, {"delonix", {1.7, 1.5, 0.982}},
         {"lagerstroemia", {1.6, 1.5, 0.976}}, {"ailanthus_altissima", {1.5, 1.9, 0.980}}, {"palm", {1.8, 1.3, 0.800}},

@@ -265,11 +265,10 @@ TEST(LazFile, ChunkTableOutsideTheFileIsAnError) {
 TEST(LazFile, ChunkTableClaimingMoreChunksThanFitIsAnError) {
     // Offset pointing at a table right after 20 bytes of chunk data, declaring 1000 chunks.
     const std::size_t data_start = laz_file(10, {}).size() + 8;
-    Bytes tail = le64(data_start + 20);
-    tail.resize(tail.size() + 20, 0);
-    Bytes table(8, 0);
-    store<std::uint32_t>(table.data() + 4, 1000);
-    tail.insert(tail.end(), table.begin(), table.end());
+    // The chunk table offset (8 bytes), 20 bytes of chunk data, then the table: version, count.
+    Bytes tail(8 + 20 + 8, 0);
+    store<std::uint64_t>(tail.data(), data_start + 20);
+    store<std::uint32_t>(tail.data() + 8 + 20 + 4, 1000);
     const std::string message = message_of([&] { read_las_buffer(laz_file(10, tail), "bad.laz"); });
     EXPECT_NE(message.find("declares 1000 chunks"), std::string::npos) << message;
 }

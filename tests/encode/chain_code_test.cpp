@@ -1,4 +1,4 @@
-// The coding rules of issue 6 one by one: Table 1 moves, Eq. 1 rounding, the paper's Fig. 4 /
+// The coding rules of Strnad et al. 2020, §3.1, one by one: Table 1 moves, Eq. 1 rounding, the paper's Fig. 4 /
 // Fig. 6 vectors, the main-child rule and its tie-breaks, multi-way forks, the root fork, and
 // contraction of zero-length internodes.
 #include "core/error.hpp"

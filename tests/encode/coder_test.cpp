@@ -1,4 +1,4 @@
-// The two coders of chain codes and radii (seed 000 §3.3 and `best`): exact round trips on
+// The two coders of chain codes and radii (Strnad et al. 2020, §3.3 and `best`): exact round trips on
 // 1,000 random trees at every LOD, non-monotone radii, arbitrary symbol strings, the §3.3 radii
 // transform on a hand-checked example, and clean errors for damaged streams.
 #include "core/error.hpp"

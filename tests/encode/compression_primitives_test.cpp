@@ -1,5 +1,5 @@
 // Coding primitives of the compression issue: bit IO, Elias and centred minimal binary codes,
-// BWT, MTF, cumulative sums and binary interpolative coding (seed 000 §2.3 worked example).
+// BWT, MTF, cumulative sums and binary interpolative coding (Strnad et al. 2020, §2.3 worked example).
 #include "core/error.hpp"
 #include "encode/bitstream.hpp"
 #include "encode/bwt.hpp"
@@ -207,7 +207,7 @@ TEST(Transforms, MtfAndCumulativeSum) {
     EXPECT_THROW(differences(std::vector<std::uint64_t>{3, 2}, 8, "test"), Error);
 }
 
-// Seed 000 §2.3: Q[1] = 18 and Q[45] = 106 bound the middle element Q[23] to [18, 106], which
+// Strnad et al. 2020, §2.3: Q[1] = 18 and Q[45] = 106 bound the middle element Q[23] to [18, 106], which
 // takes ceil(log2(89)) = 7 bits; then Q[12] takes ceil(log2(Q[23] - 18 + 1)) bits and Q[34]
 // ceil(log2(106 - Q[23] + 1)) bits.
 TEST(Interpolative, Section23WorkedExample) {

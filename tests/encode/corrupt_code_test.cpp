@@ -1,5 +1,6 @@
 // Corrupt codes and radius lists are rejected with a clear Error(InvalidInput), never a crash or
-// a hang: the four defects named by issue 6, then random and mutated codes.
+// a hang: four structural defects by name (a fork without its lateral branch, a tip
+// closing more branches than are open, a missing final tip, a radius list of the wrong length), then random and mutated codes.
 #include "core/error.hpp"
 #include "encode/chain_code.hpp"
 #include "encode/lod.hpp"

@@ -1,4 +1,4 @@
-// Skeletons built to match seed 000's figures, for the code vectors printed in the paper.
+// Skeletons built to match Strnad et al. 2020's figures, for the code vectors printed in the paper.
 #pragma once
 
 #include "core/tree_graph.hpp"

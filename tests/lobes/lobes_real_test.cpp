@@ -1,4 +1,4 @@
-// End to end on real scans: library (lobes closed, .tlobe under the seed's 40 kB, round trip)
+// End to end on real scans: library (lobes closed, .tlobe under the 40 kB of Livny et al. 2011, Table 2, round trip)
 // and the `treelobes lobes` CLI (outputs, summary, exit codes). Small scans only, to stay fast.
 #include "lobes/closed_mesh.hpp"
 #include "lobes/lobe_tree.hpp"

@@ -29,9 +29,9 @@ std::size_t count_after(const LSystem& system, int steps, const std::string& nam
 
 }  // namespace
 
-// Seed 003 §2.1: A(l) : itNum < maxIt -> B(l)[A(l/2)A(l/2)], A(l) : itNum = maxIt -> B(l).
+// Lluch et al. 2010, via Ong's seminar report, §2.1: A(l) : itNum < maxIt -> B(l)[A(l/2)A(l/2)], A(l) : itNum = maxIt -> B(l).
 TEST(Derive, Seed003ExampleSequence) {
-    const LSystem s = load_lsystem(example("seed003_example.lsys"));
+    const LSystem s = load_lsystem(example("lluch2010_example.lsys"));
     ASSERT_EQ(s.derivation_length, 3);
     // itNum is the number of the step being applied; with maxIt = 3 steps 1-2 use rule 1.
     EXPECT_EQ(derive_text(s, 0), "A(1)");

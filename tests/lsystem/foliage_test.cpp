@@ -1,4 +1,4 @@
-// Foliage of seed 003 §3.2: leaf blades, the bounding-box hierarchy that follows the branching,
+// Foliage of Lluch et al. 2010, via Ong's seminar report, §3.2: leaf blades, the bounding-box hierarchy that follows the branching,
 // the volume threshold, the combined LOD bookkeeping, and the diagonal-plane textures (render/).
 #include "lsystem/foliage.hpp"
 #include "lsystem/lsystem.hpp"

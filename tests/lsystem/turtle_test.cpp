@@ -27,7 +27,7 @@ void expect_near(const Eigen::Vector3f& a, const Eigen::Vector3d& b, double tole
 
 }  // namespace
 
-// Seed 003 §2.2: F(1) [ R(90) F(1) ] F(2), with + as the rotation.
+// Lluch et al. 2010, via Ong's seminar report, §2.2: F(1) [ R(90) F(1) ] F(2), with + as the rotation.
 TEST(Turtle, Seed003BracketExample) {
     const TurtleResult r = draw("F(1)[+(90)F(1)]F(2)");
     ASSERT_EQ(r.tree.size(), 4u);

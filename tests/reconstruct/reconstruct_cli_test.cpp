@@ -115,7 +115,7 @@ TEST(ReconstructCli, SpeciesSetsBetaGammaAndFs) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto options = nlohmann::json::parse(r.out)["trees"][0]["options"];
     EXPECT_EQ(options["species"], "pine");
-    EXPECT_DOUBLE_EQ(options["beta"].get<double>(), 1.3);  // seed 001 Table 1
+    EXPECT_DOUBLE_EQ(options["beta"].get<double>(), 1.3);  // Livny et al. 2011, Table 1
     EXPECT_DOUBLE_EQ(options["gamma"].get<double>(), 1.2);
     EXPECT_DOUBLE_EQ(options["fs"].get<double>(), 0.98);
     // An explicit flag overrides the species value.

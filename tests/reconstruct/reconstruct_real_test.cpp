@@ -1,6 +1,6 @@
 // Reconstruction of the real scans in ../shared/data (label `real`). Thresholds are the
 // accuracy this implementation reaches (see bench/reconstruct_bench.sh for the full
-// table) with a margin, so a regression fails the test; the targets are reported by
+// table) with a margin, so a regression fails the test; the accuracy targets are reported by
 // the bench script, not asserted here where they are not met yet.
 #include "core/cloud_io.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
@@ -53,7 +53,7 @@ TEST(ReconstructReal, WoodskeHs) {
 TEST(ReconstructReal, WoodskeOr) {
     const Scored s = reconstruct_and_score("woodske/OR_wood.csv", "woodske/OR_reference_skeleton.txt");
     EXPECT_EQ(s.score.components, 1u);
-    EXPECT_LT(s.score.to_reference.median, 0.02);  // the target
+    EXPECT_LT(s.score.to_reference.median, 0.02);  // the accuracy target
     EXPECT_LT(s.score.to_reference.p95, 0.09);
 }
 
@@ -87,9 +87,9 @@ TEST(ReconstructReal, ArchiAgainstTreeQsm) {
     EXPECT_LT(s.score.to_reference.median, 0.051);  // peer: 0.051
     EXPECT_LT(s.score.to_reference.p95, 0.94);      // peer: 0.940
     ASSERT_TRUE(s.score.length_ratio);
-    EXPECT_NEAR(*s.score.length_ratio, 1.0, 0.25);  // the target (peer: 2.24)
+    EXPECT_NEAR(*s.score.length_ratio, 1.0, 0.25);  // the accuracy target (peer: 2.24)
     ASSERT_TRUE(s.score.trunk_radius_error);
-    EXPECT_LT(std::abs(*s.score.trunk_radius_error), 0.10);  // the target
+    EXPECT_LT(std::abs(*s.score.trunk_radius_error), 0.10);  // the accuracy target
 }
 
 TEST(ReconstructReal, AdtreeTreesAreTreesAndTheHouseIsNot) {

@@ -118,7 +118,9 @@ TEST(Grow, SpeciesLookDifferent) {
     for (std::size_t i = 1; i < palm.skeleton.size(); ++i)
         if (palm.node_level[i] == 1) {
             const int parent = palm.skeleton.nodes[i].parent;
-            if (palm.node_level[parent] == 0) EXPECT_GT(palm.skeleton.nodes[parent].position.z(), 0.6 * height);
+            if (palm.node_level[parent] == 0) {
+                EXPECT_GT(palm.skeleton.nodes[parent].position.z(), 0.6 * height);
+            }
         }
     // Delonix crowns are wider than tall, pines much taller than wide.
     const auto delonix = synth::measure(synth::grow(species("delonix"), 5, small_budget()));

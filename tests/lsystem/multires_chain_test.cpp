@@ -1,4 +1,4 @@
-// tADT and multiresolution chain (seed 003 §3.1, §3.3): the seed's example and a larger
+// tADT and multiresolution chain (Lluch et al. 2010, via Ong's seminar report, §3.1 and §3.3): the report's example and a larger
 // hand-checked example with every metric and both orders, LOD prefixes, and exact geometry.
 #include "core/error.hpp"
 #include "lsystem/lsystem.hpp"
@@ -26,7 +26,7 @@ MultiresChain chain_of(const std::string& text, ChainMetric metric, ChainOrder o
     return build_multires_chain(parse_module_string(text), options);
 }
 
-// Seed 003's example: five symbols of length 1.
+// The example of Lluch et al. 2010 (Ong's seminar report, §3.1): five symbols of length 1.
 const std::string kSeedExample = "C1[C2[C3][C4]][C5]";
 TadtOptions seed_lengths() { return {{"C1", "C2", "C3", "C4", "C5"}, 1.0}; }
 
@@ -46,7 +46,7 @@ TEST(Tadt, SeedExampleStructureAndLengths) {
     ASSERT_EQ(t.nodes.size(), 5u);
     EXPECT_EQ(t.nodes[0].children, (std::vector<int>{1, 4}));
     EXPECT_EQ(t.nodes[1].children, (std::vector<int>{2, 3}));
-    // Total length propagated to the parent at every ']' (seed 003's walk-through).
+    // Total length propagated to the parent at every ']' (walk-through in Ong's seminar report on Lluch et al. 2010, §3.1).
     EXPECT_EQ(t.nodes[0].subtree_length, 5.0);
     EXPECT_EQ(t.nodes[1].subtree_length, 3.0);
     EXPECT_EQ(t.nodes[4].subtree_length, 1.0);
@@ -79,7 +79,7 @@ TEST(Tadt, LargerExampleLengths) {
     EXPECT_FALSE(t.nodes[12].lateral);
 }
 
-// The seed's chain, for every metric and both orders.
+// The report's chain (Ong's seminar report on Lluch et al. 2010, §3.1), for every metric and both orders.
 TEST(MultiresChain, SeedExampleExactChain) {
     for (ChainOrder order : {ChainOrder::greedy, ChainOrder::depth_first})
         for (ChainMetric metric : kMetrics) {
@@ -158,7 +158,7 @@ TEST(MultiresChain, FullChainReproducesGeometryAndPrefixesAreSubtrees) {
         TurtleOptions turtle;
     };
     std::vector<Case> cases;
-    for (const char* file : {"honda_monopodial.lsys", "abop_ternary_tropism.lsys", "seed003_example.lsys"}) {
+    for (const char* file : {"honda_monopodial.lsys", "abop_ternary_tropism.lsys", "lluch2010_example.lsys"}) {
         const LSystem s = load_lsystem(example(file));
         cases.push_back({file, apply_homomorphism(s, derive(s)), s.turtle});
     }

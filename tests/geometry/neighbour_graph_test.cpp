@@ -1,15 +1,15 @@
-// kd-tree, neighbour graph (with component bridging) and Dijkstra on small clouds whose
-// answers can be worked out by hand or by brute force.
+// The neighbour graph (geometry/neighbour_graph.hpp), with component bridging, on small clouds
+// whose answers can be worked out by hand.
 #include "core/error.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/neighbour_graph.hpp"
-#include "geometry/shortest_paths.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <vector>
 
 using namespace treelobes;
 
@@ -30,64 +30,6 @@ void add_line(std::vector<Eigen::Vector3f>& p, const Eigen::Vector3f& a, const E
 }
 
 }  // namespace
-
-TEST(KdTree, KnnMatchesBruteForce) {
-    const auto points = random_points(2000, 1);
-    const KdTree tree(points);
-    const auto queries = random_points(50, 2);
-    std::vector<int> idx;
-    std::vector<float> d2;
-    for (const auto& q : queries) {
-        tree.knn(q, 7, idx, d2);
-        std::vector<std::pair<float, int>> all;
-        for (std::size_t i = 0; i < points.size(); ++i) all.emplace_back((points[i] - q).squaredNorm(), static_cast<int>(i));
-        std::sort(all.begin(), all.end());
-        ASSERT_EQ(idx.size(), 7u);
-        for (int k = 0; k < 7; ++k) EXPECT_FLOAT_EQ(d2[k], all[k].first);
-        EXPECT_EQ(tree.nearest(q), all[0].second);
-        tree.radius_search(q, 0.1f, idx, d2);
-        const auto inside = std::count_if(all.begin(), all.end(), [](const auto& e) { return e.first < 0.01f; });
-        EXPECT_EQ(static_cast<long>(idx.size()), inside);
-        EXPECT_TRUE(std::is_sorted(d2.begin(), d2.end()));
-    }
-}
-
-TEST(KdTree, KnnTableExcludesThePointItselfAndPadsSmallClouds) {
-    const std::vector<Eigen::Vector3f> points{{0, 0, 0}, {1, 0, 0}, {3, 0, 0}};
-    const KdTree tree(points);
-    const KnnTable table = knn_of_all_points(tree, 4);
-    EXPECT_EQ(table.row(0)[0], 1);
-    EXPECT_EQ(table.row(0)[1], 2);
-    EXPECT_EQ(table.row(0)[2], -1);  // only two other points exist
-    EXPECT_FLOAT_EQ(table.row_distances(2)[0], 4.0f);
-    const KdTree empty(std::vector<Eigen::Vector3f>{});
-    EXPECT_EQ(empty.nearest({0, 0, 0}), -1);
-}
-
-TEST(GrowingKdTree, NearestMatchesBruteForceWhileGrowing) {
-    // Points arrive in batches with queries in between, across several block merges; a
-    // duplicate of an early point must resolve to the early one.
-    const auto points = random_points(700, 4);
-    const auto queries = random_points(20, 5);
-    GrowingKdTree tree;
-    EXPECT_EQ(tree.nearest({0, 0, 0}), -1);
-    std::vector<Eigen::Vector3f> added;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        tree.add(points[i]);
-        added.push_back(points[i]);
-        if (i % 37 != 0) continue;
-        for (const auto& q : queries) {
-            int brute = 0;
-            for (std::size_t j = 1; j < added.size(); ++j)
-                if ((added[j] - q).squaredNorm() < (added[brute] - q).squaredNorm()) brute = static_cast<int>(j);
-            ASSERT_EQ(tree.nearest(q), brute) << "after " << added.size() << " points";
-        }
-    }
-    tree.add(points[3]);
-    EXPECT_EQ(tree.nearest(points[3]), 3);
-    EXPECT_EQ(tree.size(), 701u);
-    EXPECT_EQ(tree.point(3), points[3]);
-}
 
 TEST(NeighbourGraph, SymmetricSortedRowsWithPowerWeights) {
     const auto points = random_points(500, 3);
@@ -171,37 +113,4 @@ TEST(NeighbourGraph, ElongatedPieceJoinsAlongItsOwnAxis) {
     NeighbourGraphOptions bad;
     bad.direction_weight = -1.0f;
     EXPECT_THROW(build_neighbour_graph(p, bad), Error);
-}
-
-TEST(ShortestPaths, SingleSourceDistancesAndParents) {
-    // An L: 0..1 m along x then 0..1 m along y, points 0.1 m apart.
-    std::vector<Eigen::Vector3f> p;
-    add_line(p, {0, 0, 0}, {1, 0, 0}, 0.1f);
-    add_line(p, {1, 0.1f, 0}, {1, 1, 0}, 0.1f);
-    const NeighbourGraph g = build_neighbour_graph(p, {2, 2.0, 0.0f, true});
-    const std::vector<int> source{0};
-    const ShortestPaths sp = shortest_paths(g, source);
-    EXPECT_EQ(sp.parent[0], -1);
-    EXPECT_NEAR(sp.length.back(), 2.0f, 1e-4f);
-    EXPECT_NEAR(sp.cost.back(), 20 * 0.01, 1e-5);  // 20 edges of 0.1 m, weight 0.1^2
-    EXPECT_EQ(sp.order.front(), 0);
-    // Parents are settled before their children.
-    std::vector<int> rank(p.size());
-    for (std::size_t i = 0; i < sp.order.size(); ++i) rank[sp.order[i]] = static_cast<int>(i);
-    for (std::size_t v = 1; v < p.size(); ++v) EXPECT_LT(rank[sp.parent[v]], rank[v]);
-}
-
-TEST(ShortestPaths, MultiSourceSplitsBetweenSources) {
-    std::vector<Eigen::Vector3f> p;
-    add_line(p, {0, 0, 0}, {2, 0, 0}, 0.1f);  // 21 points
-    const NeighbourGraph g = build_neighbour_graph(p, {2, 1.0, 0.0f, true});
-    const std::vector<int> sources{0, 20};
-    const ShortestPaths sp = shortest_paths(g, sources);
-    for (int v = 0; v < 10; ++v) EXPECT_EQ(sp.source[v], 0);
-    for (int v = 11; v <= 20; ++v) EXPECT_EQ(sp.source[v], 1);
-    EXPECT_NEAR(sp.length[10], 1.0f, 1e-5f);
-    // Same input, same answer (the midpoint's tie is broken the same way).
-    EXPECT_EQ(shortest_paths(g, sources).source, sp.source);
-    const std::vector<int> repeated{3, 3};
-    EXPECT_THROW(shortest_paths(g, repeated), Error);
 }

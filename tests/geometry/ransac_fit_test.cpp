@@ -1,9 +1,5 @@
-// The general fits of geometry/: least-squares and RANSAC circles (ransac_fit.hpp), least-squares
-// cylinders (cylinder_fit.hpp) and disjoint sets (union_find.hpp).
-#include "geometry/cylinder_fit.hpp"
+// Least-squares and RANSAC circles (geometry/ransac_fit.hpp).
 #include "geometry/ransac_fit.hpp"
-#include "geometry/union_find.hpp"
-#include "support/synthetic_clouds.hpp"
 
 #include <gtest/gtest.h>
 
@@ -55,36 +51,4 @@ TEST(CircleFit, RansacIgnoresOutliersAndReportsCoverage) {
     EXPECT_GE(fit.inliers, 300u);
     EXPECT_GT(fit.coverage, 0.9f);
     EXPECT_FALSE(fit_circle(std::vector<Eigen::Vector2f>(points.begin(), points.begin() + 4), 0.01f, 0.05f, 0.5f).ok);
-}
-
-TEST(CylinderFit, RecoversAFullCylinderFromAPoorStart) {
-    std::vector<Eigen::Vector3d> points;
-    std::mt19937 rng(2);
-    std::vector<Eigen::Vector3f> bark;
-    test::add_cylinder(bark, {{0.1f, 0.2f, 0.0f}, {0.3f, 0.1f, 0.5f}, 0.04f}, 20000.0f, rng);
-    for (const auto& p : bark) points.push_back(p.cast<double>());
-    // Started 2 cm off the axis, tilted, with half the radius.
-    const CylinderFit fit = fit_cylinder(points, {0.12, 0.21, 0.25}, {0.3, -0.1, 1.0}, 0.02);
-    ASSERT_TRUE(fit.converged);
-    EXPECT_NEAR(fit.radius, 0.04, 0.001);
-    const Eigen::Vector3d axis = Eigen::Vector3d(0.2, -0.1, 0.5).normalized();
-    EXPECT_GT(std::abs(fit.direction.dot(axis)), std::cos(0.01));
-    const Eigen::Vector3d off = fit.point - Eigen::Vector3d(0.1, 0.2, 0.0);
-    EXPECT_LT((off - axis * off.dot(axis)).norm(), 0.001);
-    EXPECT_LT(fit.rms, 0.005);
-    EXPECT_GT(fit.arc, 340.0);
-    EXPECT_FALSE(fit_cylinder(std::vector<Eigen::Vector3d>(points.begin(), points.begin() + 5), {0, 0, 0}, {0, 0, 1}, 0.04).converged);
-}
-
-TEST(UnionFind, SetsMergeOnceAndTheLargerRootSurvives) {
-    UnionFind sets(6);
-    EXPECT_TRUE(sets.unite(0, 1));
-    EXPECT_TRUE(sets.unite(2, 1));
-    EXPECT_FALSE(sets.unite(0, 2));  // already one set
-    EXPECT_EQ(sets.set_size(2), 3);
-    EXPECT_EQ(sets.find(2), 0);      // {0, 1} was larger than {2}: its root survives
-    EXPECT_TRUE(sets.unite(4, 3));   // equal sizes: the smaller index is the root
-    EXPECT_EQ(sets.find(4), 3);
-    EXPECT_NE(sets.find(5), sets.find(0));
-    EXPECT_EQ(sets.set_size(5), 1);
 }

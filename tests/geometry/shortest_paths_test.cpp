@@ -1,0 +1,56 @@
+// Dijkstra from one or several sources (geometry/shortest_paths.hpp) on hand-checked graphs.
+#include "core/error.hpp"
+#include "geometry/neighbour_graph.hpp"
+#include "geometry/shortest_paths.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+using namespace treelobes;
+
+namespace {
+
+// Points every `step` metres from a to b (inclusive).
+void add_line(std::vector<Eigen::Vector3f>& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b, float step) {
+    const int n = static_cast<int>(std::round((b - a).norm() / step));
+    for (int i = 0; i <= n; ++i) p.push_back(a + (b - a) * (static_cast<float>(i) / static_cast<float>(n)));
+}
+
+}  // namespace
+
+TEST(ShortestPaths, SingleSourceDistancesAndParents) {
+    // An L: 0..1 m along x then 0..1 m along y, points 0.1 m apart.
+    std::vector<Eigen::Vector3f> p;
+    add_line(p, {0, 0, 0}, {1, 0, 0}, 0.1f);
+    add_line(p, {1, 0.1f, 0}, {1, 1, 0}, 0.1f);
+    const NeighbourGraph g = build_neighbour_graph(p, {2, 2.0, 0.0f, true});
+    const std::vector<int> source{0};
+    const ShortestPaths sp = shortest_paths(g, source);
+    EXPECT_EQ(sp.parent[0], -1);
+    EXPECT_NEAR(sp.length.back(), 2.0f, 1e-4f);
+    EXPECT_NEAR(sp.cost.back(), 20 * 0.01, 1e-5);  // 20 edges of 0.1 m, weight 0.1^2
+    EXPECT_EQ(sp.order.front(), 0);
+    // Parents are settled before their children.
+    std::vector<int> rank(p.size());
+    for (std::size_t i = 0; i < sp.order.size(); ++i) rank[sp.order[i]] = static_cast<int>(i);
+    for (std::size_t v = 1; v < p.size(); ++v) EXPECT_LT(rank[sp.parent[v]], rank[v]);
+}
+
+TEST(ShortestPaths, MultiSourceSplitsBetweenSources) {
+    std::vector<Eigen::Vector3f> p;
+    add_line(p, {0, 0, 0}, {2, 0, 0}, 0.1f);  // 21 points
+    const NeighbourGraph g = build_neighbour_graph(p, {2, 1.0, 0.0f, true});
+    const std::vector<int> sources{0, 20};
+    const ShortestPaths sp = shortest_paths(g, sources);
+    for (int v = 0; v < 10; ++v) EXPECT_EQ(sp.source[v], 0);
+    for (int v = 11; v <= 20; ++v) EXPECT_EQ(sp.source[v], 1);
+    EXPECT_NEAR(sp.length[10], 1.0f, 1e-5f);
+    // Same input, same answer (the midpoint's tie is broken the same way).
+    EXPECT_EQ(shortest_paths(g, sources).source, sp.source);
+    const std::vector<int> repeated{3, 3};
+    EXPECT_THROW(shortest_paths(g, repeated), Error);
+}

@@ -1,0 +1,82 @@
+// fit_trunk: circles fitted to slices of a synthetic stem of known radius give its DBH, base
+// diameter and foot; a branch leaving the stem does not count as stem.
+#include "reconstruct/trunk.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+using namespace treelobes;
+
+namespace {
+
+// A vertical stem (node 0 at the foot, node 1 at `height`) sampled as a cylinder surface of
+// radius `r` around (cx, cy): a point every 2 degrees and every centimetre.
+struct Stem {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<int> internode;
+    TreeGraph tree;
+};
+
+Stem stem(float r, float height, float cx = 0.0f, float cy = 0.0f) {
+    Stem s;
+    s.tree.add_node({cx, cy, 0.0f}, 0.0f, -1);
+    s.tree.add_node({cx, cy, height}, 0.0f, 0);
+    for (float z = 0.0f; z <= height; z += 0.01f)
+        for (int a = 0; a < 180; ++a) {
+            const float t = static_cast<float>(a) * 2.0f * std::numbers::pi_v<float> / 180.0f;
+            s.points.push_back({cx + r * std::cos(t), cy + r * std::sin(t), z});
+            s.internode.push_back(1);
+        }
+    return s;
+}
+
+}  // namespace
+
+TEST(Trunk, DiametersOfACylinderAreTwiceItsRadius) {
+    const Stem s = stem(0.15f, 3.0f, 2.0f, -1.0f);
+    const TrunkFit fit = fit_trunk(s.points, s.internode, s.tree);
+    ASSERT_TRUE(fit.dbh_fitted);
+    EXPECT_NEAR(fit.dbh, 0.30f, 0.005f);
+    ASSERT_TRUE(fit.base_fitted);
+    EXPECT_NEAR(fit.base_diameter, 0.30f, 0.005f);
+    ASSERT_TRUE(fit.foot_fitted);
+    EXPECT_NEAR(fit.foot_centre.x(), 2.0f, 0.01f);
+    EXPECT_NEAR(fit.foot_centre.y(), -1.0f, 0.01f);
+    ASSERT_FALSE(fit.slices.empty());
+    for (const StemSlice& slice : fit.slices) EXPECT_TRUE(slice.good) << "slice at " << slice.height << " m";
+}
+
+TEST(Trunk, PointsOffTheMainAxisAreNotStem) {
+    // A thin side branch (node 2) at breast height: its points belong to another internode and
+    // must not widen the breast-height circle.
+    Stem s = stem(0.10f, 3.0f);
+    s.tree.add_node({1.0f, 0.0f, 1.3f}, 0.0f, 0);
+    for (float x = 0.10f; x <= 1.0f; x += 0.005f)
+        for (int a = 0; a < 36; ++a) {
+            const float t = static_cast<float>(a) * 2.0f * std::numbers::pi_v<float> / 36.0f;
+            s.points.push_back({x, 0.02f * std::cos(t), 1.3f + 0.02f * std::sin(t)});
+            s.internode.push_back(2);
+        }
+    const TrunkFit fit = fit_trunk(s.points, s.internode, s.tree);
+    ASSERT_TRUE(fit.dbh_fitted);
+    EXPECT_NEAR(fit.dbh, 0.20f, 0.005f);
+}
+
+TEST(Trunk, APartialArcIsNotTrusted) {
+    // Only a 60-degree arc of the stem was seen: below min_coverage, no slice is good.
+    Stem s;
+    s.tree.add_node({0, 0, 0}, 0.0f, -1);
+    s.tree.add_node({0, 0, 3}, 0.0f, 0);
+    for (float z = 0.0f; z <= 3.0f; z += 0.01f)
+        for (int a = 0; a < 30; ++a) {
+            const float t = static_cast<float>(a) * 2.0f * std::numbers::pi_v<float> / 180.0f;
+            s.points.push_back({0.2f * std::cos(t), 0.2f * std::sin(t), z});
+            s.internode.push_back(1);
+        }
+    const TrunkFit fit = fit_trunk(s.points, s.internode, s.tree);
+    EXPECT_FALSE(fit.dbh_fitted);
+    EXPECT_FALSE(fit.base_fitted);
+}
