@@ -45,8 +45,7 @@ struct BatchCliOptions {
 };
 
 bool has_option(const std::vector<std::string>& arguments, const std::string& name) {
-    return std::any_of(arguments.begin(), arguments.end(),
-                       [&](const std::string& a) { return a == name || a.rfind(name + "=", 0) == 0; });
+    return std::any_of(arguments.begin(), arguments.end(), [&](const std::string& a) { return a == name || a.rfind(name + "=", 0) == 0; });
 }
 
 // The tile options of every run: the user's, and with --buffer the batch's tiles as neighbours.
@@ -136,7 +135,8 @@ struct TileResult {
 };
 
 // One tile inside its error boundary (the tile refuses itself when its header says it would not fit).
-TileResult process_tile(const fs::path& input, const fs::path& dir, const std::vector<std::string>& arguments, const GlobalOptions& global) {
+TileResult process_tile(const fs::path& input, const fs::path& dir, const std::vector<std::string>& arguments,
+                        const GlobalOptions& global) {
     try {
         return {run_one_tile(input, dir, arguments, global), {}};
     } catch (const Error& e) {
@@ -209,8 +209,8 @@ int run_batch(BatchCliOptions& o, const OptionTable& table, const GlobalOptions&
     if (global.json) {
         std::cout << summary.dump(2) << "\n";
     } else {
-        std::printf("batch %s: %zu of %zu tiles%s: %zu done, %zu finished earlier (skipped), %zu failed%s\n", o.source.c_str(), tiles.size(),
-                    all.size(), o.shard.empty() ? "" : (" (shard " + o.shard + ")").c_str(), done, skipped, failures.size(),
+        std::printf("batch %s: %zu of %zu tiles%s: %zu done, %zu finished earlier (skipped), %zu failed%s\n", o.source.c_str(),
+                    tiles.size(), all.size(), o.shard.empty() ? "" : (" (shard " + o.shard + ")").c_str(), done, skipped, failures.size(),
                     failures.empty() ? "" : (" (" + failures_path.string() + ")").c_str());
     }
     return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
@@ -221,15 +221,17 @@ int run_batch(BatchCliOptions& o, const OptionTable& table, const GlobalOptions&
 void add_batch_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<BatchCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "batch", "The tile pipeline over many tiles: one folder per tile, resumable, shardable for Slurm arrays and GNU parallel "
-                 "(docs/survey.md). Options after the source that batch does not know are passed to every `tile` run");
+            "batch",
+            "The tile pipeline over many tiles: one folder per tile, resumable, shardable for Slurm arrays and GNU parallel "
+            "(docs/survey.md). Options after the source that batch does not know are passed to every `tile` run");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("source", o->source, "The tiles: a folder, a quoted pattern (\"tiles/*.las\") or a list file (one path per line)")
-        ->required();
+            ->required();
     table->add("--out", o->out, "Output folder: one subfolder per tile, named after the tile's file")->required();
     table->add("--shard", o->shard, "Run only shard i of n (0 <= i < n): every n-th tile of the sorted list, starting at i");
     table->add("--max-memory", o->max_memory,
-               "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM); passed to every `tile` run");
+               "Refuse a tile whose header point count needs more memory than this (e.g. 8G; default: half of the RAM); passed to every "
+               "`tile` run");
     table->add_flag("--overwrite", o->overwrite, "Redo tiles that an earlier run finished");
     sub->allow_extras();
     sub->fallthrough(false);  // unknown options are the tile's, not the main command's

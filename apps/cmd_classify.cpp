@@ -43,8 +43,10 @@ std::string format(const char* pattern, double value) {
 }
 
 void print(const json& summary, const GlobalOptions& global, const std::string& human) {
-    if (global.json) std::cout << summary.dump(2) << "\n";
-    else std::cout << human;
+    if (global.json)
+        std::cout << summary.dump(2) << "\n";
+    else
+        std::cout << human;
 }
 
 // failures.jsonl beside `out` (DESIGN.md: one JSON object per failure with the reason).
@@ -108,16 +110,22 @@ int run_features(const FeaturesCommand& c, const OptionTable& option_table, cons
     if (batch.table.rows() == 0) throw Error::input(c.inputs.front(), "no tree gave features (" + batch.failures.front().reason + ")");
     write_feature_csv(batch.table, c.out);
     if (!batch.failures.empty()) write_failures(batch.failures, fs::absolute(c.out));
-    const json summary = {{"command", "classify features"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"trees", batch.table.rows()},
-                          {"features", batch.table.cols()},  {"failed", batch.failures.size()}, {"points", batch.points},
-                          {"seconds", batch.seconds},        {"feature_seconds_per_tree", batch.feature_seconds / batch.table.rows()},
+    const json summary = {{"command", "classify features"},
+                          {"treelobes", kVersion},
+                          {"options", option_table.json()},
+                          {"trees", batch.table.rows()},
+                          {"features", batch.table.cols()},
+                          {"failed", batch.failures.size()},
+                          {"points", batch.points},
+                          {"seconds", batch.seconds},
+                          {"feature_seconds_per_tree", batch.feature_seconds / batch.table.rows()},
                           {"cpu_seconds_per_tree", batch.cpu_seconds / batch.table.rows()},
                           {"removed", json::parse(crown_counts_json(batch.crowns))},
                           {"out", c.out}};
     print(summary, global,
           std::to_string(batch.table.rows()) + " trees x " + std::to_string(batch.table.cols()) + " features -> " + c.out +
-              (batch.failures.empty() ? "" : " (" + std::to_string(batch.failures.size()) + " failed, see failures.jsonl)") +
-              format(" (%.1f s)\n", batch.seconds) + removed_line(summary["removed"]));
+                  (batch.failures.empty() ? "" : " (" + std::to_string(batch.failures.size()) + " failed, see failures.jsonl)") +
+                  format(" (%.1f s)\n", batch.seconds) + removed_line(summary["removed"]));
     return batch.failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
 }
 
@@ -143,23 +151,33 @@ int run_train(const TrainCommand& c, const OptionTable& option_table, const Glob
         correct += std::max_element(p.begin(), p.end()) - p.begin() == set.labels[r];
     }
     const double accuracy = static_cast<double>(correct) / static_cast<double>(table.rows());
-    json summary = {{"command", "classify train"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"trees", table.rows()},
-                          {"features", table.cols()},    {"classes", set.classes}, {"rounds", report.rounds},
-                          {"rounds_tried", report.rounds_tried}, {"temperature", report.temperature}, {"training_accuracy", accuracy}, {"seconds", seconds},
-                          {"out", c.out}};
+    json summary = {{"command", "classify train"},
+                    {"treelobes", kVersion},
+                    {"options", option_table.json()},
+                    {"trees", table.rows()},
+                    {"features", table.cols()},
+                    {"classes", set.classes},
+                    {"rounds", report.rounds},
+                    {"rounds_tried", report.rounds_tried},
+                    {"temperature", report.temperature},
+                    {"training_accuracy", accuracy},
+                    {"seconds", seconds},
+                    {"out", c.out}};
     std::string routing;
     if (model.routed()) {
-        summary["scan_routing"] = {{"feature", model.feature_names[model.route_feature]}, {"threshold", model.route_threshold},
-                                   {"sparse_classes", model.parts[0].classes.size()}, {"dense_classes", model.parts[1].classes.size()}};
-        routing = "  one model per scan kind: " + model.feature_names[model.route_feature] +
-                  format(" <= %.1f", model.route_threshold) + " (sparse: " + std::to_string(report.parts[0].rounds) + " rounds), above (dense: " +
-                  std::to_string(report.parts[1].rounds) + " rounds)\n";
+        summary["scan_routing"] = {{"feature", model.feature_names[model.route_feature]},
+                                   {"threshold", model.route_threshold},
+                                   {"sparse_classes", model.parts[0].classes.size()},
+                                   {"dense_classes", model.parts[1].classes.size()}};
+        routing = "  one model per scan kind: " + model.feature_names[model.route_feature] + format(" <= %.1f", model.route_threshold) +
+                  " (sparse: " + std::to_string(report.parts[0].rounds) +
+                  " rounds), above (dense: " + std::to_string(report.parts[1].rounds) + " rounds)\n";
     }
     print(summary, global,
           "JointBoost: " + std::to_string(table.rows()) + " trees, " + std::to_string(set.classes.size()) + " species, " +
-              std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " rounds (early stop after " +
-              std::to_string(report.rounds_tried) + format(", temperature %.2f", report.temperature) + "), training accuracy " + format("%.1f %%", 100 * accuracy) + " -> " + c.out +
-              format(" (%.2f s)\n", seconds) + routing);
+                  std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " rounds (early stop after " +
+                  std::to_string(report.rounds_tried) + format(", temperature %.2f", report.temperature) + "), training accuracy " +
+                  format("%.1f %%", 100 * accuracy) + " -> " + c.out + format(" (%.2f s)\n", seconds) + routing);
     return 0;
 }
 
@@ -232,10 +250,11 @@ int run_predict(const PredictCommand& c, const OptionTable& option_table, const 
     }
     if (!c.out.empty()) write_file_atomically(c.out, csv);
     if (!failures.empty()) write_failures(failures, fs::absolute(c.out.empty() ? std::string("predictions.csv") : c.out));
-    const json summary = {{"command", "classify predict"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"trees", trees}, {"confident", confident},
-                          {"changed_by_vote", changed},    {"failed", failures.size()}, {"out", c.out}};
+    const json summary = {{"command", "classify predict"}, {"treelobes", kVersion},      {"options", option_table.json()}, {"trees", trees},
+                          {"confident", confident},        {"changed_by_vote", changed}, {"failed", failures.size()},      {"out", c.out}};
     std::string human;
-    if (c.out.empty()) human = csv;
+    if (c.out.empty())
+        human = csv;
     else {
         human = std::to_string(table.rows()) + " trees classified (" + std::to_string(confident) + " confident";
         if (c.vote) human += ", " + std::to_string(changed) + " changed by spatial voting";
@@ -251,13 +270,13 @@ struct EvaluateCommand {
     std::vector<std::string> datasets;
     std::string train_dataset, test_dataset;  // --train / --test: one experiment instead of random splits
     bool no_class_weights = false;
-    std::string level = "species";            // or "genus": train and test on genus labels
-    std::vector<std::string> groups;          // feature groups the classifiers see (empty: all)
+    std::string level = "species";    // or "genus": train and test on genus labels
+    std::vector<std::string> groups;  // feature groups the classifiers see (empty: all)
     std::string out;
-    std::string features;       // reuse a feature table instead of computing it
+    std::string features;  // reuse a feature table instead of computing it
     bool no_xgboost = false;
     bool no_site_split = false;
-    std::string layout;         // "", "grouped" or "mixed": planting positions for voting
+    std::string layout;  // "", "grouped" or "mixed": planting positions for voting
     double spacing = 8.0;
     EvaluationOptions options;
     JointBoostOptions jointboost;
@@ -283,8 +302,7 @@ void discover(const fs::path& dir, const std::string& prefix, std::vector<BatchI
         for (const auto& entry : fs::directory_iterator(dir))
             if (entry.is_directory() && fs::exists(entry.path() / "truth.csv")) tiles.push_back(entry.path());
     std::sort(tiles.begin(), tiles.end());
-    if (tiles.empty())
-        throw Error::input(dir.string(), "neither a dataset (labels.csv) nor tiles (folders with truth.csv and tile.las)");
+    if (tiles.empty()) throw Error::input(dir.string(), "neither a dataset (labels.csv) nor tiles (folders with truth.csv and tile.las)");
     for (const auto& tile : tiles) {
         const fs::path cloud = fs::exists(tile / "tile.las") ? tile / "tile.las" : tile / "tile.ply";
         const std::string group = prefix + (tile == dir ? dir.filename().string() : tile.filename().string());
@@ -315,8 +333,8 @@ FeatureTable only_groups(const FeatureTable& table, const std::vector<std::strin
 }
 
 NamedClassifier jointboost_classifier(const JointBoostOptions& base) {
-    return {"JointBoost", [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test,
-                                 std::uint64_t seed) {
+    return {"JointBoost",
+            [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test, std::uint64_t seed) {
                 JointBoostOptions o = base;
                 o.seed = seed;
                 std::vector<std::string> names;
@@ -335,8 +353,8 @@ NamedClassifier jointboost_classifier(const JointBoostOptions& base) {
 }
 
 NamedClassifier xgboost_classifier(const XGBoostOptions& base) {
-    return {"XGBoost", [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test,
-                              std::uint64_t seed) {
+    return {"XGBoost",
+            [base](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test, std::uint64_t seed) {
                 XGBoostOptions o = base;
                 o.seed = seed;
                 XGBoostRun x = xgboost_train_predict(train, y, classes, test, o);
@@ -360,15 +378,18 @@ int run_evaluate(const EvaluateCommand& c, const OptionTable& option_table, cons
     // Ids carry the dataset folder's name when there are several folders (train/ and test/ with --train/--test).
     for (std::size_t k = 0; k < datasets.size(); ++k) {
         std::string prefix;
-        if (transfer) prefix = k == 0 ? "train/" : "test/";
-        else if (datasets.size() > 1) prefix = fs::path(datasets[k]).lexically_normal().filename().string() + "/";
+        if (transfer)
+            prefix = k == 0 ? "train/" : "test/";
+        else if (datasets.size() > 1)
+            prefix = fs::path(datasets[k]).lexically_normal().filename().string() + "/";
         discover(datasets[k], prefix, inputs, labels);
     }
     // Dataset folders that are not tiles have no site groups of their own.
     FeatureTable table;
     std::vector<BatchFailure> failures;
-    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion}, {"options", option_table.json()}, {"datasets", datasets}, {"baseline", xgboost_version()},
-                  {"class_weights", c.no_class_weights ? "none" : "balanced"}};
+    json extra = {{"command", "classify evaluate"}, {"treelobes", kVersion},
+                  {"options", option_table.json()}, {"datasets", datasets},
+                  {"baseline", xgboost_version()},  {"class_weights", c.no_class_weights ? "none" : "balanced"}};
     if (!c.features.empty()) {
         table = read_feature_csv(c.features);
         extra["features_file"] = c.features;
@@ -390,8 +411,8 @@ int run_evaluate(const EvaluateCommand& c, const OptionTable& option_table, cons
     if (c.level == "genus")
         for (auto& l : labels) {
             if (l.scientific_name.empty())
-                throw Error::input(datasets.front(), "--level genus needs a scientific_name (or genus) column in labels.csv; tree '" +
-                                                         l.id + "' has none");
+                throw Error::input(datasets.front(),
+                                   "--level genus needs a scientific_name (or genus) column in labels.csv; tree '" + l.id + "' has none");
             l.species = genus_of(l.scientific_name);
         }
     extra["level"] = c.level;
@@ -434,7 +455,8 @@ int run_evaluate(const EvaluateCommand& c, const OptionTable& option_table, cons
         for (auto r : test_rows)
             if (!trained.count(set.classes[set.labels[r]])) untrained.insert(set.classes[set.labels[r]]);
         extra["test_species_not_trained"] = untrained;
-        if (!untrained.empty()) log_warn("species of the test set that the training set lacks (always wrong): " + std::to_string(untrained.size()));
+        if (!untrained.empty())
+            log_warn("species of the test set that the training set lacks (always wrong): " + std::to_string(untrained.size()));
     } else {
         report = evaluate(set, classifiers, options);
     }
@@ -445,14 +467,15 @@ int run_evaluate(const EvaluateCommand& c, const OptionTable& option_table, cons
     json summary = json::parse(read_file(fs::path(c.out) / "summary.json"));
     print(summary, global,
           report_summary(report) + (extra.contains("removed") ? "\n" + removed_line(extra["removed"]) : std::string()) + "\nreport -> " +
-              c.out + "\n");
+                  c.out + "\n");
     return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
 }
 
 }  // namespace
 
 void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) {
-    CLI::App* classify = app.add_subcommand("classify", "Species classification: features, JointBoost, evaluation (Livny et al. 2011, §6.1)");
+    CLI::App* classify =
+            app.add_subcommand("classify", "Species classification: features, JointBoost, evaluation (Livny et al. 2011, §6.1)");
     classify->require_subcommand(1);
 
     auto features = std::make_shared<FeaturesCommand>();
@@ -462,7 +485,9 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     features_table->add("--out,-o", features->out, "Output CSV");
     features_table->add_flag("--list", features->list, "Print the feature catalogue (docs/features.md) and exit");
     add_feature_flags(*features_table, features->flags);
-    f->callback([features, features_table, &global, &job] { job = [features, features_table, &global] { return run_features(*features, *features_table, global); }; });
+    f->callback([features, features_table, &global, &job] {
+        job = [features, features_table, &global] { return run_features(*features, *features_table, global); };
+    });
 
     auto train = std::make_shared<TrainCommand>();
     CLI::App* t = classify->add_subcommand("train", "Train a JointBoost model from features.csv and labels.csv");
@@ -472,7 +497,7 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     train_table->add("--out,-o", train->out, "Model file")->required();
     train_table->add("--max-rounds", train->options.max_rounds, "Maximum boosting rounds")->check(CLI::Range(1, 100000));
     train_table->add("--folds", train->options.folds, "Cross-validation folds for early stopping and calibration (0 = off)")
-        ->check(CLI::Range(0, 20));
+            ->check(CLI::Range(0, 20));
     train_table->add("--patience", train->options.patience, "Rounds without improvement before stopping")->check(cli::NonNegativeNumber);
     train_table->add("--seed", train->options.seed, "Seed of the cross-validation folds");
     train_table->add_flag("--no-calibration{false}", train->options.calibrate,
@@ -485,7 +510,9 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
                           "The fold ensemble averages its members' scores H instead of their probabilities");
     train_table->add_flag("--no-class-weights{false}", train->options.balance_classes,
                           "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
-    t->callback([train, train_table, &global, &job] { job = [train, train_table, &global] { return run_train(*train, *train_table, global); }; });
+    t->callback([train, train_table, &global, &job] {
+        job = [train, train_table, &global] { return run_train(*train, *train_table, global); };
+    });
 
     auto predict = std::make_shared<PredictCommand>();
     CLI::App* p = classify->add_subcommand("predict", "Species of trees (point clouds or a feature table), optional spatial voting");
@@ -494,12 +521,13 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     p->add_option("inputs", predict->inputs, "Point clouds or one features.csv")->required();
     predict_table->add("--positions", predict->positions, "CSV with id, x, y (default for clouds: the mean of their points)");
     predict_table->add_flag("--vote", predict->vote, "Spatial voting among the trees given");
-    predict_table->add("--confidence", predict->voting.confidence_factor, "Confident when h1 > factor * h2")
-        ->check(CLI::Range(1.0, 100.0));
+    predict_table->add("--confidence", predict->voting.confidence_factor, "Confident when h1 > factor * h2")->check(CLI::Range(1.0, 100.0));
     predict_table->add("--radius", predict->voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber);
     predict_table->add("--out,-o", predict->out, "predictions.csv (default: print the table)");
     add_feature_flags(*predict_table, predict->flags);
-    p->callback([predict, predict_table, &global, &job] { job = [predict, predict_table, &global] { return run_predict(*predict, *predict_table, global); }; });
+    p->callback([predict, predict_table, &global, &job] {
+        job = [predict, predict_table, &global] { return run_predict(*predict, *predict_table, global); };
+    });
 
     auto evaluate = std::make_shared<EvaluateCommand>();
     CLI::App* e = classify->add_subcommand("evaluate", "The paper's protocol (50/50 splits), site split, voting, XGBoost baseline");
@@ -507,14 +535,16 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     e->add_option("datasets", evaluate->datasets, "`synth dataset` folders (labels.csv) or folders of `synth tile` outputs");
     evaluate_table->add("--train", evaluate->train_dataset, "Train on this dataset folder (with --test: one experiment, no random splits)");
     evaluate_table->add("--test", evaluate->test_dataset, "Test on this dataset folder (with --train)");
-    evaluate_table->add("--groups", evaluate->groups,
-                        "Feature groups the classifiers see (default all; e.g. --groups airborne for sparse airborne crowns)")
-        ->delimiter(',');
+    evaluate_table
+            ->add("--groups", evaluate->groups,
+                  "Feature groups the classifiers see (default all; e.g. --groups airborne for sparse airborne crowns)")
+            ->delimiter(',');
     evaluate_table->add("--train-fraction", evaluate->options.train_fraction, "Share of each species that trains in a random split")
-        ->check(CLI::Range(0.05, 0.95));
-    evaluate_table->add("--level", evaluate->level,
-                        "Classes to train and test: species, or genus (the first word of labels.csv's scientific_name)")
-        ->check(CLI::IsMember({"species", "genus"}));
+            ->check(CLI::Range(0.05, 0.95));
+    evaluate_table
+            ->add("--level", evaluate->level,
+                  "Classes to train and test: species, or genus (the first word of labels.csv's scientific_name)")
+            ->check(CLI::IsMember({"species", "genus"}));
     evaluate_table->add_flag("--no-class-weights", evaluate->no_class_weights,
                              "Every tree weighs 1 (default: N / (K n_species), so that rare species count as much as common ones)");
     evaluate_table->add("--out,-o", evaluate->out, "Report folder")->required();
@@ -522,35 +552,40 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job) 
     evaluate_table->add("--seed", evaluate->options.seed, "Seed of the splits");
     evaluate_table->add("--features", evaluate->features, "Reuse a feature table (e.g. report/features.csv of an earlier run)");
     evaluate_table->add("--confidence", evaluate->options.voting.confidence_factor, "Confident when h1 > factor * h2")
-        ->check(CLI::Range(1.0, 100.0));
+            ->check(CLI::Range(1.0, 100.0));
     evaluate_table->add("--radius", evaluate->options.voting.radius_m, "Voting neighbourhood, m")->check(cli::NonNegativeNumber);
     evaluate_table->add("--max-rounds", evaluate->jointboost.max_rounds, "JointBoost maximum rounds")->check(CLI::Range(1, 100000));
-    evaluate_table->add("--folds", evaluate->jointboost.folds,
-                        "JointBoost: cross-validation folds on the training half for early stopping and calibration (0 = off)")
-        ->check(CLI::Range(0, 20));
+    evaluate_table
+            ->add("--folds", evaluate->jointboost.folds,
+                  "JointBoost: cross-validation folds on the training half for early stopping and calibration (0 = off)")
+            ->check(CLI::Range(0, 20));
     evaluate_table->add("--patience", evaluate->jointboost.patience, "JointBoost: rounds without improvement before stopping")
-        ->check(cli::NonNegativeNumber);
+            ->check(cli::NonNegativeNumber);
     evaluate_table->add_flag("--no-calibration{false}", evaluate->jointboost.calibrate,
                              "JointBoost: keep the probability temperature at 1 instead of fitting it out of fold");
     evaluate_table->add_flag("--no-scan-routing{false}", evaluate->jointboost.route_by_scan,
                              "JointBoost: one model for all trees instead of one per scan kind (told apart by scan_point_density)");
-    evaluate_table->add("--settled-logloss", evaluate->jointboost.settled_logloss,
-                        "JointBoost: stop when every out-of-fold tree is right at a mean log-loss below this (0 = off)")
-        ->check(cli::NonNegativeNumber);
-    evaluate_table->add_flag("--refit{false}", evaluate->jointboost.fold_ensemble,
-                             "JointBoost: boost the final model again on all training trees instead of averaging the cross-validation runs");
+    evaluate_table
+            ->add("--settled-logloss", evaluate->jointboost.settled_logloss,
+                  "JointBoost: stop when every out-of-fold tree is right at a mean log-loss below this (0 = off)")
+            ->check(cli::NonNegativeNumber);
+    evaluate_table->add_flag(
+            "--refit{false}", evaluate->jointboost.fold_ensemble,
+            "JointBoost: boost the final model again on all training trees instead of averaging the cross-validation runs");
     evaluate_table->add_flag("--average-scores{false}", evaluate->jointboost.average_probabilities,
                              "JointBoost: the fold ensemble averages its members' scores H instead of their probabilities");
-    evaluate_table->add("--layout", evaluate->layout,
-                        "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
-                        "replaces the dataset's positions")
-        ->check(CLI::IsMember({"grouped", "mixed"}));
-    evaluate_table->add("--spacing", evaluate->spacing, "Distance between planted trees, m (with --layout)")
-        ->check(cli::PositiveNumber);
+    evaluate_table
+            ->add("--layout", evaluate->layout,
+                  "Plant the trees for spatial voting: grouped (one street per species) or mixed (random grid); "
+                  "replaces the dataset's positions")
+            ->check(CLI::IsMember({"grouped", "mixed"}));
+    evaluate_table->add("--spacing", evaluate->spacing, "Distance between planted trees, m (with --layout)")->check(cli::PositiveNumber);
     evaluate_table->add_flag("--no-xgboost", evaluate->no_xgboost, "Skip the XGBoost baseline");
     evaluate_table->add_flag("--no-site-split", evaluate->no_site_split, "Skip the leave-one-site-out split");
     add_feature_flags(*evaluate_table, evaluate->flags);
-    e->callback([evaluate, evaluate_table, &global, &job] { job = [evaluate, evaluate_table, &global] { return run_evaluate(*evaluate, *evaluate_table, global); }; });
+    e->callback([evaluate, evaluate_table, &global, &job] {
+        job = [evaluate, evaluate_table, &global] { return run_evaluate(*evaluate, *evaluate_table, global); };
+    });
 }
 
 }  // namespace treelobes::cli

@@ -45,11 +45,10 @@ ConvertResult copy_records(const std::filesystem::path& input, const std::filesy
     write_las_records(records, output);
     return {static_cast<std::size_t>(records.point_count), "records",
             std::string(records.compressed ? "LAZ" : "LAS") + " 1." + std::to_string(records.minor) + ", point format " +
-                std::to_string(records.point_format)};
+                    std::to_string(records.point_format)};
 }
 
-ConvertResult convert_cloud(const std::filesystem::path& input, const std::filesystem::path& output,
-                            const std::optional<Box3d>& bounds) {
+ConvertResult convert_cloud(const std::filesystem::path& input, const std::filesystem::path& output, const std::optional<Box3d>& bounds) {
     CloudReadOptions options;
     options.bounds = bounds;
     const PointCloud cloud = read_point_cloud(input, options);
@@ -71,21 +70,18 @@ int run_convert(const ConvertOptions& options, const OptionTable& table, const G
 
     const std::string in_ext = file_extension(input);
     const bool las_input = in_ext == "las" || in_ext == "laz" || (std::filesystem::is_regular_file(input, ec) && starts_with_lasf(input));
-    const ConvertResult result = las_input && out_ext == "las" && !bounds ? copy_records(input, output)
-                                                                          : convert_cloud(input, output, bounds);
+    const ConvertResult result =
+            las_input && out_ext == "las" && !bounds ? copy_records(input, output) : convert_cloud(input, output, bounds);
     if (global.json) {
-        std::cout << nlohmann::json{{"treelobes", kVersion},
-                                    {"input", options.input},
-                                    {"options", table.json()},
-                                    {"input_format", result.input_format},
-                                    {"output", options.out},
-                                    {"points", result.points},
+        std::cout << nlohmann::json{{"treelobes", kVersion},   {"input", options.input},
+                                    {"options", table.json()}, {"input_format", result.input_format},
+                                    {"output", options.out},   {"points", result.points},
                                     {"method", result.method}}
-                         .dump(2)
+                             .dump(2)
                   << "\n";
     } else {
-        std::cout << options.input << " (" << result.input_format << ") -> " << options.out << ": " << result.points
-                  << " points" << (result.method == "records" ? ", point records copied verbatim" : "") << "\n";
+        std::cout << options.input << " (" << result.input_format << ") -> " << options.out << ": " << result.points << " points"
+                  << (result.method == "records" ? ", point records copied verbatim" : "") << "\n";
     }
     return 0;
 }
@@ -94,13 +90,12 @@ int run_convert(const ConvertOptions& options, const OptionTable& table, const G
 
 void add_convert_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<ConvertOptions>();
-    CLI::App* sub = app.add_subcommand(
-        "convert", "Convert a point cloud (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV) to LAS, PLY, PCD or XYZ/CSV; LAZ to LAS "
-                   "gives the uncompressed file record for record");
+    CLI::App* sub = app.add_subcommand("convert",
+                                       "Convert a point cloud (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV) to LAS, PLY, PCD or XYZ/CSV; LAZ to LAS "
+                                       "gives the uncompressed file record for record");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", options->input, "Point cloud to read")->required();
-    table->add("--out", options->out, "Output file; its extension picks the format (.las .ply .pcd .xyz .txt .csv)")
-        ->required();
+    table->add("--out", options->out, "Output file; its extension picks the format (.las .ply .pcd .xyz .txt .csv)")->required();
     table->add("--bounds", options->bounds,
                "Keep only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); COPC files "
                "read only the octree nodes that meet the box");

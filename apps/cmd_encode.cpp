@@ -104,9 +104,8 @@ EncodeOptions encode_options_of(const EncodeCliOptions& options, const std::opti
     if (!options.resolution_given && !recorded)
         throw Error::usage("--resolution is required: " + options.skeleton + " records no chain-code resolution");
     encode_options.resolution = options.resolution_given ? options.resolution : recorded->resolution;
-    encode_options.internode_length = options.internode_length_given || !recorded
-                                          ? parse_internode_length(options.internode_length)
-                                          : recorded->internode_length;
+    encode_options.internode_length =
+            options.internode_length_given || !recorded ? parse_internode_length(options.internode_length) : recorded->internode_length;
     encode_options.radius_unit = options.radius_unit_given || !recorded ? options.radius_unit : recorded->radius_unit;
     encode_options.kind = options.f6 ? CodeKind::F6 : CodeKind::DBF6;
     return encode_options;
@@ -173,7 +172,8 @@ int run_encode_file(const EncodeCliOptions& options, const OptionTable& table, c
     const std::size_t internodes = stored.lods[0].radii.size();
     const std::size_t raw = 16 * internodes;  // Strnad et al. 2020, Table 5: 16 bytes per internode
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
+        nlohmann::json j = {{"treelobes", kVersion},
+                            {"options", table.json()},
                             {"input", options.skeleton},
                             {"out", options.out},
                             {"kind", code_kind_name(stored.kind)},
@@ -190,8 +190,8 @@ int run_encode_file(const EncodeCliOptions& options, const OptionTable& table, c
         return 0;
     }
     std::cout << "wrote " << options.out << ": " << bytes.size() << " bytes for " << internodes << " internodes ("
-              << coder_name(stored.coder) << " coder, " << stored.lods.size() << " LOD" << (stored.lods.size() > 1 ? "s" : "")
-              << ", " << static_cast<double>(raw) / static_cast<double>(bytes.size()) << "x smaller than 16 bytes per internode)\n";
+              << coder_name(stored.coder) << " coder, " << stored.lods.size() << " LOD" << (stored.lods.size() > 1 ? "s" : "") << ", "
+              << static_cast<double>(raw) / static_cast<double>(bytes.size()) << "x smaller than 16 bytes per internode)\n";
     if (options.stats) print_lod_stats(stored, sizes);
     return 0;
 }
@@ -268,10 +268,10 @@ int run_encode_forest(const EncodeCliOptions& options, const OptionTable& table,
     std::size_t internodes = 0;
     for (const auto& tree : stats.trees) internodes += tree.empty() ? 0 : tree[0].internodes;
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()}, {"input", options.forest},         {"out", options.out},
-                            {"trees", trees.size()},     {"internodes", internodes},        {"file_bytes", bytes.size()},
-                            {"raw_bytes", 16 * internodes}, {"index_bytes", stats.header_and_index},
-                            {"coder", options.coder},    {"lods", options.lods},            {"resolution", options.resolution}};
+        nlohmann::json j = {{"treelobes", kVersion},      {"options", table.json()},      {"input", options.forest},
+                            {"out", options.out},         {"trees", trees.size()},        {"internodes", internodes},
+                            {"file_bytes", bytes.size()}, {"raw_bytes", 16 * internodes}, {"index_bytes", stats.header_and_index},
+                            {"coder", options.coder},     {"lods", options.lods},         {"resolution", options.resolution}};
         if (options.stats) {
             j["tree_stats"] = nlohmann::json::array();
             for (std::size_t i = 0; i < trees.size(); ++i) {
@@ -287,14 +287,14 @@ int run_encode_forest(const EncodeCliOptions& options, const OptionTable& table,
         std::cout << j.dump(2) << "\n";
         return 0;
     }
-    std::cout << "wrote " << options.out << ": " << trees.size() << " trees, " << internodes << " internodes, "
-              << bytes.size() << " bytes (header and index " << stats.header_and_index << ")\n";
+    std::cout << "wrote " << options.out << ": " << trees.size() << " trees, " << internodes << " internodes, " << bytes.size()
+              << " bytes (header and index " << stats.header_and_index << ")\n";
     if (options.stats)
         for (std::size_t i = 0; i < trees.size(); ++i) {
             std::size_t total = 0;
             for (const StreamSizes& s : stats.trees[i]) total += s.symbols + s.radii;
-            std::cout << "  " << i << " " << trees[i].name << ": " << stats.trees[i][0].internodes << " internodes, "
-                      << total << " bytes of streams\n";
+            std::cout << "  " << i << " " << trees[i].name << ": " << stats.trees[i][0].internodes << " internodes, " << total
+                      << " bytes of streams\n";
         }
     return 0;
 }
@@ -312,7 +312,8 @@ int run_encode(const EncodeCliOptions& options, const OptionTable& table, const 
     const std::size_t dbf6_length = write_symbols(encoded.internodes, CodeKind::DBF6).size();
     const double bound = std::sqrt(3.0) * encoded.geometry.voxel_size / 2.0;
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
+        nlohmann::json j = {{"treelobes", kVersion},
+                            {"options", table.json()},
                             {"input", options.skeleton},
                             {"kind", code_kind_name(encode_options.kind)},
                             {"resolution", encoded.resolution},
@@ -335,13 +336,12 @@ int run_encode(const EncodeCliOptions& options, const OptionTable& table, const 
         return 0;
     }
     std::ostringstream summary;
-    summary << options.skeleton << ": " << code_kind_name(encode_options.kind) << " code of " << counts.internodes
-            << " internodes (" << counts.forks << " forks, " << counts.tips << " tips), " << encoded.code.symbols.size()
-            << " symbols; F6 " << f6_length << ", DBF6 " << dbf6_length << " (DBF6/F6 "
-            << (f6_length ? static_cast<double>(dbf6_length) / f6_length : 0.0) << ")\n"
+    summary << options.skeleton << ": " << code_kind_name(encode_options.kind) << " code of " << counts.internodes << " internodes ("
+            << counts.forks << " forks, " << counts.tips << " tips), " << encoded.code.symbols.size() << " symbols; F6 " << f6_length
+            << ", DBF6 " << dbf6_length << " (DBF6/F6 " << (f6_length ? static_cast<double>(dbf6_length) / f6_length : 0.0) << ")\n"
             << "  resolution " << encoded.resolution << ", internode length " << encoded.internode_length << " m"
-            << (encode_options.internode_length == 0.0 ? " (median edge)" : "") << ", voxel size "
-            << encoded.geometry.voxel_size << " m, vertex error bound " << bound << " m\n"
+            << (encode_options.internode_length == 0.0 ? " (median edge)" : "") << ", voxel size " << encoded.geometry.voxel_size
+            << " m, vertex error bound " << bound << " m\n"
             << "  radius unit " << encoded.geometry.radius_unit << " m, root radius " << encoded.geometry.root_radius;
     if (options.print_code) {
         // stdout carries exactly the code and the radii so it can be piped; the summary goes to the log.
@@ -362,20 +362,15 @@ ChainCode code_from_options(const std::string& symbols, const std::string& radii
 }
 
 nlohmann::json lod_json(const ChainCode& code, int level, double threshold) {
-    return {{"lod", level},
-            {"threshold", threshold},
-            {"internodes", code.radii.size()},
-            {"code_length", code.symbols.size()},
-            {"code", code.symbols},
-            {"radii", code.radii}};
+    return {{"lod", level},         {"threshold", threshold}, {"internodes", code.radii.size()}, {"code_length", code.symbols.size()},
+            {"code", code.symbols}, {"radii", code.radii}};
 }
 
 int run_lod(const LodCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     // LOD reduction does not depend on the code kind: F6 and DBF6 prune identically.
     const ChainCode code = code_from_options(options.code, options.radii, CodeKind::DBF6);
     const bool by_levels = options.levels > 0;
-    const std::vector<double> thresholds = by_levels ? lod_thresholds(code.radii, options.levels)
-                                                     : std::vector<double>{options.threshold};
+    const std::vector<double> thresholds = by_levels ? lod_thresholds(code.radii, options.levels) : std::vector<double>{options.threshold};
     const std::vector<ChainCode> levels = lod_chain(code, thresholds, "--code");
     if (global.json) {
         nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()}, {"input_length", code.symbols.size()}};
@@ -397,7 +392,8 @@ int run_lod(const LodCliOptions& options, const OptionTable& table, const Global
         std::cout << "# LOD " << k;
         if (k) std::cout << " (threshold " << thresholds[k - 1] << ")";
         std::cout << ": " << levels[k].radii.size() << " internodes, " << levels[k].symbols.size() << " symbols\n"
-                  << levels[k].symbols << "\n" << join_radii(levels[k].radii) << "\n";
+                  << levels[k].symbols << "\n"
+                  << join_radii(levels[k].radii) << "\n";
     }
     return 0;
 }
@@ -414,17 +410,21 @@ int run_decode(const DecodeCliOptions& options, const OptionTable& table, const 
 
     const SymbolCounts counts = count_symbols(code.symbols);
     if (global.json) {
-        std::cout << nlohmann::json{{"treelobes", kVersion}, {"options", table.json()}, {"kind", code_kind_name(code.kind)},
-                                    {"internodes", counts.internodes}, {"nodes", tree.size()},
-                                    {"tips", tree.tip_count()},     {"voxel_size", geometry.voxel_size},
-                                    {"root_radius", geometry.root_radius}, {"out", options.out}}
-                         .dump(2)
+        std::cout << nlohmann::json{{"treelobes", kVersion},
+                                    {"options", table.json()},
+                                    {"kind", code_kind_name(code.kind)},
+                                    {"internodes", counts.internodes},
+                                    {"nodes", tree.size()},
+                                    {"tips", tree.tip_count()},
+                                    {"voxel_size", geometry.voxel_size},
+                                    {"root_radius", geometry.root_radius},
+                                    {"out", options.out}}
+                             .dump(2)
                   << "\n";
         return 0;
     }
-    std::cout << "decoded " << code_kind_name(code.kind) << " code of " << counts.internodes << " internodes: "
-              << tree.size() << " nodes, " << tree.tip_count() << " tips, voxel size " << geometry.voxel_size
-              << " m; wrote " << options.out << "\n";
+    std::cout << "decoded " << code_kind_name(code.kind) << " code of " << counts.internodes << " internodes: " << tree.size() << " nodes, "
+              << tree.tip_count() << " tips, voxel size " << geometry.voxel_size << " m; wrote " << options.out << "\n";
     return 0;
 }
 
@@ -440,9 +440,7 @@ void write_tree_output(const TreeGraph& tree, const fs::path& out, bool ascii, c
     write_skeleton_ply(tree, out, !ascii, {code_parameters_comment(code)});
 }
 
-CodeParameters code_parameters_of(const StoredTree& tree) {
-    return {tree.resolution, tree.internode_length, tree.radius_unit};
-}
+CodeParameters code_parameters_of(const StoredTree& tree) { return {tree.resolution, tree.internode_length, tree.radius_unit}; }
 
 int run_decode_forest(const DecodeFileCliOptions& options, const OptionTable& table, const GlobalOptions& global) {
     ForestReader forest{fs::path(options.input)};
@@ -461,8 +459,8 @@ int run_decode_forest(const DecodeFileCliOptions& options, const OptionTable& ta
     for (std::size_t i : selected) {
         std::vector<StreamSizes> sizes;
         const StoredTree stored = forest.read(i, options.lod, &sizes);
-        trees.push_back(place_tree(decode_stored_tree(stored, options.lod, options.input + ": tree " + std::to_string(i)),
-                                   forest.entry(i)));
+        trees.push_back(
+                place_tree(decode_stored_tree(stored, options.lod, options.input + ": tree " + std::to_string(i)), forest.entry(i)));
         parameters.push_back(code_parameters_of(stored));
         internodes += sizes[static_cast<std::size_t>(options.lod)].internodes;
         nlohmann::json item = {{"tree", i}, {"name", forest.entry(i).name}, {"nodes", trees.back().size()}};
@@ -485,14 +483,16 @@ int run_decode_forest(const DecodeFileCliOptions& options, const OptionTable& ta
         }
     }
     if (global.json) {
-        std::cout << nlohmann::json{{"treelobes", kVersion}, {"options", table.json()}, {"input", options.input}, {"trees_in_file", forest.size()},
-                                    {"lod", options.lod},    {"internodes", internodes},  {"decoded", written}}
-                         .dump(2)
+        std::cout << nlohmann::json{{"treelobes", kVersion},  {"options", table.json()},
+                                    {"input", options.input}, {"trees_in_file", forest.size()},
+                                    {"lod", options.lod},     {"internodes", internodes},
+                                    {"decoded", written}}
+                             .dump(2)
                   << "\n";
         return 0;
     }
-    std::cout << "decoded " << selected.size() << " of " << forest.size() << " trees (LOD " << options.lod << ", "
-              << internodes << " internodes) from " << options.input << " into " << options.out << "\n";
+    std::cout << "decoded " << selected.size() << " of " << forest.size() << " trees (LOD " << options.lod << ", " << internodes
+              << " internodes) from " << options.input << " into " << options.out << "\n";
     return 0;
 }
 
@@ -506,7 +506,8 @@ int run_decode_file(const DecodeFileCliOptions& options, const OptionTable& tabl
     write_tree_output(tree, options.out, options.ascii, code_parameters_of(stored));
     const StreamSizes& level = sizes[static_cast<std::size_t>(options.lod)];
     if (global.json) {
-        nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()},
+        nlohmann::json j = {{"treelobes", kVersion},
+                            {"options", table.json()},
                             {"input", options.input},
                             {"kind", code_kind_name(stored.kind)},
                             {"coder", coder_name(stored.coder)},
@@ -521,8 +522,8 @@ int run_decode_file(const DecodeFileCliOptions& options, const OptionTable& tabl
         return 0;
     }
     std::cout << "decoded LOD " << options.lod << " of " << stored.lods.size() << " (" << level.internodes << " internodes, "
-              << coder_name(stored.coder) << " coder): " << tree.size() << " nodes, " << tree.tip_count() << " tips; wrote "
-              << options.out << "\n";
+              << coder_name(stored.coder) << " coder): " << tree.size() << " nodes, " << tree.tip_count() << " tips; wrote " << options.out
+              << "\n";
     if (options.stats) print_lod_stats(stored, sizes);
     return 0;
 }
@@ -530,8 +531,9 @@ int run_decode_file(const DecodeFileCliOptions& options, const OptionTable& tabl
 void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<EncodeCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "encode", "Encode a skeleton as an F6/DBF6 chain code and radius list (Strnad et al. 2020); with --out, compress it into "
-                  "a .dbf6 file, or many trees (--forest) into a .forest file");
+            "encode",
+            "Encode a skeleton as an F6/DBF6 chain code and radius list (Strnad et al. 2020); with --out, compress it into "
+            "a .dbf6 file, or many trees (--forest) into a .forest file");
     auto table = std::make_shared<OptionTable>(sub);
     auto* skeleton = sub->add_option("skeleton", options->skeleton, "Skeleton PLY (vertex 0 is the root) or .tlobe");
     auto* forest = table->add("--forest", options->forest,
@@ -542,20 +544,20 @@ void add_encode(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto* resolution = table->add("--resolution", options->resolution,
                                   "Voxels per internode length (r of Eq. 2); required unless the skeleton is a "
                                   "decoded one, which records r, l and the radius unit of its code")
-                           ->check(cli::PositiveNumber);
+                               ->check(cli::PositiveNumber);
     auto* internode_length = table->add("--internode-length", options->internode_length,
                                         "Internode length l in metres, or 'auto' for the median edge length (per "
                                         "tree; a decoded skeleton's recorded l when not given)");
     auto* radius_unit = table->add("--radius-unit", options->radius_unit,
                                    "Metres per radius step of the radius list (a decoded skeleton's recorded unit "
                                    "when not given)")
-                            ->check(cli::PositiveNumber);
+                                ->check(cli::PositiveNumber);
     table->add_flag("--f6", options->f6, "Plain F6 code instead of the differential DBF6");
     auto* print = table->add_flag("--print-code", options->print_code, "Print the code on one line and the radii on the next");
     auto* lods = table->add("--lods", options->lods, "Levels of detail stored in the file (1 = full detail only)")
-                     ->check(CLI::Range(1, kMaxLods));
+                         ->check(CLI::Range(1, kMaxLods));
     auto* coder = table->add("--coder", options->coder, "Compression: ic (Strnad et al. 2020, §3.3) or best")
-                      ->check(CLI::IsMember({"ic", "best"}));
+                          ->check(CLI::IsMember({"ic", "best"}));
     table->add_flag("--stats", options->stats, "Report the size of every stream (per LOD, per tree)");
     print->excludes(out);
     sub->callback([options, table, skeleton, forest, out, lods, coder, resolution, internode_length, radius_unit, &global, &job] {
@@ -576,16 +578,14 @@ void add_decode(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand("decode", "Decode a .dbf6 tree or .forest trees into skeleton PLY files");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", options->input, "A .dbf6 or .forest file")->required();
-    table->add("--lod", options->lod, "Level of detail to decode (0 = full detail)")
-        ->check(cli::NonNegativeNumber);
-    table->add("--tree", options->tree, "Forest files: decode only tree I (0-based) into the --out PLY")
-        ->check(cli::NonNegativeNumber);
-    table->add("--out", options->out,
-               "Output skeleton PLY; for a whole forest (no --tree) a directory receiving one PLY per tree")
-        ->required();
+    table->add("--lod", options->lod, "Level of detail to decode (0 = full detail)")->check(cli::NonNegativeNumber);
+    table->add("--tree", options->tree, "Forest files: decode only tree I (0-based) into the --out PLY")->check(cli::NonNegativeNumber);
+    table->add("--out", options->out, "Output skeleton PLY; for a whole forest (no --tree) a directory receiving one PLY per tree")
+            ->required();
     table->add_flag("--ascii", options->ascii, "Write ASCII PLY instead of binary");
     table->add_flag("--stats", options->stats, "Report the size of every stream");
-    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_decode_file(*options, *table, global); }; });
+    sub->callback(
+            [options, table, &global, &job] { job = [options, table, &global] { return run_decode_file(*options, *table, global); }; });
 }
 
 void add_lod(CLI::App& app, const GlobalOptions& global, Job& job) {
@@ -594,11 +594,9 @@ void add_lod(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto table = std::make_shared<OptionTable>(sub);
     table->add("--code", options->code, "Chain code (F6 or DBF6)")->required();
     table->add("--radii", options->radii, "Comma-separated radii, one per internode")->required();
-    auto* threshold = table->add("--threshold", options->threshold,
-                                 "Prune laterals whose first radius is below T (radius units)");
-    auto* levels = table->add("--levels", options->levels,
-                              "Print K LODs with thresholds at uniform positions of the sorted unique radii")
-                       ->check(cli::PositiveNumber);
+    auto* threshold = table->add("--threshold", options->threshold, "Prune laterals whose first radius is below T (radius units)");
+    auto* levels = table->add("--levels", options->levels, "Print K LODs with thresholds at uniform positions of the sorted unique radii")
+                           ->check(cli::PositiveNumber);
     threshold->excludes(levels);
     levels->excludes(threshold);
     sub->callback([options, table, threshold, levels, &global, &job] {
@@ -613,16 +611,13 @@ void add_decode_code(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto table = std::make_shared<OptionTable>(sub);
     table->add("--code", options->code, "Chain code")->required();
     table->add("--radii", options->radii, "Comma-separated radii, one per internode")->required();
-    table->add("--resolution", options->resolution, "Resolution r used for encoding")
-        ->required()
-        ->check(cli::PositiveNumber);
+    table->add("--resolution", options->resolution, "Resolution r used for encoding")->required()->check(cli::PositiveNumber);
     table->add("--internode-length", options->internode_length, "Internode length l (metres) used for encoding")
-        ->required()
-        ->check(cli::PositiveNumber);
-    table->add("--radius-unit", options->radius_unit, "Metres per radius step")
-        ->check(cli::PositiveNumber);
+            ->required()
+            ->check(cli::PositiveNumber);
+    table->add("--radius-unit", options->radius_unit, "Metres per radius step")->check(cli::PositiveNumber);
     table->add("--root-radius", options->root_radius, "Root vertex radius in radius units (default: the first radius)")
-        ->check(cli::NonNegativeNumber);
+            ->check(cli::NonNegativeNumber);
     table->add_flag("--f6", options->f6, "The code is plain F6 (default: DBF6)");
     table->add_flag("--ascii", options->ascii, "Write an ASCII PLY instead of binary");
     table->add("--out", options->out, "Output skeleton PLY")->required();

@@ -57,9 +57,12 @@ nlohmann::json to_json(const EvalSkeletonOptions& o, const OptionTable& table, c
                         {"components", c.components},
                         {"reference_components", ref.kind == "points" ? nlohmann::json() : nlohmann::json(c.reference_components)}};
     if (c.branches)
-        j["branches"] = {{"reference_branches", c.branches->reference_branches}, {"detected", c.branches->detected},
-                         {"recall", c.branches->recall}, {"skeleton_branches", c.branches->skeleton_branches},
-                         {"correct", c.branches->correct}, {"precision", c.branches->precision}};
+        j["branches"] = {{"reference_branches", c.branches->reference_branches},
+                         {"detected", c.branches->detected},
+                         {"recall", c.branches->recall},
+                         {"skeleton_branches", c.branches->skeleton_branches},
+                         {"correct", c.branches->correct},
+                         {"precision", c.branches->precision}};
     return j;
 }
 
@@ -104,15 +107,18 @@ int run_eval_skeleton(const EvalSkeletonOptions& o, const OptionTable& table, co
     if (!o.visible_in.empty()) {
         const PointCloud scan = read_point_cloud(o.visible_in);
         const ExtraAttribute* internode = scan.extra("internode");
-        if (!internode) throw Error::input(o.visible_in, "--visible-in needs a scan with the `internode` attribute (a `treelobes synth` scan)");
+        if (!internode)
+            throw Error::input(o.visible_in, "--visible-in needs a scan with the `internode` attribute (a `treelobes synth` scan)");
         // Leaf points count too: they carry the internode of the twig they grow on, whose place
         // they show (a skeleton through a leafy twig is right).
         reference = visible_reference(reference, internode->values, o.visible_points);
     }
     const SkeletonComparison c = compare_skeletons(skeleton, reference, o.eval);
     if (!o.samples_out.empty()) write_samples(c, o.samples_out);
-    if (global.json) std::cout << to_json(o, table, reference, c).dump(2) << "\n";
-    else print_human(o, reference, c);
+    if (global.json)
+        std::cout << to_json(o, table, reference, c).dump(2) << "\n";
+    else
+        print_human(o, reference, c);
     return 0;
 }
 
@@ -122,27 +128,31 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* eval = app.add_subcommand("eval", "Score results against references");
     eval->require_subcommand(1);
     auto options = std::make_shared<EvalSkeletonOptions>();
-    CLI::App* sub = eval->add_subcommand("skeleton", "Compare a skeleton PLY with a reference skeleton, TreeQSM cylinders or skeleton points");
+    CLI::App* sub =
+            eval->add_subcommand("skeleton", "Compare a skeleton PLY with a reference skeleton, TreeQSM cylinders or skeleton points");
     auto table = std::make_shared<OptionTable>(sub);
     table->add("--skeleton", options->skeleton, "Skeleton PLY or QSM to score")->required();
-    table->add("--reference", options->reference, "Skeleton PLY, QSM (TreeQSM cylinder table or SimpleForest/rTwig CSV) or x y z point list")->required();
+    table->add("--reference", options->reference,
+               "Skeleton PLY, QSM (TreeQSM cylinder table or SimpleForest/rTwig CSV) or x y z point list")
+            ->required();
     table->add("--reference-kind", options->reference_kind, "auto, skeleton, treeqsm or points")
-        ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}));
-    table->add("--skeleton-kind", options->skeleton_kind, "auto, skeleton (PLY), treeqsm (TreeQSM table or SimpleForest/rTwig CSV) or points: score QSMs and other models too")
-        ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}));
-    table->add("--sample-step", options->eval.sample_step, "Metres between samples along segments")
-        ->check(cli::PositiveNumber);
-    table->add("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")
-        ->check(cli::PositiveNumber);
-    table->add("--min-branch-diameter", options->eval.min_branch_diameter, "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
-        ->check(cli::NonNegativeNumber);
+            ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}));
+    table->add("--skeleton-kind", options->skeleton_kind,
+               "auto, skeleton (PLY), treeqsm (TreeQSM table or SimpleForest/rTwig CSV) or points: score QSMs and other models too")
+            ->check(CLI::IsMember({"auto", "skeleton", "treeqsm", "points"}));
+    table->add("--sample-step", options->eval.sample_step, "Metres between samples along segments")->check(cli::PositiveNumber);
+    table->add("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")->check(cli::PositiveNumber);
+    table->add("--min-branch-diameter", options->eval.min_branch_diameter,
+               "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
+            ->check(cli::NonNegativeNumber);
     table->add("--visible-in", options->visible_in,
                "A synthetic scan of the reference (points labelled with `internode`): score against the part of the "
                "reference it sees, i.e. the internodes holding --visible-points of its points (bark or leaves) and their way to the root");
     table->add("--visible-points", options->visible_points, "Scan points an internode needs to count as seen")
-        ->check(CLI::Range(1, 1000000));
+            ->check(CLI::Range(1, 1000000));
     table->add("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
-    sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_eval_skeleton(*options, *table, global); }; });
+    sub->callback(
+            [options, table, &global, &job] { job = [options, table, &global] { return run_eval_skeleton(*options, *table, global); }; });
 }
 
 }  // namespace treelobes::cli

@@ -34,10 +34,10 @@ struct ExportCliOptions {
     std::string input;
     std::string format;
     std::string out;
-    int lod = 0;                     // LOD of .dbf6 / .forest inputs
+    int lod = 0;  // LOD of .dbf6 / .forest inputs
     TreeGeometryOptions geometry;
     bool no_leaves = false;
-    std::string crs;                 // overrides the inputs' sidecar CRS
+    std::string crs;  // overrides the inputs' sidecar CRS
     CityJsonOptions cityjson;
 };
 
@@ -74,7 +74,7 @@ std::vector<std::string> write_qsm(const ExportInput& input, const ExportCliOpti
 std::vector<std::pair<std::string, double>> extras_of(const TreeSummary& t) {
     const TreeMeasures& m = t.measures;
     std::vector<std::pair<std::string, double>> extras = {
-        {"height", m.height}, {"trunkDiameter", m.dbh}, {"crownDiameter", m.crown_diameter}, {"woodVolume", m.wood_volume}};
+            {"height", m.height}, {"trunkDiameter", m.dbh}, {"crownDiameter", m.crown_diameter}, {"woodVolume", m.wood_volume}};
     if (t.confidence) extras.emplace_back("confidence", *t.confidence);
     return extras;
 }
@@ -98,8 +98,8 @@ void write_mesh_file(const ExportInput& input, const ExportCliOptions& o) {
     write_georef_sidecar(o.out, all.origin, Georeference{o.crs.empty() ? input.crs : o.crs, {}});
 }
 
-nlohmann::json summary_json(const ExportCliOptions& o, const OptionTable& table, const ExportInput& input, const std::vector<TreeSummary>& trees,
-                            const std::vector<std::string>& outputs) {
+nlohmann::json summary_json(const ExportCliOptions& o, const OptionTable& table, const ExportInput& input,
+                            const std::vector<TreeSummary>& trees, const std::vector<std::string>& outputs) {
     nlohmann::json list = nlohmann::json::array();
     for (const auto& t : trees)
         list.push_back({{"name", t.name},
@@ -112,14 +112,10 @@ nlohmann::json summary_json(const ExportCliOptions& o, const OptionTable& table,
                         {"branches", t.measures.branches},
                         {"lobes", t.measures.lobes},
                         {"confidence", t.confidence ? nlohmann::json(*t.confidence) : nlohmann::json()}});
-    return {{"treelobes", kVersion},
-            {"command", "export"},
-            {"input", o.input},
-            {"format", o.format},
-            {"options", table.json()},
-            {"crs", o.crs.empty() ? input.crs : o.crs},
-            {"outputs", outputs},
-            {"trees", list}};
+    return {{"treelobes", kVersion},   {"command", "export"},
+            {"input", o.input},        {"format", o.format},
+            {"options", table.json()}, {"crs", o.crs.empty() ? input.crs : o.crs},
+            {"outputs", outputs},      {"trees", list}};
 }
 
 int run_export(ExportCliOptions o, const OptionTable& table, const GlobalOptions& global) {
@@ -129,10 +125,14 @@ int run_export(ExportCliOptions o, const OptionTable& table, const GlobalOptions
     std::vector<TreeSummary> summaries;
     for (const auto& tree : input.trees) summaries.push_back({tree.name, measure_tree(tree), tree.confidence});
     std::vector<std::string> outputs{o.out};
-    if (o.format == "qsm-txt" || o.format == "qsm-csv") outputs = write_qsm(input, o);
-    else if (o.format == "glb") write_glb(input, summaries, o);
-    else if (o.format == "cityjson") write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs, o.cityjson));
-    else write_mesh_file(input, o);
+    if (o.format == "qsm-txt" || o.format == "qsm-csv")
+        outputs = write_qsm(input, o);
+    else if (o.format == "glb")
+        write_glb(input, summaries, o);
+    else if (o.format == "cityjson")
+        write_file_atomically(o.out, cityjson_text(input.trees, o.crs.empty() ? input.crs : o.crs, o.cityjson));
+    else
+        write_mesh_file(input, o);
     if (global.json) {
         std::cout << summary_json(o, table, input, summaries, outputs).dump(2) << "\n";
         return 0;
@@ -155,17 +155,16 @@ void add_export_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--format", options->format,
                "ply|obj (branch tubes + lobes), glb (with LODs), cityjson, qsm-txt (TreeQSM cylinder, branch and tree tables), "
                "qsm-csv (SimpleForest/rTwig)")
-        ->required()
-        ->check(CLI::IsMember({"ply", "obj", "glb", "cityjson", "qsm-txt", "qsm-csv"}));
+            ->required()
+            ->check(CLI::IsMember({"ply", "obj", "glb", "cityjson", "qsm-txt", "qsm-csv"}));
     table->add("--out", options->out, "Output file (QSM of several trees: a folder of <tree>.txt / <tree>.csv)")->required();
-    table->add("--lod", options->lod, "LOD of .dbf6/.forest inputs to export (0 = full detail)")
-        ->check(cli::NonNegativeNumber);
+    table->add("--lod", options->lod, "LOD of .dbf6/.forest inputs to export (0 = full detail)")->check(cli::NonNegativeNumber);
     table->add("--lods", options->geometry.lods, "glb: levels of detail (MSFT_lod), 1..8")->check(CLI::Range(1, 8));
     table->add("--sides", options->geometry.sides, "Branch tube sides at full detail, 3..64")->check(CLI::Range(3, 64));
     table->add_flag("--no-leaves", options->no_leaves, "glb: no leaf cards on skeletons without lobes");
-    table->add("--leaf-size", options->geometry.leaf_size, "glb: leaf card edge in metres")
-        ->check(cli::PositiveNumber);
-    table->add_flag("--instances", options->cityjson.instances, "cityjson: LoD 2 as GeometryInstances of one template per species (geometry-templates)");
+    table->add("--leaf-size", options->geometry.leaf_size, "glb: leaf card edge in metres")->check(cli::PositiveNumber);
+    table->add_flag("--instances", options->cityjson.instances,
+                    "cityjson: LoD 2 as GeometryInstances of one template per species (geometry-templates)");
     table->add("--crs", options->crs, "CRS of the input (EPSG:25832 or WKT) when its georef sidecar has none");
     sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_export(*options, *table, global); }; });
 }

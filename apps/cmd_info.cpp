@@ -22,17 +22,16 @@ struct InfoOptions {
     std::string bounds;  // --bounds: describe only the points inside this box
 };
 
-std::string chunk_size_text(std::uint32_t chunk_size) {
-    return chunk_size == 0xFFFFFFFFu ? "variable" : std::to_string(chunk_size);
-}
+std::string chunk_size_text(std::uint32_t chunk_size) { return chunk_size == 0xFFFFFFFFu ? "variable" : std::to_string(chunk_size); }
 
 nlohmann::json to_json(const FileInfo& info) {
     nlohmann::json j = {{"path", info.path},
                         {"kind", info.kind},
                         {"format", info.format},
                         {"points", info.point_count},
-                        {"bounds", {{"min", {info.bounds_min.x(), info.bounds_min.y(), info.bounds_min.z()}},
-                                    {"max", {info.bounds_max.x(), info.bounds_max.y(), info.bounds_max.z()}}}}};
+                        {"bounds",
+                         {{"min", {info.bounds_min.x(), info.bounds_min.y(), info.bounds_min.z()}},
+                          {"max", {info.bounds_max.x(), info.bounds_max.y(), info.bounds_max.z()}}}}};
     if (!info.version.empty()) j["version"] = info.version;
     if (info.las_point_format >= 0) {
         j["point_format"] = info.las_point_format;
@@ -54,11 +53,12 @@ nlohmann::json to_json(const FileInfo& info) {
     if (info.dropped_non_finite) j["dropped_non_finite"] = info.dropped_non_finite;
     if (info.format == "laz") {
         j["laz"] = {{"point_format", info.las_point_format}, {"chunks", info.laz_chunks}};
-        if (info.laz_chunk_size == 0xFFFFFFFFu) j["laz"]["chunk_size"] = "variable";
-        else j["laz"]["chunk_size"] = info.laz_chunk_size;
+        if (info.laz_chunk_size == 0xFFFFFFFFu)
+            j["laz"]["chunk_size"] = "variable";
+        else
+            j["laz"]["chunk_size"] = info.laz_chunk_size;
     }
-    if (info.copc_levels >= 0)
-        j["copc"] = {{"levels", info.copc_levels}, {"nodes", info.copc_nodes}, {"nodes_read", info.copc_nodes_read}};
+    if (info.copc_levels >= 0) j["copc"] = {{"levels", info.copc_levels}, {"nodes", info.copc_nodes}, {"nodes_read", info.copc_nodes_read}};
     if (info.bounds_query) j["bounds_query"] = true;
     j["attributes"] = nlohmann::json::array();
     for (const auto& [name, type] : info.attributes) j["attributes"].push_back({{"name", name}, {"type", type}});
@@ -73,8 +73,8 @@ void print_human(const FileInfo& info) {
     if (info.las_point_format >= 0) std::cout << ", point format " << info.las_point_format;
     std::cout << "\n";
     if (info.format == "laz")
-        std::cout << "  LAZ (point format " << info.las_point_format << ", chunk size " << chunk_size_text(info.laz_chunk_size)
-                  << "), " << info.laz_chunks << (info.laz_chunks == 1 ? " chunk" : " chunks") << "\n";
+        std::cout << "  LAZ (point format " << info.las_point_format << ", chunk size " << chunk_size_text(info.laz_chunk_size) << "), "
+                  << info.laz_chunks << (info.laz_chunks == 1 ? " chunk" : " chunks") << "\n";
     if (info.copc_levels >= 0) {
         std::cout << "  COPC octree: " << info.copc_levels << " levels, " << info.copc_nodes << " nodes";
         if (info.bounds_query) std::cout << " (" << info.copc_nodes_read << " read for --bounds)";
@@ -83,7 +83,8 @@ void print_human(const FileInfo& info) {
     const char* noun = info.kind == "point cloud" ? "points" : info.kind == "skeleton" ? "nodes" : "vertices";
     if (info.kind == "qsm")
         std::cout << "  " << info.object_count << " cylinders, total length " << info.total_length << " m, volume " << info.volume << " m3";
-    else std::cout << "  " << info.point_count << " " << noun << (info.bounds_query ? " inside --bounds" : "");
+    else
+        std::cout << "  " << info.point_count << " " << noun << (info.bounds_query ? " inside --bounds" : "");
     if (info.kind == "mesh" || info.kind == "city model") std::cout << ", " << info.face_count << " faces";
     if (info.format == "glb") std::cout << ", " << info.object_count << " scene nodes";
     if (info.kind == "city model") std::cout << ", " << info.object_count << " city objects";
@@ -91,8 +92,8 @@ void print_human(const FileInfo& info) {
     if (info.dropped_non_finite) std::cout << " (" << info.dropped_non_finite << " NaN/inf points dropped)";
     std::cout << "\n";
     char line[256];
-    std::snprintf(line, sizeof line, "  bounds x %.3f .. %.3f, y %.3f .. %.3f, z %.3f .. %.3f\n", info.bounds_min.x(),
-                  info.bounds_max.x(), info.bounds_min.y(), info.bounds_max.y(), info.bounds_min.z(), info.bounds_max.z());
+    std::snprintf(line, sizeof line, "  bounds x %.3f .. %.3f, y %.3f .. %.3f, z %.3f .. %.3f\n", info.bounds_min.x(), info.bounds_max.x(),
+                  info.bounds_min.y(), info.bounds_max.y(), info.bounds_min.z(), info.bounds_max.z());
     std::cout << line;
     if (!info.attributes.empty()) {
         std::cout << "  attributes:";
@@ -110,8 +111,10 @@ int run_info(const InfoOptions& options, const OptionTable& table, const GlobalO
     for (const auto& file : options.files) {
         try {
             const FileInfo info = describe_file(file, bounds);
-            if (global.json) files.push_back(to_json(info));
-            else print_human(info);
+            if (global.json)
+                files.push_back(to_json(info));
+            else
+                print_human(info);
         } catch (const Error& e) {
             std::cerr << "treelobes: error: " << e.what() << "\n";
             if (global.json) files.push_back({{"path", file}, {"error", e.what()}});
@@ -126,12 +129,13 @@ int run_info(const InfoOptions& options, const OptionTable& table, const GlobalO
 
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<InfoOptions>();
-    CLI::App* sub = app.add_subcommand("info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes (PLY, OBJ, OFF, glb), skeletons, QSMs and CityJSON");
+    CLI::App* sub = app.add_subcommand(
+            "info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes (PLY, OBJ, OFF, glb), skeletons, QSMs and CityJSON");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("files", options->files, "Files to describe")->required();
     table->add("--bounds", options->bounds,
-              "Describe only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); "
-              "COPC files read only the octree nodes that meet the box");
+               "Describe only the points inside minx,miny,minz,maxx,maxy,maxz (or minx,miny,maxx,maxy); "
+               "COPC files read only the octree nodes that meet the box");
     sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_info(*options, *table, global); }; });
 }
 

@@ -59,11 +59,12 @@ nlohmann::json lobe_json(const lobes::LobeTree& tree, const lobes::Lobe& lobe) {
             {"faces", lobe.mesh.faces.size()},
             {"volume", rounded(lobe.volume(), 5)},
             {"area", rounded(lobe.area(), 4)},
-            {"seed", {{"node", lobe.seed_node},
-                      {"position", {rounded(seed.x()), rounded(seed.y()), rounded(seed.z())}},
-                      {"thickness", rounded(tree.seed_thickness(lobe), 5)},
-                      {"direction", {rounded(lobe.seed_direction.x(), 3), rounded(lobe.seed_direction.y(), 3),
-                                     rounded(lobe.seed_direction.z(), 3)}}}}};
+            {"seed",
+             {{"node", lobe.seed_node},
+              {"position", {rounded(seed.x()), rounded(seed.y()), rounded(seed.z())}},
+              {"thickness", rounded(tree.seed_thickness(lobe), 5)},
+              {"direction",
+               {rounded(lobe.seed_direction.x(), 3), rounded(lobe.seed_direction.y(), 3), rounded(lobe.seed_direction.z(), 3)}}}}};
 }
 
 TriangleMesh merged_lobes(const lobes::LobeTree& tree) {
@@ -89,8 +90,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const OptionTable& table, const
     // Read back what is written: the summary reports the decoded lobes' closedness.
     const lobes::LobeTree decoded = lobes::decode_tlobe(bytes, input.string());
     std::size_t closed = 0;
-    for (const auto& lobe : decoded.lobes)
-        closed += lobes::check_closed(lobe.mesh).closed() && lobe.volume() > 0 ? 1 : 0;
+    for (const auto& lobe : decoded.lobes) closed += lobes::check_closed(lobe.mesh).closed() && lobe.volume() > 0 ? 1 : 0;
     const auto coded = std::chrono::steady_clock::now();
 
     const fs::path dir(o.out);
@@ -119,31 +119,38 @@ nlohmann::json run_one(const LobesCliOptions& o, const OptionTable& table, const
     seconds["lobes"] = span(reconstructed, lobed);
     seconds["encode and verify"] = span(lobed, coded);
     nlohmann::json summary = {
-        {"treelobes", kVersion},
-        {"input", input.string()},
-        {"options", table.json()},
-        {"skeleton", {{"internodes", r.skeleton.size() > 0 ? r.skeleton.size() - 1 : 0},
-                      {"main_nodes", tree.skeleton.size()},
-                      {"root_diameter", rounded(tree.root_diameter, 4)},
-                      {"low_confidence_edges", report.low_confidence_edges}}},
-        {"clusters", {{"found", report.clusters}, {"kept_as_branches_small", report.kept_small},
-                      {"kept_as_branches_no_shape", report.kept_no_shape}}},
-        {"points", {{"lobes", report.lobe_points}, {"main", report.main_points}, {"dropped_attached_to_lobes", report.dropped_points_attached}}},
-        {"lobe_count", tree.lobes.size()},
-        {"closed_lobes", closed},
-        {"lobe_faces", faces},
-        {"faces_before_simplification", report.faces_before_simplification},
-        {"tlobe_bytes", bytes.size()},
-        {"occupancy_cell", occupancy_cell > 0 ? nlohmann::json(rounded(occupancy_cell, 4)) : nlohmann::json()},
-        {"lobes", lobes_json},
-        {"outputs", {{"tlobe", tlobe.string()}, {"lobes", tree.lobes.empty() ? nlohmann::json() : nlohmann::json(meshes.string())},
-                     {"main_skeleton", main.string()}}},
-        {"seconds", seconds}};
+            {"treelobes", kVersion},
+            {"input", input.string()},
+            {"options", table.json()},
+            {"skeleton",
+             {{"internodes", r.skeleton.size() > 0 ? r.skeleton.size() - 1 : 0},
+              {"main_nodes", tree.skeleton.size()},
+              {"root_diameter", rounded(tree.root_diameter, 4)},
+              {"low_confidence_edges", report.low_confidence_edges}}},
+            {"clusters",
+             {{"found", report.clusters},
+              {"kept_as_branches_small", report.kept_small},
+              {"kept_as_branches_no_shape", report.kept_no_shape}}},
+            {"points",
+             {{"lobes", report.lobe_points}, {"main", report.main_points}, {"dropped_attached_to_lobes", report.dropped_points_attached}}},
+            {"lobe_count", tree.lobes.size()},
+            {"closed_lobes", closed},
+            {"lobe_faces", faces},
+            {"faces_before_simplification", report.faces_before_simplification},
+            {"tlobe_bytes", bytes.size()},
+            {"occupancy_cell", occupancy_cell > 0 ? nlohmann::json(rounded(occupancy_cell, 4)) : nlohmann::json()},
+            {"lobes", lobes_json},
+            {"outputs",
+             {{"tlobe", tlobe.string()},
+              {"lobes", tree.lobes.empty() ? nlohmann::json() : nlohmann::json(meshes.string())},
+              {"main_skeleton", main.string()}}},
+            {"seconds", seconds}};
     write_file_atomically(summary_path, summary.dump(2) + "\n");
     if (!global.json)
         std::printf("%s: %zu lobes (%zu closed, %zu faces), %zu main nodes, %.1f kB .tlobe; reconstruct %.2f s, lobes %.2f s\n",
                     input.string().c_str(), tree.lobes.size(), closed, faces, tree.skeleton.size(), bytes.size() / 1000.0,
-                    std::chrono::duration<double>(reconstructed - start).count(), std::chrono::duration<double>(lobed - reconstructed).count());
+                    std::chrono::duration<double>(reconstructed - start).count(),
+                    std::chrono::duration<double>(lobed - reconstructed).count());
     return summary;
 }
 
@@ -173,8 +180,9 @@ int run_lobes(LobesCliOptions& o, const OptionTable& table, const GlobalOptions&
         write_file_atomically(fs::path(o.out) / "failures.jsonl", lines);
     }
     if (global.json)
-        std::cout << nlohmann::json{{"treelobes", kVersion}, {"command", "lobes"}, {"out", o.out}, {"trees", trees},
-                                    {"failures", failures}}.dump(2) << "\n";
+        std::cout << nlohmann::json{{"treelobes", kVersion}, {"command", "lobes"}, {"out", o.out}, {"trees", trees}, {"failures", failures}}
+                             .dump(2)
+                  << "\n";
     if (failures.empty()) return 0;
     return o.inputs.size() == 1 ? last_code : static_cast<int>(ExitCode::PartialFailure);
 }
@@ -286,31 +294,37 @@ int run_synthesize(const SynthesizeCliOptions& o, const OptionTable& table, cons
     for (const auto& lobe : textured.lobes) {
         instances += lobe.instances.size();
         filled += lobe.filled;
-        per_lobe.push_back({{"patches", lobe.instances.size()}, {"docks_used", lobe.docks_used}, {"docks_outside", lobe.docks_outside}, {"docks_redundant", lobe.docks_redundant},
-                            {"reseeds", lobe.reseeds}, {"target_cells", lobe.target_cells}, {"filled", rounded(lobe.filled, 3)},
-                            {"triangles", lobe.triangles}, {"budget_spent", lobe.budget_spent}});
+        per_lobe.push_back({{"patches", lobe.instances.size()},
+                            {"docks_used", lobe.docks_used},
+                            {"docks_outside", lobe.docks_outside},
+                            {"docks_redundant", lobe.docks_redundant},
+                            {"reseeds", lobe.reseeds},
+                            {"target_cells", lobe.target_cells},
+                            {"filled", rounded(lobe.filled, 3)},
+                            {"triangles", lobe.triangles},
+                            {"budget_spent", lobe.budget_spent}});
     }
-    nlohmann::json summary = {
-        {"treelobes", kVersion},
-        {"input", o.input},
-        {"options", table.json()},
-        {"species", profile.entry.name},
-        {"seed", o.synthesis.texturing.seed},
-        {"lod", o.lod},
-        {"library", {{"branchlets", textured.library.branchlets}, {"patches", textured.library.patches.size()}}},
-        {"lobes", tree.lobes.size()},
-        {"patch_instances", instances},
-        {"mean_lobe_filled", tree.lobes.empty() ? 0.0 : rounded(filled / static_cast<double>(tree.lobes.size()), 3)},
-        {"skeleton_edges", mesh.skeleton_edges},
-        {"twig_segments", mesh.twig_segments},
-        {"leaves", mesh.leaf_count},
-        {"leaf_share", rounded(textured.leaf_share, 3)},
-        {"triangles", mesh.triangles()},
-        {"max_triangles", o.synthesis.max_triangles},
-        {"patch_budget", textured.patch_budget},
-        {"lobe_texturing", per_lobe},
-        {"output", o.out}};
-    nlohmann::json seconds = {{"read", rounded(read_seconds)}, {"texturing", rounded(texturing_seconds)},
+    nlohmann::json summary = {{"treelobes", kVersion},
+                              {"input", o.input},
+                              {"options", table.json()},
+                              {"species", profile.entry.name},
+                              {"seed", o.synthesis.texturing.seed},
+                              {"lod", o.lod},
+                              {"library", {{"branchlets", textured.library.branchlets}, {"patches", textured.library.patches.size()}}},
+                              {"lobes", tree.lobes.size()},
+                              {"patch_instances", instances},
+                              {"mean_lobe_filled", tree.lobes.empty() ? 0.0 : rounded(filled / static_cast<double>(tree.lobes.size()), 3)},
+                              {"skeleton_edges", mesh.skeleton_edges},
+                              {"twig_segments", mesh.twig_segments},
+                              {"leaves", mesh.leaf_count},
+                              {"leaf_share", rounded(textured.leaf_share, 3)},
+                              {"triangles", mesh.triangles()},
+                              {"max_triangles", o.synthesis.max_triangles},
+                              {"patch_budget", textured.patch_budget},
+                              {"lobe_texturing", per_lobe},
+                              {"output", o.out}};
+    nlohmann::json seconds = {{"read", rounded(read_seconds)},
+                              {"texturing", rounded(texturing_seconds)},
                               {o.lod < 1 ? "lod_extraction" : "meshing", rounded(mesh_seconds)}};
     if (cloud && mesh.triangles() == 0) log_warn(o.input + ": the synthesized mesh is empty; no fidelity metrics");
     if (cloud && mesh.triangles() > 0) {
@@ -338,7 +352,8 @@ int run_synthesize(const SynthesizeCliOptions& o, const OptionTable& table, cons
         std::cout << summary.dump(2) << "\n";
     } else {
         std::printf("%s: %zu lobes textured with %zu %s patches -> %zu triangles (%zu leaves) in %.2f s", o.input.c_str(),
-                    tree.lobes.size(), instances, profile.entry.name.c_str(), mesh.triangles(), mesh.leaf_count, texturing_seconds + mesh_seconds);
+                    tree.lobes.size(), instances, profile.entry.name.c_str(), mesh.triangles(), mesh.leaf_count,
+                    texturing_seconds + mesh_seconds);
         if (summary.contains("fidelity"))
             std::printf("; input points to mesh: median %.3f m, p95 %.3f m", summary["fidelity"]["median_point_to_mesh"].get<double>(),
                         summary["fidelity"]["p95_point_to_mesh"].get<double>());
@@ -351,27 +366,29 @@ int run_synthesize(const SynthesizeCliOptions& o, const OptionTable& table, cons
 
 void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<LobesCliOptions>();
-    CLI::App* sub = app.add_subcommand("lobes", "Lobe-based representation (.tlobe) of single-tree scans: main skeleton + alpha-shape lobes");
+    CLI::App* sub =
+            app.add_subcommand("lobes", "Lobe-based representation (.tlobe) of single-tree scans: main skeleton + alpha-shape lobes");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("inputs", o->inputs, "Point clouds of single trees (LAS, PLY, PCD, XYZ/CSV)")->required();
     table->add("--out", o->out, "Output folder")->required();
-    add_species_flags(*table, o->flags, "Lobe diameter factor f_s of Eq. 2: larger -> more, smaller lobes (default 1.0, or the species')", o->stage);
-    table->add("--alpha-factor", o->lobes.alpha.alpha_factor, "alpha = FACTOR * alpha_min (ball radii)")
-        ->check(CLI::Range(1.0, 100.0));
+    add_species_flags(*table, o->flags, "Lobe diameter factor f_s of Eq. 2: larger -> more, smaller lobes (default 1.0, or the species')",
+                      o->stage);
+    table->add("--alpha-factor", o->lobes.alpha.alpha_factor, "alpha = FACTOR * alpha_min (ball radii)")->check(CLI::Range(1.0, 100.0));
     table->add("--min-cluster-points", o->lobes.min_cluster_points, "Smaller clusters stay on the skeleton as branches")
-        ->check(CLI::Range(4, 100000));
+            ->check(CLI::Range(4, 100000));
     table->add("--max-shape-points", o->lobes.max_shape_points, "Larger clusters are thinned on a grid before the alpha shape")
-        ->check(CLI::Range(100, 10000000));
-    table->add("--dropped-point-reach", o->lobes.dropped_point_reach, "Outliers dropped by the reconstruction within this many metres of a lobe's points join its occupancy (0 = off)")
-        ->check(CLI::Range(0.0, 10.0));
+            ->check(CLI::Range(100, 10000000));
+    table->add("--dropped-point-reach", o->lobes.dropped_point_reach,
+               "Outliers dropped by the reconstruction within this many metres of a lobe's points join its occupancy (0 = off)")
+            ->check(CLI::Range(0.0, 10.0));
     table->add("--face-budget", o->lobes.face_budget, "Lobe faces over the whole tree after simplification")
-        ->check(CLI::Range(100, 10000000));
-    table->add("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")
-        ->check(CLI::Range(0.0001, 0.1));
+            ->check(CLI::Range(100, 10000000));
+    table->add("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")->check(CLI::Range(0.0001, 0.1));
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_lobes(*o, *table, global); }; });
 
     auto so = std::make_shared<SynthesizeCliOptions>();
-    CLI::App* syn = app.add_subcommand("synthesize", "Full tree mesh from a .tlobe: main branches plus lobes textured with species patches");
+    CLI::App* syn =
+            app.add_subcommand("synthesize", "Full tree mesh from a .tlobe: main branches plus lobes textured with species patches");
     auto syn_table = std::make_shared<OptionTable>(syn);
     syn->add_option("input", so->input, "Lobe-based representation (.tlobe) from `treelobes lobes`")->required();
     syn_table->add("--out", so->out, "Output mesh (.ply, .obj, .off); a summary goes next to it as .json")->required();
@@ -379,20 +396,26 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     syn_table->add("--seed", so->synthesis.texturing.seed, "Random seed of patch fitting");
     syn_table->add("--library-seed", so->synthesis.library.seed, "Random seed of the species' patch library");
     syn_table->add("--lod", so->lod, "Level of detail: fraction of skeleton edges, twigs and leaves kept (0..1]")
-        ->check(CLI::Range(0.001, 1.0));
-    syn_table->add("--max-triangles", so->synthesis.max_triangles, "Triangles of the synthesized tree at most (a hard bound): the main branches', the rest shared by the lobes by volume; leafy patches are thinned")
-        ->check(CLI::Range(1000, 1000000000));
-    syn_table->add("--max-lobe-patches", so->synthesis.texturing.max_patches_per_lobe, "Patches per lobe at most (a safety bound; --max-triangles governs)")
-        ->check(CLI::Range(1, 10000000));
-    syn_table->add("--fill-cell", so->synthesis.texturing.fill_cell, "Smallest edge of the lobe fill cells, metres (cells are sized to the lobe's patch budget)")
-        ->check(CLI::Range(0.01, 10.0));
-    syn_table->add("--max-fill-cells", so->synthesis.texturing.max_fill_cells, "Fill cells per lobe at most (larger lobes get larger cells)")
-        ->check(CLI::Range(1.0, 1e7));
+            ->check(CLI::Range(0.001, 1.0));
+    syn_table
+            ->add("--max-triangles", so->synthesis.max_triangles,
+                  "Triangles of the synthesized tree at most (a hard bound): the main branches', the rest shared by the lobes by volume; "
+                  "leafy patches are thinned")
+            ->check(CLI::Range(1000, 1000000000));
+    syn_table
+            ->add("--max-lobe-patches", so->synthesis.texturing.max_patches_per_lobe,
+                  "Patches per lobe at most (a safety bound; --max-triangles governs)")
+            ->check(CLI::Range(1, 10000000));
+    syn_table
+            ->add("--fill-cell", so->synthesis.texturing.fill_cell,
+                  "Smallest edge of the lobe fill cells, metres (cells are sized to the lobe's patch budget)")
+            ->check(CLI::Range(0.01, 10.0));
+    syn_table
+            ->add("--max-fill-cells", so->synthesis.texturing.max_fill_cells, "Fill cells per lobe at most (larger lobes get larger cells)")
+            ->check(CLI::Range(1.0, 1e7));
     syn_table->add("--points", so->points, "The input cloud: report the one-sided distance from its points to the mesh");
     syn_table->add("--preview", so->preview, "PNG preview: input points (with --points) next to the synthesized tree");
-    syn->callback([so, syn_table, &global, &job] {
-        job = [so, syn_table, &global] { return run_synthesize(*so, *syn_table, global); };
-    });
+    syn->callback([so, syn_table, &global, &job] { job = [so, syn_table, &global] { return run_synthesize(*so, *syn_table, global); }; });
 }
 
 }  // namespace treelobes::cli

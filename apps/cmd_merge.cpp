@@ -41,8 +41,10 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
     write_file_atomically(out / "trees.geojson", merged.trees_geojson);
     write_file_atomically(out / "survey.forest", std::string(merged.forest.begin(), merged.forest.end()));
     write_file_atomically(out / "summary.json", merged.summary_json);
-    if (merged.failures_jsonl.empty()) fs::remove(out / "failures.jsonl", ec);
-    else write_file_atomically(out / "failures.jsonl", merged.failures_jsonl);
+    if (merged.failures_jsonl.empty())
+        fs::remove(out / "failures.jsonl", ec);
+    else
+        write_file_atomically(out / "failures.jsonl", merged.failures_jsonl);
     const bool partial = !merged.failures_jsonl.empty() || !folders.incomplete.empty();
     if (global.json) {
         // summary.json holds no paths (the same survey merges into the same bytes wherever it goes), so
@@ -62,8 +64,9 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
 
 void add_merge_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<MergeCliOptions>();
-    CLI::App* sub = app.add_subcommand("merge", "Join tile and batch outputs into one trees.csv, trees.geojson, survey.forest and summary.json, "
-                                                "order-independent (docs/survey.md)");
+    CLI::App* sub = app.add_subcommand("merge",
+                                       "Join tile and batch outputs into one trees.csv, trees.geojson, survey.forest and summary.json, "
+                                       "order-independent (docs/survey.md)");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("dirs", o->inputs, "Tile output folders or batch output folders (their finished tiles)")->required();
     table->add("--out", o->out, "Output folder")->required();

@@ -49,8 +49,8 @@ struct MultiresCliOptions {
     std::string order = "greedy";
     std::vector<long long> lods;
     bool all = false;
-    int steps = -1;                 // -1: the file's derivation length
-    long long seed = -1;            // -1: the file's seed
+    int steps = -1;       // -1: the file's derivation length
+    long long seed = -1;  // -1: the file's seed
     std::vector<std::string> defines;
     std::size_t max_modules = kDefaultMaxModules;
     std::vector<std::string> length_modules{"F", "f"};
@@ -165,20 +165,18 @@ void write_leaves_csv(const std::vector<LeafPlacement>& leaves, const fs::path& 
         out.precision(9);  // float round trip
         out << "x,y,z,hx,hy,hz,ux,uy,uz,size,node\n";
         for (const auto& l : leaves)
-            out << l.position.x() << ',' << l.position.y() << ',' << l.position.z() << ',' << l.heading.x() << ','
-                << l.heading.y() << ',' << l.heading.z() << ',' << l.up.x() << ',' << l.up.y() << ',' << l.up.z() << ','
-                << l.size << ',' << l.node << '\n';
+            out << l.position.x() << ',' << l.position.y() << ',' << l.position.z() << ',' << l.heading.x() << ',' << l.heading.y() << ','
+                << l.heading.z() << ',' << l.up.x() << ',' << l.up.y() << ',' << l.up.z() << ',' << l.size << ',' << l.node << '\n';
     });
 }
 
 // Three leaf tones, picked per leaf by a fixed hash so textures are deterministic and not flat.
 constexpr render::Rgba kLeafTones[3] = {{58, 128, 40, 255}, {86, 150, 52, 255}, {42, 104, 36, 255}};
 
-std::array<render::Image, 6> box_textures(const FoliageBox& box, const std::vector<LeafPlacement>& leaves,
-                                          const Eigen::Vector3d& origin, int size) {
+std::array<render::Image, 6> box_textures(const FoliageBox& box, const std::vector<LeafPlacement>& leaves, const Eigen::Vector3d& origin,
+                                          int size) {
     std::vector<LeafPlacement> tone_leaves[3];
-    for (std::size_t l = box.leaf_begin; l < box.leaf_end; ++l)
-        tone_leaves[(l * 2654435761u >> 7) % 3].push_back(leaves[l]);
+    for (std::size_t l = box.leaf_begin; l < box.leaf_end; ++l) tone_leaves[(l * 2654435761u >> 7) % 3].push_back(leaves[l]);
     TriangleMesh meshes[3];
     std::vector<render::FoliageLayer> layers;
     for (int t = 0; t < 3; ++t) {
@@ -194,8 +192,8 @@ std::array<render::Image, 6> box_textures(const FoliageBox& box, const std::vect
 nlohmann::json vector_json(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 // Foliage hierarchy, textures and atlas; returns the "foliage" block of summary.json.
-nlohmann::json write_foliage(const FoliageHierarchy& hierarchy, const std::vector<LeafPlacement>& leaves,
-                             const Eigen::Vector3d& origin, const MultiresCliOptions& o, const fs::path& out) {
+nlohmann::json write_foliage(const FoliageHierarchy& hierarchy, const std::vector<LeafPlacement>& leaves, const Eigen::Vector3d& origin,
+                             const MultiresCliOptions& o, const fs::path& out) {
     std::vector<render::Image> tiles;
     nlohmann::json boxes = nlohmann::json::array();
     if (o.texture_planes) fs::create_directories(out / "textures");
@@ -265,9 +263,10 @@ nlohmann::json write_foliage(const FoliageHierarchy& hierarchy, const std::vecto
     nlohmann::json doc = {{"texture_size", o.texture_size},
                           {"atlas", tiles.empty() ? nlohmann::json() : nlohmann::json("atlas.png")},
                           {"atlas_columns", columns},
-                          {"note", "tile i sits at pixel ((i % atlas_columns) * texture_size, (i / atlas_columns) * "
-                                   "texture_size); texel (x, y) of a tile lies at corner + s*u + t*v, s = (x + 0.5) / "
-                                   "texture_size, t = 1 - (y + 0.5) / texture_size"},
+                          {"note",
+                           "tile i sits at pixel ((i % atlas_columns) * texture_size, (i / atlas_columns) * "
+                           "texture_size); texel (x, y) of a tile lies at corner + s*u + t*v, s = (x + 0.5) / "
+                           "texture_size, t = 1 - (y + 0.5) / texture_size"},
                           {"boxes", boxes}};
     write_file_atomically(out / "foliage.json", doc.dump(1) + "\n");
     return summary;
@@ -350,18 +349,16 @@ void print_multires_report(const nlohmann::json& summary, const MultiresCliOptio
               << summary["metric"].get<std::string>() << ", order " << summary["order"].get<std::string>() << "\n";
     for (const auto& entry : summary["lods"]) {
         char line[200];
-        std::snprintf(line, sizeof line, "  LOD %zu: %zu nodes, %zu tips, length %.4g (%.1f %%) -> %s\n",
-                      entry["lod"].get<std::size_t>(), entry["nodes"].get<std::size_t>(), entry["tips"].get<std::size_t>(),
-                      entry["length"].get<double>(), 100.0 * entry["length_fraction"].get<double>(),
-                      entry["skeleton"].get<std::string>().c_str());
+        std::snprintf(line, sizeof line, "  LOD %zu: %zu nodes, %zu tips, length %.4g (%.1f %%) -> %s\n", entry["lod"].get<std::size_t>(),
+                      entry["nodes"].get<std::size_t>(), entry["tips"].get<std::size_t>(), entry["length"].get<double>(),
+                      100.0 * entry["length_fraction"].get<double>(), entry["skeleton"].get<std::string>().c_str());
         std::cout << line;
     }
     if (summary.contains("foliage")) {
         const nlohmann::json& foliage = summary["foliage"];
-        std::cout << "  foliage: " << foliage["leaves"] << " leaves, " << foliage["boxes"] << " boxes (depth "
-                  << foliage["hierarchy_depth"] << "), " << foliage["textures"] << " textures of " << o.texture_size << "x"
-                  << o.texture_size << " (" << foliage["texture_bytes_rgba"] << " bytes RGBA) for boxes above volume ratio "
-                  << o.texture_threshold << "\n";
+        std::cout << "  foliage: " << foliage["leaves"] << " leaves, " << foliage["boxes"] << " boxes (depth " << foliage["hierarchy_depth"]
+                  << "), " << foliage["textures"] << " textures of " << o.texture_size << "x" << o.texture_size << " ("
+                  << foliage["texture_bytes_rgba"] << " bytes RGBA) for boxes above volume ratio " << o.texture_threshold << "\n";
     }
     std::cout << "  chain: " << (out / "chain.txt").string() << ", summary: " << (out / "summary.json").string() << "\n";
 }
@@ -405,29 +402,26 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
     // Levels that add branch length (the others only add apices or leaves).
     std::size_t growing = 1;
     for (std::size_t k = 1; k < chain.lod_count(); ++k) growing += chain.lod_length[k] > chain.lod_length[k - 1];
-    nlohmann::json summary = {{"treelobes", kVersion},
-                              {"command", "multires"},
-                              {"options", table.json()},
-                              {"input", name},
-                              {"input_kind", source.kind},
-                              {"metric", to_string(*metric)},
-                              {"order", to_string(*order)},
-                              {"modules", source.string.size()},
-                              {"internodes", source.string.count("F")},
-                              {"tadt_nodes", chain.tadt.nodes.size()},
-                              {"chain_entries", chain.entries.size()},
-                              {"saves", saves},
-                              {"restores", chain.restores.size()},
-                              {"lod_count", chain.lod_count()},
-                              {"lods_adding_length", growing},
-                              {"total_length", full_length},
-                              {"chain", "chain.txt"},
-                              {"lods", lod_json},
-                              {"seconds",
-                               {{"load", load_seconds},
-                                {"chain", chain_seconds},
-                                {"foliage", foliage_seconds},
-                                {"extract", extract_seconds}}}};
+    nlohmann::json summary = {
+            {"treelobes", kVersion},
+            {"command", "multires"},
+            {"options", table.json()},
+            {"input", name},
+            {"input_kind", source.kind},
+            {"metric", to_string(*metric)},
+            {"order", to_string(*order)},
+            {"modules", source.string.size()},
+            {"internodes", source.string.count("F")},
+            {"tadt_nodes", chain.tadt.nodes.size()},
+            {"chain_entries", chain.entries.size()},
+            {"saves", saves},
+            {"restores", chain.restores.size()},
+            {"lod_count", chain.lod_count()},
+            {"lods_adding_length", growing},
+            {"total_length", full_length},
+            {"chain", "chain.txt"},
+            {"lods", lod_json},
+            {"seconds", {{"load", load_seconds}, {"chain", chain_seconds}, {"foliage", foliage_seconds}, {"extract", extract_seconds}}}};
     if (foliage.hierarchy) summary["foliage"] = foliage.summary;
     if (source.kind == "lsystem") summary["derived_modules"] = source.derived_modules;
     write_file_atomically(out / "summary.json", summary.dump(2) + "\n");
@@ -445,34 +439,32 @@ int run_multires(const MultiresCliOptions& o, const OptionTable& table, const Gl
 void add_multires_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<MultiresCliOptions>();
     CLI::App* sub = app.add_subcommand(
-        "multires", "Multiresolution chain (Lluch et al. 2010) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
+            "multires", "Multiresolution chain (Lluch et al. 2010) of an L-system, a bracketed string or a skeleton PLY; writes LODs");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", o->input, "L-system file (docs/lsystem.md) or skeleton PLY");
     table->add("--string", o->string, "A bracketed module string instead of a file, e.g. 'C1[C2[C3][C4]][C5]'");
     table->add("--out", o->out, "Output folder")->required();
     table->add("--metric", o->metric, "Child order: branching-length (default), children, descendants, longest-path")
-        ->check(CLI::IsMember({"branching-length", "children", "descendants", "longest-path", "branching_length",
-                               "longest_path"}));
+            ->check(CLI::IsMember({"branching-length", "children", "descendants", "longest-path", "branching_length", "longest_path"}));
     table->add("--order", o->order, "Resume at: greedy (largest remaining branch, default) or depth-first")
-        ->check(CLI::IsMember({"greedy", "depth-first", "depth_first"}));
+            ->check(CLI::IsMember({"greedy", "depth-first", "depth_first"}));
     auto* lod = table->add("--lod", o->lods, "LOD level(s) to write (0 = coarsest); default: coarsest and full");
     table->add_flag("--all", o->all, "Write every LOD level")->excludes(lod);
     table->add("--steps", o->steps, "Derivation length (overrides the file)")->check(CLI::Range(0, kMaxDerivationLength));
     table->add("--seed", o->seed, "Seed of stochastic rules (overrides the file)")->check(cli::NonNegativeNumber);
     table->add("--define,-D", o->defines, "Override a #define constant: NAME=VALUE (repeatable)");
     table->add("--max-modules", o->max_modules, "Largest module string a derivation may produce")
-        ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));
-    table->add("--length-modules", o->length_modules, "Modules whose first parameter is a length in the tADT")
-        ->delimiter(',');
+            ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));
+    table->add("--length-modules", o->length_modules, "Modules whose first parameter is a length in the tADT")->delimiter(',');
     table->add_flag("--mesh", o->mesh, "Also write a tube mesh per LOD (<lod>.mesh.ply)");
     table->add("--texture-threshold", o->texture_threshold,
                "Foliage boxes whose volume / root volume exceeds this get six textures (0 <= R < 1)")
-        ->check(CLI::Range(0.0, 0.999999));
+            ->check(CLI::Range(0.0, 0.999999));
     table->add("--texture-size", o->texture_size, "Texture width and height in pixels")->check(CLI::Range(8, 1024));
     table->add_flag("--texture-planes", o->texture_planes, "Also write every texture as its own PNG (textures/)");
     table->add("--small-foliage", o->small_foliage,
                "Leaves of unreached sub-branches below the texture threshold: geometry (default) or omit")
-        ->check(CLI::IsMember({"geometry", "omit"}));
+            ->check(CLI::IsMember({"geometry", "omit"}));
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_multires(*o, *table, global); }; });
 }
 

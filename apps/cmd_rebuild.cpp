@@ -120,8 +120,8 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> world_bounds(const TriangleMesh& mes
 struct SpeciesChoice {
     std::string reconstruction;  // empty: generic parameters
     std::string patches;
-    std::string source;          // "given", "classifier", "default"
-    double probability = 0;      // classifier only
+    std::string source;      // "given", "classifier", "default"
+    double probability = 0;  // classifier only
 };
 
 SpeciesChoice choose_species(const RebuildCliOptions& o, const PointCloud& samples) {
@@ -143,9 +143,13 @@ SpeciesChoice choose_species(const RebuildCliOptions& o, const PointCloud& sampl
 }
 
 json distance_json(const lobes::DistanceSummary& d, double diagonal) {
-    return {{"mean", rounded(d.mean, 4)},         {"median", rounded(d.median, 4)}, {"p95", rounded(d.p95, 4)},
-            {"max", rounded(d.max, 4)},           {"mean_of_diagonal", rounded(d.mean / diagonal, 5)},
-            {"p95_of_diagonal", rounded(d.p95 / diagonal, 5)}, {"max_of_diagonal", rounded(d.max / diagonal, 5)}};
+    return {{"mean", rounded(d.mean, 4)},
+            {"median", rounded(d.median, 4)},
+            {"p95", rounded(d.p95, 4)},
+            {"max", rounded(d.max, 4)},
+            {"mean_of_diagonal", rounded(d.mean / diagonal, 5)},
+            {"p95_of_diagonal", rounded(d.p95 / diagonal, 5)},
+            {"max_of_diagonal", rounded(d.max / diagonal, 5)}};
 }
 
 // Metro-style comparison (Cignoni et al. 1998): both surfaces sampled alike, each sample's
@@ -179,7 +183,7 @@ json silhouette_ious(const TriangleMesh& original, const TriangleMesh& rebuilt, 
     top.lo = lo;
     top.hi = hi;
     const std::pair<const char*, render::View> views[] = {
-        {"front", render::View::side(lo, hi, 0, 0)}, {"side", render::View::side(lo, hi, 90, 0)}, {"top", top}};
+            {"front", render::View::side(lo, hi, 0, 0)}, {"side", render::View::side(lo, hi, 90, 0)}, {"top", top}};
     json ious = json::object();
     for (const auto& [name, view] : views) {
         render::Rasterizer a(kSize, kSize, view), b(kSize, kSize, view);
@@ -191,8 +195,9 @@ json silhouette_ious(const TriangleMesh& original, const TriangleMesh& rebuilt, 
 }
 
 // original | samples | rebuilt, one camera framing the original (side view, 10 degrees up).
-void write_comparison_png(const fs::path& path, const TriangleMesh& original, const std::vector<std::uint8_t>& wood, const PointCloud& samples,
-                          const lobes::SynthesizedMesh& rebuilt, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, int height) {
+void write_comparison_png(const fs::path& path, const TriangleMesh& original, const std::vector<std::uint8_t>& wood,
+                          const PointCloud& samples, const lobes::SynthesizedMesh& rebuilt, const Eigen::Vector3d& lo,
+                          const Eigen::Vector3d& hi, int height) {
     const render::View view = render::View::side(lo, hi, 0, 10);
     const double across = std::max(hi.x() - lo.x(), hi.y() - lo.y()), tall = std::max(1e-6, hi.z() - lo.z());
     const int width = std::clamp(static_cast<int>(height * across / tall * 1.05), height / 4, 2 * height);
@@ -234,15 +239,18 @@ void print_summary(const json& r) {
     std::printf("  mesh     %.2f MB, %zu triangles (%zu wood, %zu leaf)\n", s["original_bytes"].get<double>() / 1e6,
                 r["input_mesh"]["triangles"].get<std::size_t>(), r["input_mesh"]["labels"]["wood_faces"].get<std::size_t>(),
                 r["input_mesh"]["labels"]["leaf_faces"].get<std::size_t>());
-    std::printf("  samples  %zu (%s), species %s (%s)\n", r["samples"]["points"].get<std::size_t>(), r["samples"]["pattern"].get<std::string>().c_str(),
-                r["species"]["patches"].get<std::string>().c_str(), r["species"]["source"].get<std::string>().c_str());
+    std::printf("  samples  %zu (%s), species %s (%s)\n", r["samples"]["points"].get<std::size_t>(),
+                r["samples"]["pattern"].get<std::string>().c_str(), r["species"]["patches"].get<std::string>().c_str(),
+                r["species"]["source"].get<std::string>().c_str());
     std::printf("  .tlobe   %.1f kB (%.0fx smaller), .dbf6 %.1f kB, %zu lobes\n", s["tlobe_bytes"].get<double>() / 1e3,
                 s["compression_factor"].get<double>(), s["dbf6_bytes"].get<double>() / 1e3, r["lobes"]["count"].get<std::size_t>());
     std::printf("  rebuilt  %zu triangles; distance mean %.3f m (%.2f %% of the diagonal), p95 %.3f m, Hausdorff %.3f m\n",
                 r["rebuilt"]["triangles"].get<std::size_t>(), f["symmetric"]["mean"].get<double>(),
-                100 * f["symmetric"]["mean_of_diagonal"].get<double>(), f["symmetric"]["p95"].get<double>(), f["symmetric"]["max"].get<double>());
-    std::printf("  silhouette IoU front %.2f, side %.2f, top %.2f; leaf area %.1f -> %.1f m^2\n", f["silhouette_iou"]["front"].get<double>(),
-                f["silhouette_iou"]["side"].get<double>(), f["silhouette_iou"]["top"].get<double>(), f["leaf_area"]["original_m2"].get<double>(),
+                100 * f["symmetric"]["mean_of_diagonal"].get<double>(), f["symmetric"]["p95"].get<double>(),
+                f["symmetric"]["max"].get<double>());
+    std::printf("  silhouette IoU front %.2f, side %.2f, top %.2f; leaf area %.1f -> %.1f m^2\n",
+                f["silhouette_iou"]["front"].get<double>(), f["silhouette_iou"]["side"].get<double>(),
+                f["silhouette_iou"]["top"].get<double>(), f["leaf_area"]["original_m2"].get<double>(),
                 f["leaf_area"]["rebuilt_m2"].get<double>());
     std::printf("  %.1f s (%.1f s CPU), peak memory %.0f MB\n", r["seconds"]["total"].get<double>(), r["seconds"]["cpu"].get<double>(),
                 r["peak_memory_mb"].get<double>());
@@ -258,7 +266,8 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     sampling.density = o.density;
     sampling.stations = o.stations;
     sampling.seed = o.seed;
-    if (o.density > 0 && sampling.pattern != synth::SamplePattern::Uniform) throw Error::usage("--density is for --scan uniform; scans take --samples");
+    if (o.density > 0 && sampling.pattern != synth::SamplePattern::Uniform)
+        throw Error::usage("--density is for --scan uniform; scans take --samples");
     synth::MeshLabelOptions labelling;
     if (!o.leaf_materials.empty()) {
         labelling.leaf_words = synth::parse_word_list(o.leaf_materials);
@@ -348,52 +357,88 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     json seconds = clock.seconds();
     seconds["total"] = rounded(std::chrono::duration<double>(Clock::now() - started).count(), 3);
     seconds["cpu"] = rounded(cpu_seconds(), 3);  // all threads; on a busy machine a steadier figure than the wall time
-    json report = {
-        {"treelobes", kVersion},
-        {"command", "rebuild"},
-        {"input", o.input},
-        {"out", o.out},
-        {"options", table.json()},
-        {"input_mesh", {{"format", named.report.format}, {"bytes", original_bytes}, {"vertices", original.vertices.size()},
-                        {"triangles", original.faces.size()}, {"polygons_split", named.report.polygons_split},
-                        {"degenerate_faces_dropped", named.report.degenerate_faces}, {"normals_ignored", named.report.normals_ignored},
-                        {"named_parts", named.names.size()},
-                        {"origin", {original.origin.x(), original.origin.y(), original.origin.z()}},
-                        {"bbox_diagonal_m", rounded(diagonal, 4)},
-                        {"area_m2", rounded(sample_report.surface_area, 3)},
-                        {"labels", {{"wood_faces", label_report.wood_by_name + label_report.wood_by_geometry},
-                                    {"leaf_faces", label_report.leaf_by_name + label_report.leaf_by_geometry},
-                                    {"wood_by_name", label_report.wood_by_name}, {"leaf_by_name", label_report.leaf_by_name},
-                                    {"wood_by_geometry", label_report.wood_by_geometry}, {"leaf_by_geometry", label_report.leaf_by_geometry},
-                                    {"geometry_parts", label_report.parts}, {"leaf_parts", label_report.leaf_parts},
-                                    {"wood_area_m2", rounded(label_report.wood_area, 3)}, {"leaf_area_m2", rounded(label_report.leaf_area, 3)}}}}},
-        {"samples", {{"pattern", synth::sample_pattern_name(sampling.pattern)}, {"points", samples.size()},
-                     {"wood", sample_report.wood_points}, {"leaf", sample_report.leaf_points}, {"pulses", sample_report.pulses},
-                     {"scanned_points", sample_report.scanned_points}, {"angular_step_deg", rounded(sample_report.angular_step_deg, 4)},
+    json report = {{"treelobes", kVersion},
+                   {"command", "rebuild"},
+                   {"input", o.input},
+                   {"out", o.out},
+                   {"options", table.json()},
+                   {"input_mesh",
+                    {{"format", named.report.format},
+                     {"bytes", original_bytes},
+                     {"vertices", original.vertices.size()},
+                     {"triangles", original.faces.size()},
+                     {"polygons_split", named.report.polygons_split},
+                     {"degenerate_faces_dropped", named.report.degenerate_faces},
+                     {"normals_ignored", named.report.normals_ignored},
+                     {"named_parts", named.names.size()},
+                     {"origin", {original.origin.x(), original.origin.y(), original.origin.z()}},
+                     {"bbox_diagonal_m", rounded(diagonal, 4)},
+                     {"area_m2", rounded(sample_report.surface_area, 3)},
+                     {"labels",
+                      {{"wood_faces", label_report.wood_by_name + label_report.wood_by_geometry},
+                       {"leaf_faces", label_report.leaf_by_name + label_report.leaf_by_geometry},
+                       {"wood_by_name", label_report.wood_by_name},
+                       {"leaf_by_name", label_report.leaf_by_name},
+                       {"wood_by_geometry", label_report.wood_by_geometry},
+                       {"leaf_by_geometry", label_report.leaf_by_geometry},
+                       {"geometry_parts", label_report.parts},
+                       {"leaf_parts", label_report.leaf_parts},
+                       {"wood_area_m2", rounded(label_report.wood_area, 3)},
+                       {"leaf_area_m2", rounded(label_report.leaf_area, 3)}}}}},
+                   {"samples",
+                    {{"pattern", synth::sample_pattern_name(sampling.pattern)},
+                     {"points", samples.size()},
+                     {"wood", sample_report.wood_points},
+                     {"leaf", sample_report.leaf_points},
+                     {"pulses", sample_report.pulses},
+                     {"scanned_points", sample_report.scanned_points},
+                     {"angular_step_deg", rounded(sample_report.angular_step_deg, 4)},
                      {"pulse_density", rounded(sample_report.pulse_density, 2)}}},
-        {"species", {{"reconstruction", species.reconstruction.empty() ? json() : json(species.reconstruction)},
-                     {"patches", profile.entry.name}, {"source", species.source},
+                   {"species",
+                    {{"reconstruction", species.reconstruction.empty() ? json() : json(species.reconstruction)},
+                     {"patches", profile.entry.name},
+                     {"source", species.source},
                      {"probability", species.source == "classifier" ? json(rounded(species.probability, 4)) : json()}}},
-        {"reconstruction", {{"internodes", reconstruction.summary.internodes}, {"height_m", rounded(reconstruction.summary.height, 3)},
-                            {"used_points", reconstruction.summary.used_points}, {"branches", reconstruction.summary.branches}}},
-        {"lobes", {{"count", tree.lobes.size()}, {"faces", lobe_faces}, {"main_nodes", tree.skeleton.size()},
-                   {"points_in_lobes", lobe_report.lobe_points}}},
-        {"sizes", {{"original_bytes", original_bytes}, {"tlobe_bytes", tlobe_bytes.size()}, {"dbf6_bytes", dbf6_bytes},
-                   {"budget_bytes", file_options.max_bytes}, {"within_budget", tlobe_bytes.size() <= file_options.max_bytes},
-                   {"compression_factor", rounded(original_bytes / static_cast<double>(tlobe_bytes.size()), 1)},
-                   {"compression_factor_dbf6", dbf6_bytes > 0 ? json(rounded(original_bytes / dbf6_bytes, 1)) : json()}}},
-        {"rebuilt", {{"triangles", rebuilt.triangles()}, {"wood_triangles", rebuilt.wood.faces.size()},
-                     {"leaf_triangles", rebuilt.leaves.faces.size()}, {"leaves", rebuilt.leaf_count},
+                   {"reconstruction",
+                    {{"internodes", reconstruction.summary.internodes},
+                     {"height_m", rounded(reconstruction.summary.height, 3)},
+                     {"used_points", reconstruction.summary.used_points},
+                     {"branches", reconstruction.summary.branches}}},
+                   {"lobes",
+                    {{"count", tree.lobes.size()},
+                     {"faces", lobe_faces},
+                     {"main_nodes", tree.skeleton.size()},
+                     {"points_in_lobes", lobe_report.lobe_points}}},
+                   {"sizes",
+                    {{"original_bytes", original_bytes},
+                     {"tlobe_bytes", tlobe_bytes.size()},
+                     {"dbf6_bytes", dbf6_bytes},
+                     {"budget_bytes", file_options.max_bytes},
+                     {"within_budget", tlobe_bytes.size() <= file_options.max_bytes},
+                     {"compression_factor", rounded(original_bytes / static_cast<double>(tlobe_bytes.size()), 1)},
+                     {"compression_factor_dbf6", dbf6_bytes > 0 ? json(rounded(original_bytes / dbf6_bytes, 1)) : json()}}},
+                   {"rebuilt",
+                    {{"triangles", rebuilt.triangles()},
+                     {"wood_triangles", rebuilt.wood.faces.size()},
+                     {"leaf_triangles", rebuilt.leaves.faces.size()},
+                     {"leaves", rebuilt.leaf_count},
                      {"mesh_bytes", file_bytes(mesh_path)}}},
-        {"fidelity", fidelity},
-        {"outputs", {{"tlobe", tlobe_path.string()}, {"dbf6", dbf6_path.string()}, {"mesh", mesh_path.string()},
-                     {"skeleton", skeleton_path.string()}, {"samples", samples_path.string()}, {"comparison_png", png_path.string()},
+                   {"fidelity", fidelity},
+                   {"outputs",
+                    {{"tlobe", tlobe_path.string()},
+                     {"dbf6", dbf6_path.string()},
+                     {"mesh", mesh_path.string()},
+                     {"skeleton", skeleton_path.string()},
+                     {"samples", samples_path.string()},
+                     {"comparison_png", png_path.string()},
                      {"report", report_path.string()}}},
-        {"seconds", seconds},
-        {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
+                   {"seconds", seconds},
+                   {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
     write_file_atomically(report_path, report.dump(2) + "\n");
-    if (global.json) std::cout << report.dump(2) << "\n";
-    else print_summary(report);
+    if (global.json)
+        std::cout << report.dump(2) << "\n";
+    else
+        print_summary(report);
     return 0;
 }
 
@@ -403,27 +448,35 @@ void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<RebuildCliOptions>();
     o->synthesis.max_triangles = 200000;
     o->flags.species = "auto";
-    CLI::App* sub = app.add_subcommand("rebuild", "A heavy polygonal tree (OBJ/PLY/OFF/STL) in, a light lobe-based tree (.tlobe, .dbf6) out, with a fidelity report");
+    CLI::App* sub = app.add_subcommand(
+            "rebuild", "A heavy polygonal tree (OBJ/PLY/OFF/STL) in, a light lobe-based tree (.tlobe, .dbf6) out, with a fidelity report");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("mesh", o->input, "Tree model: .obj (materials/groups name bark and leaves), .ply, .off, .stl")->required();
-    table->add("--out", o->out, "Output folder: <stem>.tlobe, .dbf6, _rebuilt.ply, _skeleton.ply, _samples.ply, _compare.png, report.json")->required();
+    table->add("--out", o->out, "Output folder: <stem>.tlobe, .dbf6, _rebuilt.ply, _skeleton.ply, _samples.ply, _compare.png, report.json")
+            ->required();
     add_species_flags(*table, o->flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')", o->stage);
-    sub->get_option("--species")->description("Species from config/species.yaml, or auto: the classifier's choice with --model, else generic parameters and lagerstroemia patches")
-        ->capture_default_str();
+    sub->get_option("--species")
+            ->description(
+                    "Species from config/species.yaml, or auto: the classifier's choice with --model, else generic parameters and "
+                    "lagerstroemia patches")
+            ->capture_default_str();
     table->add("--model", o->model, "JointBoost model (`classify train`) that picks the species for --species auto");
-    table->add("--scan", o->scan, "Sampling: uniform (area-weighted on the surface), tls (terrestrial scanner around the model), als (airborne)")
-        ->check(CLI::IsMember({"uniform", "tls", "als"}));
+    table->add("--scan", o->scan,
+               "Sampling: uniform (area-weighted on the surface), tls (terrestrial scanner around the model), als (airborne)")
+            ->check(CLI::IsMember({"uniform", "tls", "als"}));
     table->add("--samples", o->samples, "Points sampled (scans: at most, about this many)")->check(CLI::Range(100, 50000000));
     table->add("--density", o->density, "Uniform sampling: points per m^2 of surface instead of --samples")->check(PositiveNumber);
     table->add("--stations", o->stations, "TLS stations around the model")->check(CLI::Range(1, 16));
     table->add("--seed", o->seed, "Random seed of sampling and synthesis");
     table->add("--budget-kb", o->budget_kb, "Size the .tlobe may take (kB); its lobe occupancy grid is coarsened to fit")
-        ->check(CLI::Range(2.0, 10000.0));
-    table->add("--leaf-materials", o->leaf_materials, "Comma-separated names (substrings, any case) of leaf materials/groups/objects; other named faces are wood");
-    table->add("--max-triangles", o->synthesis.max_triangles, "Triangles of the synthesized tree at most")->check(CLI::Range(1000, 1000000000));
+            ->check(CLI::Range(2.0, 10000.0));
+    table->add("--leaf-materials", o->leaf_materials,
+               "Comma-separated names (substrings, any case) of leaf materials/groups/objects; other named faces are wood");
+    table->add("--max-triangles", o->synthesis.max_triangles, "Triangles of the synthesized tree at most")
+            ->check(CLI::Range(1000, 1000000000));
     table->add("--dbf6-resolution", o->dbf6_resolution, "DBF6 resolution r of the skeleton file")->check(PositiveNumber);
     table->add("--compare-samples", o->compare_samples, "Samples per surface for the distances original <-> rebuilt")
-        ->check(CLI::Range(1000, 10000000));
+            ->check(CLI::Range(1000, 10000000));
     table->add("--image-height", o->image_height, "Height of the comparison PNG, pixels")->check(CLI::Range(64, 4096));
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_rebuild(*o, *table, global); }; });
 }

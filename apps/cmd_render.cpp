@@ -39,12 +39,12 @@ namespace {
 struct RenderOptions {
     std::vector<std::string> inputs;
     std::string out;
-    int size = 800;             // panel height in pixels
-    double azimuth = 0;         // degrees around the vertical axis
-    double elevation = 10;      // degrees above the horizon
-    std::string view;           // front, side, top, orbit (the first three override azimuth and elevation)
-    int frames = 24;            // orbit: frames per turn
-    int frame_ms = 100;         // orbit: time each frame is shown
+    int size = 800;         // panel height in pixels
+    double azimuth = 0;     // degrees around the vertical axis
+    double elevation = 10;  // degrees above the horizon
+    std::string view;       // front, side, top, orbit (the first three override azimuth and elevation)
+    int frames = 24;        // orbit: frames per turn
+    int frame_ms = 100;     // orbit: time each frame is shown
     std::string colour = "plain";
     bool contact_sheet = false;  // one labelled panel per tree of a tile output folder
     int columns = 0;             // contact sheet columns (0: about square)
@@ -63,16 +63,16 @@ struct Subject {
 template <typename Visit>
 void for_each_point(const Drawable& item, Visit&& visit) {
     std::visit(
-        [&](const auto& thing) {
-            using T = std::decay_t<decltype(thing)>;
-            if constexpr (std::is_same_v<T, PointCloud>)
-                for (const auto& p : thing.positions) visit(thing.origin + p.template cast<double>());
-            else if constexpr (std::is_same_v<T, TriangleMesh>)
-                for (const auto& p : thing.vertices) visit(thing.origin + p.template cast<double>());
-            else
-                for (const auto& n : thing.nodes) visit(thing.origin + n.position.template cast<double>());
-        },
-        item);
+            [&](const auto& thing) {
+                using T = std::decay_t<decltype(thing)>;
+                if constexpr (std::is_same_v<T, PointCloud>)
+                    for (const auto& p : thing.positions) visit(thing.origin + p.template cast<double>());
+                else if constexpr (std::is_same_v<T, TriangleMesh>)
+                    for (const auto& p : thing.vertices) visit(thing.origin + p.template cast<double>());
+                else
+                    for (const auto& n : thing.nodes) visit(thing.origin + n.position.template cast<double>());
+            },
+            item);
 }
 
 void bounds_of(const Drawable& item, Eigen::Vector3d& lo, Eigen::Vector3d& hi) {
@@ -118,7 +118,8 @@ std::vector<render::Rgba> species_colours(const PointCloud& cloud, const std::ve
     std::vector<render::Rgba> colours;
     colours.reserve(cloud.size());
     for (int index : species.of_point) colours.push_back(index < 0 ? unknown_species_colour : palette[index]);
-    if (std::find(species.of_point.begin(), species.of_point.end(), -1) != species.of_point.end()) legend["(none)"] = unknown_species_colour;
+    if (std::find(species.of_point.begin(), species.of_point.end(), -1) != species.of_point.end())
+        legend["(none)"] = unknown_species_colour;
     return colours;
 }
 
@@ -170,16 +171,21 @@ render::Image draw(const Subject& subject, const RenderOptions& options, const r
     render::Rasterizer r(width, height, view);
     const std::string& colour = options.colour;
     std::visit(
-        [&](const auto& thing) {
-            using T = std::decay_t<decltype(thing)>;
-            if constexpr (std::is_same_v<T, PointCloud>) {
-                if (!subject.point_colours.empty()) r.draw_points(world_points(thing), subject.point_colours, 2);
-                else r.draw_points(thing, {40, 90, 40, 255}, 2);
-            } else if constexpr (std::is_same_v<T, TriangleMesh>) r.draw_mesh(thing, {150, 110, 70, 255});
-            else if (colour == "radius" || colour == "order") draw_coloured_skeleton(r, thing, colour);
-            else r.draw_skeleton(thing, {120, 30, 20, 255});
-        },
-        subject.item);
+            [&](const auto& thing) {
+                using T = std::decay_t<decltype(thing)>;
+                if constexpr (std::is_same_v<T, PointCloud>) {
+                    if (!subject.point_colours.empty())
+                        r.draw_points(world_points(thing), subject.point_colours, 2);
+                    else
+                        r.draw_points(thing, {40, 90, 40, 255}, 2);
+                } else if constexpr (std::is_same_v<T, TriangleMesh>)
+                    r.draw_mesh(thing, {150, 110, 70, 255});
+                else if (colour == "radius" || colour == "order")
+                    draw_coloured_skeleton(r, thing, colour);
+                else
+                    r.draw_skeleton(thing, {120, 30, 20, 255});
+            },
+            subject.item);
     return r.image();
 }
 
@@ -267,18 +273,22 @@ render::Image draw_contact_sheet(const std::string& path, const RenderOptions& o
         const render::View view = make_view(options, lo, hi);
         aspects.push_back(view.aspect());
         panels.push_back({&tree, std::move(subject), view});
-        if (options.colour == "species") legend[tree.species.empty() ? "(none)" : tree.species] = tree.species.empty() ? unknown_species_colour : species_colour(tree.species);
+        if (options.colour == "species")
+            legend[tree.species.empty() ? "(none)" : tree.species] =
+                    tree.species.empty() ? unknown_species_colour : species_colour(tree.species);
     }
     if (panels.empty()) throw Error::input(path, "no tree with points in the tile output");
     std::nth_element(aspects.begin(), aspects.begin() + aspects.size() / 2, aspects.end());
     const int height = options.size, width = std::clamp(static_cast<int>(std::lround(height * aspects[aspects.size() / 2])), 32, 4096);
     const int scale = std::max(1, height / 100), label_height = render::text_height(scale) + 4 * scale;
-    const int columns = options.columns > 0 ? options.columns : std::max(1, static_cast<int>(std::ceil(std::sqrt(panels.size() * double(height) / width))));
+    const int columns = options.columns > 0 ? options.columns
+                                            : std::max(1, static_cast<int>(std::ceil(std::sqrt(panels.size() * double(height) / width))));
     const int rows = static_cast<int>((panels.size() + columns - 1) / columns);
     const int gap = 2 * scale;
     render::Image sheet(columns * (width + gap) + gap, rows * (height + label_height + gap) + gap, {255, 255, 255, 255});
     for (std::size_t k = 0; k < panels.size(); ++k) {
-        const int x0 = gap + static_cast<int>(k % columns) * (width + gap), y0 = gap + static_cast<int>(k / columns) * (height + label_height + gap);
+        const int x0 = gap + static_cast<int>(k % columns) * (width + gap),
+                  y0 = gap + static_cast<int>(k / columns) * (height + label_height + gap);
         sheet.fill_rect(x0, y0, x0 + width, y0 + label_height, {235, 235, 235, 255});
         render::draw_text(sheet, x0 + 2 * scale, y0 + 2 * scale, tree_label(*panels[k].tree), scale, {20, 20, 20, 255});
         const render::Image image = draw(panels[k].subject, options, panels[k].view, width, height);
@@ -301,8 +311,10 @@ int run_render(const RenderOptions& options, const OptionTable& table, const Glo
         summary["trees"] = trees;
         summary["width"] = sheet.width;
         summary["height"] = sheet.height;
-        if (global.json) std::cout << summary.dump(2) << "\n";
-        else std::cout << "wrote " << options.out << " (" << trees << " trees)\n";
+        if (global.json)
+            std::cout << summary.dump(2) << "\n";
+        else
+            std::cout << "wrote " << options.out << " (" << trees << " trees)\n";
         return 0;
     }
     std::vector<Subject> subjects;
@@ -329,7 +341,8 @@ int run_render(const RenderOptions& options, const OptionTable& table, const Glo
         summary["height"] = image.height;
     }
     if (!legend.empty()) summary["species"] = legend_entries(legend).size() - legend.count("(none)");
-    if (global.json) std::cout << summary.dump(2) << "\n";
+    if (global.json)
+        std::cout << summary.dump(2) << "\n";
     else
         std::cout << "wrote " << options.out << " (" << subjects.size() << " panel(s)"
                   << (summary.contains("frames") ? ", " + summary["frames"].dump() + " frames" : std::string()) << ")\n";
@@ -342,19 +355,25 @@ void add_render_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<RenderOptions>();
     CLI::App* sub = app.add_subcommand("render", "Draw point clouds, meshes, skeletons and tile outputs side by side into a PNG");
     auto table = std::make_shared<OptionTable>(sub);
-    sub->add_option("inputs", options->inputs, "Point clouds, meshes (PLY/OBJ/OFF), skeleton PLYs or tile output folders (their points.las)")->required();
+    sub->add_option("inputs", options->inputs,
+                    "Point clouds, meshes (PLY/OBJ/OFF), skeleton PLYs or tile output folders (their points.las)")
+            ->required();
     table->add("--out,-o", options->out, "Output PNG")->required();
     table->add("--size", options->size, "Panel height in pixels")->check(CLI::Range(64, 4096));
     table->add("--azimuth", options->azimuth, "View direction around the vertical axis, degrees");
-    table->add("--elevation", options->elevation, "View elevation above the horizon, degrees")
-        ->check(CLI::Range(-90.0, 90.0));
-    table->add("--view", options->view, "front (along +y), side (along -x) or top (down), overriding --azimuth/--elevation; orbit: an animated PNG turning once around the vertical axis from --azimuth at --elevation")
-        ->check(CLI::IsMember({"front", "side", "top", "orbit"}));
+    table->add("--elevation", options->elevation, "View elevation above the horizon, degrees")->check(CLI::Range(-90.0, 90.0));
+    table->add("--view", options->view,
+               "front (along +y), side (along -x) or top (down), overriding --azimuth/--elevation; orbit: an animated PNG turning once "
+               "around the vertical axis from --azimuth at --elevation")
+            ->check(CLI::IsMember({"front", "side", "top", "orbit"}));
     table->add("--frames", options->frames, "--view orbit: frames per turn")->check(CLI::Range(2, 360));
     table->add("--frame-ms", options->frame_ms, "--view orbit: milliseconds each frame is shown")->check(CLI::Range(10, 10000));
-    table->add("--color", options->colour, "plain; clouds: height, tree (treeID) or species (species attribute, or trees.csv of a tile output folder; with a legend); skeletons: radius or order (branch order)")
-        ->check(CLI::IsMember({"plain", "height", "tree", "species", "radius", "order"}));
-    table->add_flag("--contact-sheet", options->contact_sheet, "One tile output folder: every tree in its own panel (filling it), sorted by id, labelled with id, species and height");
+    table->add("--color", options->colour,
+               "plain; clouds: height, tree (treeID) or species (species attribute, or trees.csv of a tile output folder; with a legend); "
+               "skeletons: radius or order (branch order)")
+            ->check(CLI::IsMember({"plain", "height", "tree", "species", "radius", "order"}));
+    table->add_flag("--contact-sheet", options->contact_sheet,
+                    "One tile output folder: every tree in its own panel (filling it), sorted by id, labelled with id, species and height");
     table->add("--columns", options->columns, "--contact-sheet: panels per row (0: about square)")->check(CLI::Range(0, 1000));
     sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_render(*options, *table, global); }; });
 }

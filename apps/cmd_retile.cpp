@@ -43,12 +43,12 @@ int run_retile(const RetileCliOptions& o, const OptionTable& table, const Global
         written_points += tile.points;
     }
     if (global.json) {
-        const nlohmann::json summary = {{"command", "retile"}, {"inputs", o.inputs}, {"options", table.json()}, {"size", o.retile.size},
-                                        {"points", written_points}, {"tiles", listed}};
+        const nlohmann::json summary = {{"command", "retile"},   {"inputs", o.inputs},       {"options", table.json()},
+                                        {"size", o.retile.size}, {"points", written_points}, {"tiles", listed}};
         std::cout << summary.dump(2) << "\n";
     } else {
-        std::printf("retile: %zu inputs, %zu points -> %zu tiles of %g m in %s\n", o.inputs.size(), written_points, tiles.size(), o.retile.size,
-                    o.out.c_str());
+        std::printf("retile: %zu inputs, %zu points -> %zu tiles of %g m in %s\n", o.inputs.size(), written_points, tiles.size(),
+                    o.retile.size, o.out.c_str());
     }
     return 0;
 }
@@ -57,15 +57,17 @@ int run_retile(const RetileCliOptions& o, const OptionTable& table, const Global
 
 void add_retile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<RetileCliOptions>();
-    CLI::App* sub = app.add_subcommand("retile", "Cut point clouds into square LAS 1.4 tiles (CRS, scale and offset kept), named by their "
-                                                 "lower-left corner, for `treelobes batch` (docs/survey.md)");
+    CLI::App* sub = app.add_subcommand("retile",
+                                       "Cut point clouds into square LAS 1.4 tiles (CRS, scale and offset kept), named by their "
+                                       "lower-left corner, for `treelobes batch` (docs/survey.md)");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("inputs", o->inputs, "Point clouds (LAS, PLY, PCD, XYZ), one CRS")->required()->check(CLI::ExistingFile);
     table->add("--size", o->retile.size, "Tile side, metres")->required()->check(PositiveNumber);
     table->add("--out", o->out, "Output folder")->required();
     table->add("--prefix", o->retile.prefix, "File name prefix: <prefix>_<x>_<y>.las");
-    table->add("--max-memory", o->max_memory, "Refuse inputs whose header point counts need more memory than this (e.g. 8G; default: "
-                                              "half of the RAM)");
+    table->add("--max-memory", o->max_memory,
+               "Refuse inputs whose header point counts need more memory than this (e.g. 8G; default: "
+               "half of the RAM)");
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_retile(*o, *table, global); }; });
 }
 

@@ -119,13 +119,16 @@ void apply_beam(SynthFlags& f) {
     if (f.separation) beam.min_separation_m = *f.separation;
     if (f.threshold) beam.detection_threshold = *f.threshold;
     f.grow.leaves = !f.no_leaves;
-    if (f.scanner == "als") synth::check_options(f.als);
-    else synth::check_options(f.tls);
+    if (f.scanner == "als")
+        synth::check_options(f.als);
+    else
+        synth::check_options(f.tls);
 }
 
 json beam_json(const synth::BeamOptions& b) {
-    return {{"divergence_mrad", b.divergence_mrad}, {"sub_rays", b.sub_rays},      {"range_noise_m", b.range_noise_m},
-            {"max_returns", b.max_returns},         {"min_separation_m", b.min_separation_m}, {"detection_threshold", b.detection_threshold}};
+    return {{"divergence_mrad", b.divergence_mrad},   {"sub_rays", b.sub_rays},
+            {"range_noise_m", b.range_noise_m},       {"max_returns", b.max_returns},
+            {"min_separation_m", b.min_separation_m}, {"detection_threshold", b.detection_threshold}};
 }
 
 json scanner_json(const SynthFlags& f) {
@@ -169,9 +172,15 @@ fs::path prepare_folder(const std::string& out) {
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
 
 json metrics_json(const synth::TreeMetrics& m, double age) {
-    return {{"height_m", m.height_m},         {"dbh_m", m.dbh_m},         {"crown_diameter_m", m.crown_diameter_m},
-            {"age_years", age},                {"internodes", m.internodes}, {"leaves", m.leaves},
-            {"leaf_area_m2", m.leaf_area_m2}, {"lai", m.lai},             {"skeleton_length_m", m.total_length_m}};
+    return {{"height_m", m.height_m},
+            {"dbh_m", m.dbh_m},
+            {"crown_diameter_m", m.crown_diameter_m},
+            {"age_years", age},
+            {"internodes", m.internodes},
+            {"leaves", m.leaves},
+            {"leaf_area_m2", m.leaf_area_m2},
+            {"lai", m.lai},
+            {"skeleton_length_m", m.total_length_m}};
 }
 
 // The two panels next to each other on a white background.
@@ -192,7 +201,8 @@ void write_previews(const synth::TreeMesh& mesh, const PointCloud& cloud, const 
     for (const auto& v : mesh.leaves.vertices) lo = lo.cwiseMin(v.cast<double>()), hi = hi.cwiseMax(v.cast<double>());
     if (!(lo.x() <= hi.x())) return;
     const render::View view = render::View::side(lo, hi, 0.0, 10.0);
-    const int width = std::max(200, static_cast<int>(height * std::max(hi.x() - lo.x(), hi.y() - lo.y()) / std::max(1e-6, hi.z() - lo.z())));
+    const int width =
+            std::max(200, static_cast<int>(height * std::max(hi.x() - lo.x(), hi.y() - lo.y()) / std::max(1e-6, hi.z() - lo.z())));
     render::Rasterizer tree(width, height, view);
     tree.draw_mesh(mesh.wood, {110, 75, 45, 255});
     tree.draw_mesh(mesh.leaves, {70, 140, 50, 255});
@@ -253,8 +263,10 @@ TreeResult make_tree(const SpeciesProfile& profile, std::uint64_t seed, const Sy
 }
 
 void print_or_json(const json& summary, const GlobalOptions& global, const std::string& human) {
-    if (global.json) std::cout << summary.dump(2) << "\n";
-    else std::cout << human;
+    if (global.json)
+        std::cout << summary.dump(2) << "\n";
+    else
+        std::cout << human;
 }
 
 std::string format(const char* pattern, double a, double b = 0, double c = 0) {
@@ -289,13 +301,13 @@ int run_tree(SynthFlags f, const TreeFlags& t, const OptionTable& table, const G
     summary["seconds"] = seconds_since(start);
     summary["peak_memory_mb"] = peak_memory_mb();
     const json& tree = r.truth["tree"];
-    print_or_json(summary, global,
-                  profile.entry.display_name + " (seed " + std::to_string(f.seed) + "): " +
-                      format("height %.1f m, DBH %.2f m, crown %.1f m", tree["height_m"], tree["dbh_m"], tree["crown_diameter_m"]) + ", " +
-                      std::to_string(tree["internodes"].get<std::size_t>()) + " internodes, " +
-                      std::to_string(tree["leaves"].get<std::size_t>()) + " leaves\n" + f.scanner + " scan: " +
-                      std::to_string(r.points) + " points -> " + (folder / (name + "." + f.cloud_format)).string() +
-                      format(" (%.1f s)\n", summary["seconds"]));
+    print_or_json(
+            summary, global,
+            profile.entry.display_name + " (seed " + std::to_string(f.seed) +
+                    "): " + format("height %.1f m, DBH %.2f m, crown %.1f m", tree["height_m"], tree["dbh_m"], tree["crown_diameter_m"]) +
+                    ", " + std::to_string(tree["internodes"].get<std::size_t>()) + " internodes, " +
+                    std::to_string(tree["leaves"].get<std::size_t>()) + " leaves\n" + f.scanner + " scan: " + std::to_string(r.points) +
+                    " points -> " + (folder / (name + "." + f.cloud_format)).string() + format(" (%.1f s)\n", summary["seconds"]));
     return 0;
 }
 
@@ -351,7 +363,8 @@ int run_dataset(SynthFlags f, const DatasetFlags& d, const OptionTable& table, c
                 log_warn(file + ": " + e.what());
             } catch (const json::exception& e) {
                 ++failed;
-                failures += json{{"item", file}, {"seed", seed}, {"reason", std::string("unreadable truth file: ") + e.what()}}.dump() + "\n";
+                failures +=
+                        json{{"item", file}, {"seed", seed}, {"reason", std::string("unreadable truth file: ") + e.what()}}.dump() + "\n";
             }
             progress.advance();
         }
@@ -378,8 +391,8 @@ int run_dataset(SynthFlags f, const DatasetFlags& d, const OptionTable& table, c
     write_file_atomically(folder / "summary.json", summary.dump(2) + "\n");
     print_or_json(summary, global,
                   std::to_string(made + skipped) + " trees of " + std::to_string(chosen.size()) + " species (" + std::to_string(made) +
-                      " made, " + std::to_string(skipped) + " kept, " + std::to_string(failed) + " failed), " + std::to_string(points) +
-                      " points -> " + (folder / "labels.csv").string() + format(" (%.1f s)\n", summary["seconds"]));
+                          " made, " + std::to_string(skipped) + " kept, " + std::to_string(failed) + " failed), " + std::to_string(points) +
+                          " points -> " + (folder / "labels.csv").string() + format(" (%.1f s)\n", summary["seconds"]));
     return failed ? static_cast<int>(ExitCode::PartialFailure) : 0;
 }
 
@@ -438,8 +451,12 @@ int run_tile(SynthFlags f, TileFlags t, const OptionTable& table, const GlobalOp
                     {"command", "synth tile"},
                     {"options", table.json()},
                     {"seed", f.seed},
-                    {"tile", {{"size_m", t.tile.size_m}, {"trees", tile.scene.trees.size()}, {"slope_deg", t.tile.slope_deg},
-                              {"understory_per_100m2", t.tile.understory_per_100m2}, {"understory_blades", tile.scene.understory.size()}}},
+                    {"tile",
+                     {{"size_m", t.tile.size_m},
+                      {"trees", tile.scene.trees.size()},
+                      {"slope_deg", t.tile.slope_deg},
+                      {"understory_per_100m2", t.tile.understory_per_100m2},
+                      {"understory_blades", tile.scene.understory.size()}}},
                     {"scanner", scanner_json(f)},
                     {"leaf_density", f.grow.leaf_density},
                     {"max_leaves", f.grow.max_leaves},
@@ -453,8 +470,8 @@ int run_tile(SynthFlags f, TileFlags t, const OptionTable& table, const GlobalOp
     write_file_atomically(folder / "summary.json", summary.dump(2) + "\n");
     print_or_json(summary, global,
                   format("tile %.0f x %.0f m", t.tile.size_m, t.tile.size_m) + ", " + std::to_string(tile.scene.trees.size()) + " trees, " +
-                      f.scanner + " scan: " + std::to_string(cloud.size()) + format(" points (%.2f per m^2) -> ", cloud.size() / area) +
-                      cloud_file.string() + format(" (%.1f s)\n", seconds_since(start)));
+                          f.scanner + " scan: " + std::to_string(cloud.size()) + format(" points (%.2f per m^2) -> ", cloud.size() / area) +
+                          cloud_file.string() + format(" (%.1f s)\n", seconds_since(start)));
     return 0;
 }
 
@@ -472,9 +489,11 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     tree_table->add("--height", tree->height, "Tree height, m (default: drawn from the species' range)");
     tree_table->add("--ground-margin", tree->ground_margin, "Ground scanned beyond the crown, m");
     tree_table->add_flag("--no-mesh", tree->no_mesh, "Do not write the tree mesh");
-    tree_table->add("--mesh-format", tree->mesh_format, "Tree mesh file: ply (geometry) or obj (objects, groups and materials: bark / leaf)")
-        ->check(CLI::IsMember({"ply", "obj"}));
-    tree_table->add_flag("--preview", tree_flags->preview, "Also write <name>_mesh.png, <name>_scan.png and both side by side, <name>_preview.png");
+    tree_table
+            ->add("--mesh-format", tree->mesh_format, "Tree mesh file: ply (geometry) or obj (objects, groups and materials: bark / leaf)")
+            ->check(CLI::IsMember({"ply", "obj"}));
+    tree_table->add_flag("--preview", tree_flags->preview,
+                         "Also write <name>_mesh.png, <name>_scan.png and both side by side, <name>_preview.png");
     tree_table->add("--preview-height", tree_flags->preview_height, "Height of the preview PNGs, pixels")->check(CLI::Range(64, 4096));
     add_common_flags(*tree_table, *tree_flags);
     tree_cmd->callback([tree_flags, tree, tree_table, &global, &job] {

@@ -67,19 +67,27 @@ struct TileCliOptions {
     forestry::TreePipelineOptions trees;
     std::string outlier_test = "auto";
     int map_px = 1600;
-    double buffer = 0;        // metres; 0 = no buffer
-    std::string neighbours;   // LIST|DIR|GLOB; empty = the input's folder
-    double tile_size = 0;     // a retile square's side: the core from the name; 0 = from the header
-    std::string max_memory;   // empty = default_memory_budget_bytes()
+    double buffer = 0;       // metres; 0 = no buffer
+    std::string neighbours;  // LIST|DIR|GLOB; empty = the input's folder
+    double tile_size = 0;    // a retile square's side: the core from the name; 0 = from the header
+    std::string max_memory;  // empty = default_memory_budget_bytes()
 };
 
 // Names of the outputs in DIR (docs/tile.md).
 struct TileOutputs {
     fs::path dir, points, csv, geojson, forest, dtm, hillshade, map, summary, failures, trees;
     explicit TileOutputs(const fs::path& out)
-        : dir(out), points(out / "points.las"), csv(out / "trees.csv"), geojson(out / "trees.geojson"), forest(out / "tile.forest"),
-          dtm(out / "dtm.asc"), hillshade(out / "hillshade.png"), map(out / "top_view.png"), summary(out / "summary.json"),
-          failures(out / "failures.jsonl"), trees(out / "trees") {}
+            : dir(out),
+              points(out / "points.las"),
+              csv(out / "trees.csv"),
+              geojson(out / "trees.geojson"),
+              forest(out / "tile.forest"),
+              dtm(out / "dtm.asc"),
+              hillshade(out / "hillshade.png"),
+              map(out / "top_view.png"),
+              summary(out / "summary.json"),
+              failures(out / "failures.jsonl"),
+              trees(out / "trees") {}
     fs::path tree_file(int id, const std::string& suffix) const {
         char name[32];
         std::snprintf(name, sizeof name, "tree_%04d", id);
@@ -140,7 +148,8 @@ std::vector<std::int32_t> input_tree_ids(const PointCloud& cloud, const std::str
 }
 
 // The input points with treeID, classification (2 = ground) and HeightAboveGround.
-PointCloud labelled_points(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::int32_t>& tree_id, bool fresh_segmentation) {
+PointCloud labelled_points(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::int32_t>& tree_id,
+                           bool fresh_segmentation) {
     PointCloud out = cloud;
     if (fresh_segmentation)
         if (ExtraAttribute* old = out.extra("treeID")) {
@@ -155,8 +164,10 @@ PointCloud labelled_points(const PointCloud& cloud, const Terrain& terrain, cons
     hag.values.assign(terrain.height_above_ground.begin(), terrain.height_above_ground.end());
     if (out.classification.empty()) out.classification.assign(out.size(), 1);  // ASPRS 1: unclassified
     for (std::size_t i = 0; i < out.size(); ++i) {
-        if (terrain.is_ground[i]) out.classification[i] = 2;
-        else if (out.classification[i] == 2) out.classification[i] = 1;  // no longer ground by the DTM
+        if (terrain.is_ground[i])
+            out.classification[i] = 2;
+        else if (out.classification[i] == 2)
+            out.classification[i] = 1;  // no longer ground by the DTM
     }
     return out;
 }
@@ -165,8 +176,7 @@ void write_tree_products(const TileOutputs& out, const forestry::TreeOutcome& ou
     write_skeleton_ply(products.skeleton, out.tree_file(outcome.id, kSkeletonSuffix));
     write_mesh(products.branches, out.tree_file(outcome.id, kBranchesSuffix));
     write_file_atomically(out.tree_file(outcome.id, kTlobeSuffix), products.tlobe);
-    write_file_atomically(out.tree_file(outcome.id, kDbf6Suffix),
-                          std::string(products.dbf6.begin(), products.dbf6.end()));
+    write_file_atomically(out.tree_file(outcome.id, kDbf6Suffix), std::string(products.dbf6.begin(), products.dbf6.end()));
 }
 
 bool tree_files_exist(const TileOutputs& out, int id) {
@@ -255,8 +265,10 @@ std::size_t keep_core_trees(std::vector<forestry::TreeInput>& trees, std::vector
     std::vector<forestry::TreeInput> kept;
     for (forestry::TreeInput& tree : trees) {
         const Eigen::Vector3d base = origin + tree.base;
-        if (core.holds(base.x(), base.y())) kept.push_back(std::move(tree));
-        else dropped.insert(tree.id);
+        if (core.holds(base.x(), base.y()))
+            kept.push_back(std::move(tree));
+        else
+            dropped.insert(tree.id);
     }
     trees = std::move(kept);
     for (std::int32_t& id : tree_id)
@@ -296,8 +308,13 @@ json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::
     for (const fs::path& file : buffered.neighbours_read) read.push_back(file.filename().string());
     const survey::TileCore& c = *plan.core;
     return {{"metres", o.buffer},
-            {"core", {{"min_x", c.min_x}, {"min_y", c.min_y}, {"max_x", c.max_x}, {"max_y", c.max_y}, {"from", c.source},
-                      {"half_open", c.half_open}}},
+            {"core",
+             {{"min_x", c.min_x},
+              {"min_y", c.min_y},
+              {"max_x", c.max_x},
+              {"max_y", c.max_y},
+              {"from", c.source},
+              {"half_open", c.half_open}}},
             {"neighbours_read", read},
             {"neighbours_skipped", buffered.neighbours_skipped}};
 }
@@ -348,8 +365,9 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     const std::map<int, std::string> global_ids = survey_ids(trees, cloud.origin);
     for (forestry::TreeInput& tree : trees) order_points_by_position(tree);
     seconds["segmentation"] = rounded(seconds_since(mark));
-    if (trees.empty()) log_warn(o.input + ": no trees found (" + std::to_string(terrain.ground_points) + " of " + std::to_string(cloud.size()) +
-                                " points are ground); the outputs list none");
+    if (trees.empty())
+        log_warn(o.input + ": no trees found (" + std::to_string(terrain.ground_points) + " of " + std::to_string(cloud.size()) +
+                 " points are ground); the outputs list none");
 
     // Trees finished by an earlier run are read back; the others go through the pipeline.
     const json options = options_json(table, o, segmentation);
@@ -374,14 +392,15 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     json stage_seconds = json::object();
     {
         Progress progress("trees", todo.size());
-        const auto made = forestry::process_trees(todo, o.trees, [&](const forestry::TreeOutcome& outcome, const forestry::TreeProducts* products) {
-            if (products) {
-                write_tree_products(out, outcome, *products);
-                lobe_counts[position_of.at(outcome.id)] = products->lobes;
-            }
-            for (const auto& [stage, s] : outcome.seconds) stage_seconds[stage] = stage_seconds.value(stage, 0.0) + s;
-            progress.advance();
-        });
+        const auto made =
+                forestry::process_trees(todo, o.trees, [&](const forestry::TreeOutcome& outcome, const forestry::TreeProducts* products) {
+                    if (products) {
+                        write_tree_products(out, outcome, *products);
+                        lobe_counts[position_of.at(outcome.id)] = products->lobes;
+                    }
+                    for (const auto& [stage, s] : outcome.seconds) stage_seconds[stage] = stage_seconds.value(stage, 0.0) + s;
+                    progress.advance();
+                });
         progress.finish();
         for (std::size_t k = 0; k < made.size(); ++k) outcomes[todo_index[k]] = made[k];
     }
@@ -399,7 +418,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     for (std::size_t i = 0; i < outcomes.size(); ++i) {
         const auto& outcome = outcomes[i];
         if (!outcome.ok) {
-            failures.push_back({{"tree_id", outcome.id}, {"reason", outcome.failure}, {"exit_code", static_cast<int>(outcome.failure_code)}});
+            failures.push_back(
+                    {{"tree_id", outcome.id}, {"reason", outcome.failure}, {"exit_code", static_cast<int>(outcome.failure_code)}});
             continue;
         }
         row_of[i] = rows.size();
@@ -454,25 +474,38 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     const std::string dbh_text = dbh_counts(rows, dbh);
     std::size_t tree_points = 0;
     for (const auto& row : rows) tree_points += row.measures.points;
-    const json summary = {
-        {"treelobes", kVersion},
-        {"command", "tile"},
-        {"input", o.input},
-        {"out", o.out},
-        {"options", options},
-        {"buffer", buffer_json(o, plan, buffered)},
-        {"counts", {{"points", buffered.own_points}, {"buffer_points", cloud.size() - buffered.own_points},
-                    {"non_finite_dropped", cloud.source.dropped_non_finite}, {"trees_in_buffer", trees_in_buffer},
-                    {"ground_points", terrain.ground_points}, {"ground_source", terrain.ground_source},
-                    {"tree_points", tree_points}, {"trees_found", outcomes.size()}, {"trees", rows.size()},
-                    {"trees_reused", reused}, {"trees_failed", failures.size()}, {"dbh", dbh}}},
-        {"crs", cloud.georef.empty() ? json(nullptr) : json(cloud.georef.crs_wkt)},
-        {"outputs", {{"points", out.points.string()}, {"trees_csv", out.csv.string()}, {"trees_geojson", out.geojson.string()},
-                     {"forest", out.forest.string()}, {"dtm", out.dtm.string()}, {"hillshade", out.hillshade.string()},
-                     {"top_view", out.map.string()}, {"trees", out.trees.string()},
-                     {"failures", failures.empty() ? json(nullptr) : json(out.failures.string())}}},
-        {"seconds", seconds},
-        {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
+    const json summary = {{"treelobes", kVersion},
+                          {"command", "tile"},
+                          {"input", o.input},
+                          {"out", o.out},
+                          {"options", options},
+                          {"buffer", buffer_json(o, plan, buffered)},
+                          {"counts",
+                           {{"points", buffered.own_points},
+                            {"buffer_points", cloud.size() - buffered.own_points},
+                            {"non_finite_dropped", cloud.source.dropped_non_finite},
+                            {"trees_in_buffer", trees_in_buffer},
+                            {"ground_points", terrain.ground_points},
+                            {"ground_source", terrain.ground_source},
+                            {"tree_points", tree_points},
+                            {"trees_found", outcomes.size()},
+                            {"trees", rows.size()},
+                            {"trees_reused", reused},
+                            {"trees_failed", failures.size()},
+                            {"dbh", dbh}}},
+                          {"crs", cloud.georef.empty() ? json(nullptr) : json(cloud.georef.crs_wkt)},
+                          {"outputs",
+                           {{"points", out.points.string()},
+                            {"trees_csv", out.csv.string()},
+                            {"trees_geojson", out.geojson.string()},
+                            {"forest", out.forest.string()},
+                            {"dtm", out.dtm.string()},
+                            {"hillshade", out.hillshade.string()},
+                            {"top_view", out.map.string()},
+                            {"trees", out.trees.string()},
+                            {"failures", failures.empty() ? json(nullptr) : json(out.failures.string())}}},
+                          {"seconds", seconds},
+                          {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
     write_file_atomically(out.summary, summary.dump(2) + "\n");
     if (global.json) {
         std::cout << summary.dump(2) << "\n";
@@ -495,37 +528,47 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     // `lobes` command takes 6,000), which keeps the alpha shapes, the slowest per-tree stage, affordable.
     o->trees.lobes.max_shape_points = 2000;
     CLI::App* sub = app.add_subcommand(
-        "tile", "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
-                "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
+            "tile",
+            "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
+            "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, LAZ or COPC, PLY, PCD or XYZ/CSV")->required();
     table->add("--out", o->out, "Output folder")->required();
-    table->add("--mode", o->mode, "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
-                                  "paths) or auto (from the point density)")
-        ->check(CLI::IsMember({"auto", "als", "tls"}));
+    table->add("--mode", o->mode,
+               "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
+               "paths) or auto (from the point density)")
+            ->check(CLI::IsMember({"auto", "als", "tls"}));
     table->add_flag("--use-input-segmentation", o->use_input_segmentation,
                     "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
     table->add("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");
     table->add("--vote-radius", o->voting.radius_m, "Spatial voting neighbourhood, metres")->check(NonNegativeNumber);
     table->add("--vote-confidence", o->voting.confidence_factor, "A tree is confident when h1 > factor * h2")
-        ->check(CLI::Range(1.0, 100.0));
+            ->check(CLI::Range(1.0, 100.0));
     table->add("--dtm-cell", o->terrain.cell_size, "DTM cell size, metres")->check(PositiveNumber);
-    table->add("--min-tree-height", o->segment.min_tree_height, "Lower tops are not trees, metres above ground")
-        ->check(PositiveNumber);
+    table->add("--min-tree-height", o->segment.min_tree_height, "Lower tops are not trees, metres above ground")->check(PositiveNumber);
     table->add("--min-tree-points", o->trees.min_points, "Trees with fewer points fail (listed in failures.jsonl)")
-        ->check(CLI::Range(10, 100000000));
+            ->check(CLI::Range(10, 100000000));
     table->add("--outlier-test", o->outlier_test, "Outlier test of the per-tree reconstruction: auto, global, local")
-        ->check(CLI::IsMember({"auto", "global", "local"}));
-    table->add("--lobe-shape-points", o->trees.lobes.max_shape_points, "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
-        ->check(CLI::Range(100, 10000000));
-    table->add("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")
-        ->check(CLI::Range(1.0, 64.0));
+            ->check(CLI::IsMember({"auto", "global", "local"}));
+    table->add("--lobe-shape-points", o->trees.lobes.max_shape_points,
+               "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
+            ->check(CLI::Range(100, 10000000));
+    table->add("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")->check(CLI::Range(1.0, 64.0));
     table->add("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16));
     table->add("--map-size", o->map_px, "Longer side of top_view.png, pixels")->check(CLI::Range(200, 20000));
-    table->add("--buffer", o->buffer, "Also read the neighbouring tiles' points within this many metres of the tile's core; the tile keeps the trees whose stem base lies in its core (docs/survey.md)")->check(NonNegativeNumber);
-    table->add("--neighbours", o->neighbours, "With --buffer: the neighbouring tiles, a folder, a quoted pattern or a list file (default: the tile's folder)");
-    table->add("--tile-size", o->tile_size, "With --buffer: the tile is a `retile` square of this side, its core [x, x+size) x [y, y+size) from its name <prefix>_<x>_<y> (default: the header's bounds)")->check(PositiveNumber);
-    table->add("--max-memory", o->max_memory, "Refuse the tile before reading it when its header point count (buffer included) needs more memory than this (e.g. 8G; default: half of the RAM)");
+    table->add("--buffer", o->buffer,
+               "Also read the neighbouring tiles' points within this many metres of the tile's core; the tile keeps the trees whose stem "
+               "base lies in its core (docs/survey.md)")
+            ->check(NonNegativeNumber);
+    table->add("--neighbours", o->neighbours,
+               "With --buffer: the neighbouring tiles, a folder, a quoted pattern or a list file (default: the tile's folder)");
+    table->add("--tile-size", o->tile_size,
+               "With --buffer: the tile is a `retile` square of this side, its core [x, x+size) x [y, y+size) from its name "
+               "<prefix>_<x>_<y> (default: the header's bounds)")
+            ->check(PositiveNumber);
+    table->add("--max-memory", o->max_memory,
+               "Refuse the tile before reading it when its header point count (buffer included) needs more memory than this (e.g. 8G; "
+               "default: half of the RAM)");
     table->add_flag("--overwrite", o->overwrite, "Redo outputs and trees that exist from an earlier run");
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_tile(*o, *table, global); }; });
 }

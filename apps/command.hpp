@@ -19,9 +19,9 @@
 namespace treelobes::cli {
 
 struct GlobalOptions {
-    int threads = 0;                 // 0 = all cores
+    int threads = 0;  // 0 = all cores
     std::string log_level = "info";
-    bool json = false;               // machine-readable summary on stdout
+    bool json = false;  // machine-readable summary on stdout
 };
 
 using Job = std::function<int()>;  // returns the process exit code
@@ -30,14 +30,14 @@ using Job = std::function<int()>;  // returns the process exit code
 // NonNegativeNumber let "nan" through and quote the whole double range in their message.
 inline CLI::Validator finite_number(bool zero_allowed) {
     return CLI::Validator(
-        [zero_allowed](std::string& text) -> std::string {
-            double value = 0;
-            if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
-            if (!std::isfinite(value) || (zero_allowed ? value < 0 : value <= 0))
-                return std::string("must be a finite number ") + (zero_allowed ? ">= 0" : "> 0") + ", got " + text;
-            return {};
-        },
-        zero_allowed ? "NUMBER >= 0" : "NUMBER > 0");
+            [zero_allowed](std::string& text) -> std::string {
+                double value = 0;
+                if (!CLI::detail::lexical_cast(text, value)) return "'" + text + "' is not a number";
+                if (!std::isfinite(value) || (zero_allowed ? value < 0 : value <= 0))
+                    return std::string("must be a finite number ") + (zero_allowed ? ">= 0" : "> 0") + ", got " + text;
+                return {};
+            },
+            zero_allowed ? "NUMBER >= 0" : "NUMBER > 0");
 }
 inline const CLI::Validator PositiveNumber = finite_number(false);
 inline const CLI::Validator NonNegativeNumber = finite_number(true);
@@ -55,9 +55,12 @@ inline Box3d parse_bounds(const std::string& text) {
     }
     constexpr double inf = std::numeric_limits<double>::infinity();
     Box3d box;
-    if (v.size() == 6) box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-    else if (v.size() == 4) box = {{v[0], v[1], -inf}, {v[2], v[3], inf}};
-    else throw Error::usage("--bounds takes minx,miny,minz,maxx,maxy,maxz or minx,miny,maxx,maxy, got '" + text + "'");
+    if (v.size() == 6)
+        box = {{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+    else if (v.size() == 4)
+        box = {{v[0], v[1], -inf}, {v[2], v[3], inf}};
+    else
+        throw Error::usage("--bounds takes minx,miny,minz,maxx,maxy,maxz or minx,miny,maxx,maxy, got '" + text + "'");
     if ((box.min.array() > box.max.array()).any()) throw Error::usage("--bounds: a minimum exceeds its maximum in '" + text + "'");
     return box;
 }

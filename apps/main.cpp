@@ -21,7 +21,7 @@ void add_global_flags(CLI::App& app, cli::GlobalOptions& global) {
     app.set_version_flag("--version", std::string("treelobes ") + kVersion);
     app.add_option("--threads", global.threads, "Worker threads (0 = all cores)")->check(cli::NonNegativeNumber);
     app.add_option("--log-level", global.log_level, "Log level on stderr: error, warn, info, debug")
-        ->check(CLI::IsMember({"error", "warn", "info", "debug"}));
+            ->check(CLI::IsMember({"error", "warn", "info", "debug"}));
     app.add_flag("--json", global.json, "Print the summary as JSON on stdout");
 }
 

@@ -29,7 +29,10 @@ nlohmann::json summary_value(const T& value) {
         char text[32];
         const auto end = std::to_chars(text, text + sizeof text, value).ptr;
         return std::stod(std::string(text, end));
-    } else if constexpr (requires { typename T::value_type; value.has_value(); }) {
+    } else if constexpr (requires {
+                             typename T::value_type;
+                             value.has_value();
+                         }) {
         return value ? summary_value(*value) : nlohmann::json();
     } else if constexpr (requires { value.begin(); } && !std::is_same_v<T, std::string>) {
         nlohmann::json list = nlohmann::json::array();

@@ -11,7 +11,7 @@ void add_species_flags(OptionTable& table, SpeciesFlags& flags, const std::strin
     table.add("--gamma", flags.gamma, "Allometry exponent of Eq. 1 (default 1.5, or the species')")->check(cli::PositiveNumber);
     table.add("--fs", flags.fs, fs_help)->check(CLI::Range(0.01, 1.0));
     table.add("--ground", flags.ground, "Ground points: auto (remove a detected ground plane), remove, keep")
-        ->check(CLI::IsMember({"auto", "remove", "keep"}));
+            ->check(CLI::IsMember({"auto", "remove", "keep"}));
     table.report_as("--species", [&flags] { return flags.species.empty() ? nlohmann::json() : nlohmann::json(flags.species); });
     table.report_as("--beta", [&stage] { return stage.skeleton.beta; });
     table.report_as("--gamma", [&stage] { return stage.allometry.gamma; });

@@ -13,8 +13,8 @@
 namespace treelobes::cli {
 
 struct SpeciesFlags {
-    std::string species;                   // canonical name after apply_species_flags()
-    std::optional<double> beta, gamma, fs; // explicit values override the species'
+    std::string species;                    // canonical name after apply_species_flags()
+    std::optional<double> beta, gamma, fs;  // explicit values override the species'
     std::string ground = "auto";
 };
 

@@ -50,7 +50,7 @@ std::vector<TileTree> read_trees_csv(const fs::path& file) {
         const std::vector<std::string> cells = split_csv_line(line);
         if (cells.size() != header.size())
             throw Error::input(file.string(), "line " + std::to_string(row) + ": " + std::to_string(cells.size()) + " cells, header has " +
-                                                  std::to_string(header.size()));
+                                                      std::to_string(header.size()));
         TileTree tree;
         try {
             tree.id = std::stoi(cells[id_column]);
@@ -128,10 +128,12 @@ PointSpecies point_species(const PointCloud& cloud, const std::vector<TileTree>*
         return index_names(name_of_key, tree_id->values);
     }
     // key: the species id of config/species.yaml
-    const auto attribute = std::find_if(cloud.extras.begin(), cloud.extras.end(),
-                                        [](const ExtraAttribute& a) { return lower(a.name) == "species" || lower(a.name) == "scalar_species"; });
+    const auto attribute = std::find_if(cloud.extras.begin(), cloud.extras.end(), [](const ExtraAttribute& a) {
+        return lower(a.name) == "species" || lower(a.name) == "scalar_species";
+    });
     if (attribute == cloud.extras.end())
-        throw Error::input(path, "--color species needs a species attribute (LAS extra bytes or PLY scalar_species) or a tile output folder");
+        throw Error::input(path,
+                           "--color species needs a species attribute (LAS extra bytes or PLY scalar_species) or a tile output folder");
     std::map<long long, std::string> library_names;
     for (const auto& entry : species_library()) library_names[entry.id] = entry.name;
     for (double value : attribute->values) {

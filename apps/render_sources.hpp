@@ -14,13 +14,13 @@ namespace treelobes::cli {
 
 struct TileTree {
     int id = 0;
-    std::string species;   // empty when the tile ran without a species model
-    double height_m = 0;   // NaN when trees.csv has none
+    std::string species;  // empty when the tile ran without a species model
+    double height_m = 0;  // NaN when trees.csv has none
 };
 
 struct TileOutput {
-    PointCloud points;               // points.las
-    std::vector<TileTree> trees;     // trees.csv, sorted by id
+    PointCloud points;            // points.las
+    std::vector<TileTree> trees;  // trees.csv, sorted by id
 };
 
 // A folder holding the trees.csv and points.las that `treelobes tile` writes.

@@ -27,7 +27,8 @@ int main(int argc, char** argv) {
     const auto profiles = load_species_profiles(default_species_file());
     double total = 0, total_cpu = 0;
     int trees = 0;
-    std::printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s\n", "species", "points", "total_s", "cpu_s", "prepare", "points", "normals", "hull", "skeleton");
+    std::printf("%-22s %8s %8s %8s %8s %8s %8s %8s %8s\n", "species", "points", "total_s", "cpu_s", "prepare", "points", "normals", "hull",
+                "skeleton");
     for (const char* name : {"pine", "oak", "palm", "birch", "willow", "ficus_virens"}) {
         synth::GrowOptions grow;
         grow.height_m = 12;
@@ -40,15 +41,16 @@ int main(int argc, char** argv) {
         const PointCloud scan = synth::scan_tls(scene, tls, 1);
         PointCloud cloud;
         const double step = std::max(1.0, static_cast<double>(scan.size()) / static_cast<double>(target));
-        for (double i = 0; i < static_cast<double>(scan.size()); i += step) cloud.positions.push_back(scan.positions[static_cast<std::size_t>(i)]);
+        for (double i = 0; i < static_cast<double>(scan.size()); i += step)
+            cloud.positions.push_back(scan.positions[static_cast<std::size_t>(i)]);
         classify::FeatureTimings t;
         const auto start = std::chrono::steady_clock::now();
         const std::clock_t cpu_start = std::clock();
         classify::compute_features(cloud, {}, name, &t);
         const double cpu = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        std::printf("%-22s %8zu %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n", name, cloud.size(), seconds, cpu, t.prepare, t.points, t.normals,
-                    t.hull, t.skeleton);
+        std::printf("%-22s %8zu %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f %8.3f\n", name, cloud.size(), seconds, cpu, t.prepare, t.points,
+                    t.normals, t.hull, t.skeleton);
         total += seconds, total_cpu += cpu, ++trees;
     }
     std::printf("mean %.3f s wall, %.3f s CPU per tree of ~%zu points\n", total / trees, total_cpu / trees, target);

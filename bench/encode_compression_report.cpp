@@ -66,8 +66,7 @@ std::size_t gzip9(const Bytes& in) {
 std::size_t bzip2_9(const Bytes& in) {
     unsigned int size = static_cast<unsigned int>(in.size() + in.size() / 100 + 600);
     Bytes out(size);
-    if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(out.data()), &size,
-                                 const_cast<char*>(reinterpret_cast<const char*>(in.data())),
+    if (BZ2_bzBuffToBuffCompress(reinterpret_cast<char*>(out.data()), &size, const_cast<char*>(reinterpret_cast<const char*>(in.data())),
                                  static_cast<unsigned int>(in.size()), 9, 0, 0) != BZ_OK)
         throw Error(ExitCode::Internal, "bzip2");
     return size;
@@ -76,8 +75,8 @@ std::size_t bzip2_9(const Bytes& in) {
 std::size_t xz9e(const Bytes& in) {
     Bytes out(lzma_stream_buffer_bound(in.size()));
     std::size_t position = 0;
-    if (lzma_easy_buffer_encode(9 | LZMA_PRESET_EXTREME, LZMA_CHECK_CRC64, nullptr, in.data(), in.size(), out.data(),
-                                &position, out.size()) != LZMA_OK)
+    if (lzma_easy_buffer_encode(9 | LZMA_PRESET_EXTREME, LZMA_CHECK_CRC64, nullptr, in.data(), in.size(), out.data(), &position,
+                                out.size()) != LZMA_OK)
         throw Error(ExitCode::Internal, "xz");
     return position;
 }
@@ -224,24 +223,26 @@ Row5 measure_tree(const std::string& name, const TreeGraph& tree, int runs, bool
 }
 
 void print_table5(const std::vector<Row5>& rows) {
-    std::printf("\n## Table 5: sizes in bytes at r = 5 (full detail)\n\n"
-                "cc ic / cc best are whole .dbf6 files (header and CRC included); the factor in parentheses is raw / size.\n"
-                "`best vs min` = cc best relative to the smallest general-purpose result.\n\n"
-                "| tree | internodes | raw | raw gzip -9 | cc bin | cc gzip -9 | cc bzip2 -9 | cc xz -9e | cc zstd -22 | "
-                "cc brotli -q 11 | cc ic | cc best | ic vs gzip | best vs min | ic decode ms | best decode ms |\n"
-                "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+            "\n## Table 5: sizes in bytes at r = 5 (full detail)\n\n"
+            "cc ic / cc best are whole .dbf6 files (header and CRC included); the factor in parentheses is raw / size.\n"
+            "`best vs min` = cc best relative to the smallest general-purpose result.\n\n"
+            "| tree | internodes | raw | raw gzip -9 | cc bin | cc gzip -9 | cc bzip2 -9 | cc xz -9e | cc zstd -22 | "
+            "cc brotli -q 11 | cc ic | cc best | ic vs gzip | best vs min | ic decode ms | best decode ms |\n"
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Row5& r : rows) {
         const double raw = static_cast<double>(r.raw);
-        std::printf("| %s | %zu | %zu | %zu | %zu | %zu | %zu | %zu | %zu | %zu | %zu (%.1f) | %zu (%.1f) | %+.1f %% | %+.1f %% | "
-                    "%.2f | %.2f |\n",
-                    r.name.c_str(), r.internodes, r.raw, r.raw_gzip, r.cc_bin, r.general.gzip, r.general.bzip2, r.general.xz,
-                    r.general.zstd, r.general.brotli, r.ic, raw / r.ic, r.best, raw / r.best,
-                    100.0 * (static_cast<double>(r.ic) / r.general.gzip - 1.0),
-                    100.0 * (static_cast<double>(r.best) / r.general.smallest() - 1.0), r.ic_ms, r.best_ms);
+        std::printf(
+                "| %s | %zu | %zu | %zu | %zu | %zu | %zu | %zu | %zu | %zu | %zu (%.1f) | %zu (%.1f) | %+.1f %% | %+.1f %% | "
+                "%.2f | %.2f |\n",
+                r.name.c_str(), r.internodes, r.raw, r.raw_gzip, r.cc_bin, r.general.gzip, r.general.bzip2, r.general.xz, r.general.zstd,
+                r.general.brotli, r.ic, raw / r.ic, r.best, raw / r.best, 100.0 * (static_cast<double>(r.ic) / r.general.gzip - 1.0),
+                100.0 * (static_cast<double>(r.best) / r.general.smallest() - 1.0), r.ic_ms, r.best_ms);
     }
-    std::printf("\n### Where the bytes go: symbol and radii streams (bytes), DBF6 symbols per internode\n\n"
-                "| tree | symbols / internode | ic symbols | best symbols | best vs ic | ic radii | best radii | best vs ic |\n"
-                "|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+            "\n### Where the bytes go: symbol and radii streams (bytes), DBF6 symbols per internode\n\n"
+            "| tree | symbols / internode | ic symbols | best symbols | best vs ic | ic radii | best radii | best vs ic |\n"
+            "|---|---|---|---|---|---|---|---|\n");
     for (const Row5& r : rows)
         std::printf("| %s | %.2f | %zu | %zu | %+.1f %% | %zu | %zu | %+.1f %% |\n", r.name.c_str(),
                     static_cast<double>(r.symbols) / r.internodes, r.ic_streams.symbols, r.best_streams.symbols,
@@ -300,17 +301,20 @@ void table6(const std::vector<ForestTree>& forest, int runs) {
     }
     std::printf("\n## Table 6: forest of %zu trees, %zu internodes at r = 5 (raw %zu bytes)\n\n", forest.size(), internodes,
                 16 * internodes);
-    std::printf("General-purpose compressors on the forest's code+radii bytes at r = 5, full detail: gzip -9 %zu, bzip2 -9 %zu, "
-                "xz -9e %zu, zstd -22 %zu, brotli -q 11 %zu (smallest %zu).\n\n",
-                general.gzip, general.bzip2, general.xz, general.zstd, general.brotli, general.smallest());
-    std::printf("The same compressors on each tree separately (random access), summed: gzip -9 %zu, bzip2 -9 %zu, "
-                "xz -9e %zu, zstd -22 %zu, brotli -q 11 %zu (smallest %zu).\n\n",
-                per_tree.gzip, per_tree.bzip2, per_tree.xz, per_tree.zstd, per_tree.brotli, per_tree.smallest());
+    std::printf(
+            "General-purpose compressors on the forest's code+radii bytes at r = 5, full detail: gzip -9 %zu, bzip2 -9 %zu, "
+            "xz -9e %zu, zstd -22 %zu, brotli -q 11 %zu (smallest %zu).\n\n",
+            general.gzip, general.bzip2, general.xz, general.zstd, general.brotli, general.smallest());
+    std::printf(
+            "The same compressors on each tree separately (random access), summed: gzip -9 %zu, bzip2 -9 %zu, "
+            "xz -9e %zu, zstd -22 %zu, brotli -q 11 %zu (smallest %zu).\n\n",
+            per_tree.gzip, per_tree.bzip2, per_tree.xz, per_tree.zstd, per_tree.brotli, per_tree.smallest());
     for (Coder coder : {Coder::Interpolative, Coder::Best}) {
         char note[400] = "";
-        std::printf("### coder %s: .forest size (full decode of LOD 0 to placed skeletons, one thread)\n\n"
-                    "| LODs | r = 3 | r = 5 | r = 10 |\n|---|---|---|---|\n",
-                    coder_name(coder));
+        std::printf(
+                "### coder %s: .forest size (full decode of LOD 0 to placed skeletons, one thread)\n\n"
+                "| LODs | r = 3 | r = 5 | r = 10 |\n|---|---|---|---|\n",
+                coder_name(coder));
         for (int lods : {1, 3, 5}) {
             std::printf("| %d |", lods);
             for (double r : {3.0, 5.0, 10.0}) {
@@ -323,10 +327,11 @@ void table6(const std::vector<ForestTree>& forest, int runs) {
                 const double ms = decode_forest_ms(file, runs, nodes);
                 std::printf(" %.3f MB (%.0f ms) |", static_cast<double>(file.size()) / 1e6, ms);
                 if (lods == 1 && r == 5.0)
-                    std::snprintf(note, sizeof note, "%s r=5 1 LOD: %zu bytes, %+.1f %% vs smallest general on the whole forest, "
-                                 "%+.1f %% vs smallest general per tree, %zu nodes decoded\n", coder_name(coder), file.size(),
-                                 100.0 * (static_cast<double>(file.size()) / general.smallest() - 1.0),
-                                 100.0 * (static_cast<double>(file.size()) / per_tree.smallest() - 1.0), nodes);
+                    std::snprintf(note, sizeof note,
+                                  "%s r=5 1 LOD: %zu bytes, %+.1f %% vs smallest general on the whole forest, "
+                                  "%+.1f %% vs smallest general per tree, %zu nodes decoded\n",
+                                  coder_name(coder), file.size(), 100.0 * (static_cast<double>(file.size()) / general.smallest() - 1.0),
+                                  100.0 * (static_cast<double>(file.size()) / per_tree.smallest() - 1.0), nodes);
             }
             std::printf("\n");
         }
@@ -341,19 +346,23 @@ int main(int argc, char** argv) {
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
-        if (arg == "--trees" && i + 1 < argc) trees = std::stoi(argv[++i]);
-        else if (arg == "--runs" && i + 1 < argc) runs = std::max(1, std::stoi(argv[++i]));
+        if (arg == "--trees" && i + 1 < argc)
+            trees = std::stoi(argv[++i]);
+        else if (arg == "--runs" && i + 1 < argc)
+            runs = std::max(1, std::stoi(argv[++i]));
         else if (arg == "--help" || arg == "-h") {
             std::printf("usage: encode_compression_report [--trees N (forest size, 0 = no Table 6)] [--runs K] [SKELETON.ply ...]\n");
             return 0;
-        } else files.push_back(arg);
+        } else
+            files.push_back(arg);
     }
     try {
         bool ok = true;
-        std::printf("# Compression of chain-coded trees (Strnad et al. 2020, §4, Experiments 2 and 3)\n\n"
-                    "Trees: synth::grow, leafless, seed 1, one per species of config/species.yaml; internode length l = median "
-                    "edge, radius unit 1 mm. Times: thread CPU time, fastest of %d runs, one thread.\n",
-                    runs);
+        std::printf(
+                "# Compression of chain-coded trees (Strnad et al. 2020, §4, Experiments 2 and 3)\n\n"
+                "Trees: synth::grow, leafless, seed 1, one per species of config/species.yaml; internode length l = median "
+                "edge, radius unit 1 mm. Times: thread CPU time, fastest of %d runs, one thread.\n",
+                runs);
         std::vector<Row5> rows;
         for (const bench::NamedTree& t : bench::table5_trees()) rows.push_back(measure_tree(t.name, t.tree, runs, ok));
         for (const std::string& file : files) rows.push_back(measure_tree(file, read_skeleton_ply(file), runs, ok));

@@ -75,9 +75,9 @@ void BM_DecodeStreamsOnly(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_DecodeStreamsOnly)
-    ->Arg(static_cast<int>(Coder::Best))
-    ->Arg(static_cast<int>(Coder::Interpolative))
-    ->Unit(benchmark::kMillisecond);
+        ->Arg(static_cast<int>(Coder::Best))
+        ->Arg(static_cast<int>(Coder::Interpolative))
+        ->Unit(benchmark::kMillisecond);
 
 // Chain code to skeleton only (decode_tree), all trees.
 void BM_CodesToSkeletons(benchmark::State& state) {

@@ -39,8 +39,8 @@ struct Subject {
 };
 
 std::vector<test::RandomTreeProfile> species_profiles(bool quick) {
-    auto profile = [](std::string name, int nodes, int trunk, double wiggle, double fork, int laterals, double angle,
-                      double ratio, int order, int stems) {
+    auto profile = [](std::string name, int nodes, int trunk, double wiggle, double fork, int laterals, double angle, double ratio,
+                      int order, int stems) {
         test::RandomTreeProfile p;
         p.name = std::move(name);
         p.max_nodes = nodes;
@@ -56,11 +56,11 @@ std::vector<test::RandomTreeProfile> species_profiles(bool quick) {
         return p;
     };
     std::vector<test::RandomTreeProfile> profiles = {
-        profile("excurrent-whorled", 5000, 80, 2.0, 0.7, 4, 75.0, 0.4, 4, 1),
-        profile("decurrent-bifurcating", 5000, 40, 8.0, 0.5, 1, 35.0, 0.9, 7, 1),
-        profile("multistem-shrub", 2000, 20, 12.0, 0.5, 2, 40.0, 0.85, 6, 4),
-        profile("straight-sparse", 1000, 80, 0.0, 0.25, 1, 50.0, 0.6, 4, 1),
-        profile("tortuous", 3000, 35, 25.0, 0.5, 2, 50.0, 0.85, 7, 1),
+            profile("excurrent-whorled", 5000, 80, 2.0, 0.7, 4, 75.0, 0.4, 4, 1),
+            profile("decurrent-bifurcating", 5000, 40, 8.0, 0.5, 1, 35.0, 0.9, 7, 1),
+            profile("multistem-shrub", 2000, 20, 12.0, 0.5, 2, 40.0, 0.85, 6, 4),
+            profile("straight-sparse", 1000, 80, 0.0, 0.25, 1, 50.0, 0.6, 4, 1),
+            profile("tortuous", 3000, 35, 25.0, 0.5, 2, 50.0, 0.85, 7, 1),
     };
     if (quick)
         for (auto& p : profiles) p.max_nodes /= 10;
@@ -136,8 +136,9 @@ void print_tables(const std::vector<Subject>& subjects, const std::vector<std::v
         for (const Row& row : rows[t]) std::printf(" %zu/%zu/%zu/%zu |", row.dbf6[0], row.dbf6[1], row.dbf6[2], row.dbf6[3]);
         std::printf("\n");
     }
-    std::printf("\nReduction of the DBF6 length relative to F6 in %%, LOD0/../LOD3 (cf. Table 4)\n\n"
-                "| tree | r = 3 | r = 5 | r = 10 |\n|---|---|---|---|\n");
+    std::printf(
+            "\nReduction of the DBF6 length relative to F6 in %%, LOD0/../LOD3 (cf. Table 4)\n\n"
+            "| tree | r = 3 | r = 5 | r = 10 |\n|---|---|---|---|\n");
     for (std::size_t t = 0; t < subjects.size(); ++t) {
         std::printf("| %s |", subjects[t].name.c_str());
         for (const Row& row : rows[t]) {
@@ -147,17 +148,17 @@ void print_tables(const std::vector<Subject>& subjects, const std::vector<std::v
         }
         std::printf("\n");
     }
-    std::printf("\nDBF6/F6 length ratio at LOD0, normalised Hausdorff max/avg of the decoded skeleton (cf. Fig. 5),\n"
-                "largest vertex error / bound √3·d/2, encode and decode time\n\n"
-                "| tree | r | DBF6/F6 | Δmax | Δavg | vertex error / bound | encode ms | decode ms |\n"
-                "|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+            "\nDBF6/F6 length ratio at LOD0, normalised Hausdorff max/avg of the decoded skeleton (cf. Fig. 5),\n"
+            "largest vertex error / bound √3·d/2, encode and decode time\n\n"
+            "| tree | r | DBF6/F6 | Δmax | Δavg | vertex error / bound | encode ms | decode ms |\n"
+            "|---|---|---|---|---|---|---|---|\n");
     for (std::size_t t = 0; t < subjects.size(); ++t)
         for (std::size_t i = 0; i < rows[t].size(); ++i) {
             const Row& row = rows[t][i];
             std::printf("| %s | %g | %.3f | %.2e | %.2e | %.3f%s | %.2f | %.2f |\n", subjects[t].name.c_str(), kResolutions[i],
-                        static_cast<double>(row.dbf6[0]) / row.f6[0], row.hausdorff.max_normalised,
-                        row.hausdorff.mean_normalised, row.bound.max_error / row.bound.bound,
-                        row.bound.within_bound ? "" : " EXCEEDED", row.encode_ms, row.decode_ms);
+                        static_cast<double>(row.dbf6[0]) / row.f6[0], row.hausdorff.max_normalised, row.hausdorff.mean_normalised,
+                        row.bound.max_error / row.bound.bound, row.bound.within_bound ? "" : " EXCEEDED", row.encode_ms, row.decode_ms);
         }
 }
 
@@ -168,11 +169,13 @@ int main(int argc, char** argv) {
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
-        if (arg == "--quick") quick = true;
+        if (arg == "--quick")
+            quick = true;
         else if (arg == "--help" || arg == "-h") {
             std::printf("usage: encode_report [--quick] [SKELETON.ply ...]\n");
             return 0;
-        } else files.push_back(arg);
+        } else
+            files.push_back(arg);
     }
     try {
         std::vector<Subject> subjects;

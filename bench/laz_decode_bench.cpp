@@ -36,8 +36,8 @@ void full_decode(const std::filesystem::path& file) {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
         seconds[threads - 1] = best_seconds(5, [&] { read_las_records(file); });
     }
-    std::printf("%-28s %9zu  %12.0f  %12.0f  %7.2fx\n", file.filename().c_str(), points, points / seconds[0],
-                points / seconds[1], seconds[0] / seconds[1]);
+    std::printf("%-28s %9zu  %12.0f  %12.0f  %7.2fx\n", file.filename().c_str(), points, points / seconds[0], points / seconds[1],
+                seconds[0] / seconds[1]);
 }
 
 void selective_decode(const std::filesystem::path& file) {
@@ -47,8 +47,8 @@ void selective_decode(const std::filesystem::path& file) {
     const std::size_t points = read_point_cloud(file).size();
     const double full = best_seconds(30, [&] { read_point_cloud(file); });
     const double selective = best_seconds(30, [&] { read_point_cloud(file, lean); });
-    std::printf("%-28s %9zu  %12.0f  %12.0f  %7.2fx\n", file.filename().c_str(), points, points / full,
-                points / selective, full / selective);
+    std::printf("%-28s %9zu  %12.0f  %12.0f  %7.2fx\n", file.filename().c_str(), points, points / full, points / selective,
+                full / selective);
 }
 
 }  // namespace

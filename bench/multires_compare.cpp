@@ -65,8 +65,8 @@ TreeGraph treeqsm_tree(const fs::path& path) {
         }
         const Eigen::Vector3d end = Eigen::Vector3d(sx, sy, sz) + length * Eigen::Vector3d(ax, ay, az) - tree.origin;
         if (parent < 0 || parent > static_cast<int>(end_node.size()))
-            throw Error::input(path.string(), "cylinder " + std::to_string(end_node.size() + 1) + " has parent " +
-                                                  std::to_string(parent) + " that comes later");
+            throw Error::input(path.string(), "cylinder " + std::to_string(end_node.size() + 1) + " has parent " + std::to_string(parent) +
+                                                      " that comes later");
         const int from = parent == 0 ? 0 : end_node[static_cast<std::size_t>(parent - 1)];
         end_node.push_back(tree.add_node(end.cast<float>(), static_cast<float>(radius), from));
     }
@@ -147,14 +147,16 @@ void compare(const Subject& s, bool quick, std::vector<std::string>& verdicts) {
 
     // Uncompressed DBF6: 4 bits per symbol (9 symbols), 2 bytes per radius.
     const std::size_t dbf6_bytes = (encoded.code.symbols.size() + 1) / 2 + 2 * encoded.code.radii.size();
-    std::printf("\n### %s\n\n%zu internodes, %zu tips, %.2f m of branches. LOD hierarchy: multires %zu levels, chain of "
-                "%zu entries, %zu bytes (string + chain, uncompressed); DBF6 %zu levels from one code of %zu symbols + %zu "
-                "radii, %zu bytes (uncompressed).\n\n",
-                s.name.c_str(), full.size() - 1, full.tip_count(), full.total_length(), multires.chain.lod_count(),
-                multires.chain.entries.size(), multires.bytes(), codes.size(), encoded.code.symbols.size(),
-                encoded.code.radii.size(), dbf6_bytes);
-    std::printf("| DBF6 T (mm) | DBF6 internodes | DBF6 error max / mean | multires LOD | multires internodes | "
-                "multires error max / mean | smaller max error |\n|---|---|---|---|---|---|---|\n");
+    std::printf(
+            "\n### %s\n\n%zu internodes, %zu tips, %.2f m of branches. LOD hierarchy: multires %zu levels, chain of "
+            "%zu entries, %zu bytes (string + chain, uncompressed); DBF6 %zu levels from one code of %zu symbols + %zu "
+            "radii, %zu bytes (uncompressed).\n\n",
+            s.name.c_str(), full.size() - 1, full.tip_count(), full.total_length(), multires.chain.lod_count(),
+            multires.chain.entries.size(), multires.bytes(), codes.size(), encoded.code.symbols.size(), encoded.code.radii.size(),
+            dbf6_bytes);
+    std::printf(
+            "| DBF6 T (mm) | DBF6 internodes | DBF6 error max / mean | multires LOD | multires internodes | "
+            "multires error max / mean | smaller max error |\n|---|---|---|---|---|---|---|\n");
     int multires_wins = 0, dbf6_wins = 0;
     for (std::size_t k = 0; k < codes.size(); ++k) {
         const TreeGraph decoded = encode::decode_tree(codes[k], encoded.geometry, s.name);
@@ -164,8 +166,8 @@ void compare(const Subject& s, bool quick, std::vector<std::string>& verdicts) {
         const bool m_better = m.error < d.error;
         (m_better ? multires_wins : dbf6_wins) += 1;
         std::printf("| %s | %zu | %.4f / %.5f | %zu | %zu | %.4f / %.5f | %s |\n",
-                    k == 0 ? "full" : std::to_string(static_cast<int>(thresholds[k - 1])).c_str(), d.internodes, d.error,
-                    d.mean, lod, m.internodes, m.error, m.mean, m_better ? "multires" : "DBF6");
+                    k == 0 ? "full" : std::to_string(static_cast<int>(thresholds[k - 1])).c_str(), d.internodes, d.error, d.mean, lod,
+                    m.internodes, m.error, m.mean, m_better ? "multires" : "DBF6");
     }
     verdicts.push_back(s.name + ": multires smaller at " + std::to_string(multires_wins) + " of " +
                        std::to_string(multires_wins + dbf6_wins) + " levels");
@@ -186,8 +188,9 @@ int main(int argc, char** argv) {
         const bool real = fs::exists(qsm);
         if (real) subjects.push_back({"aRchi tree1, TreeQSM cylinders (real)", treeqsm_tree(qsm)});
 
-        std::printf("## Multiresolution chain vs DBF6 LOD\n\nError: symmetric Hausdorff distance to the full tree / "
-                    "bounding-box diagonal. DBF6 at r = 5 includes its voxel quantisation (the `full` row).\n");
+        std::printf(
+                "## Multiresolution chain vs DBF6 LOD\n\nError: symmetric Hausdorff distance to the full tree / "
+                "bounding-box diagonal. DBF6 at r = 5 includes its voxel quantisation (the `full` row).\n");
         if (!real) std::printf("\n(real tree skipped: %s not found)\n", qsm.string().c_str());
         std::vector<std::string> verdicts;
         for (const Subject& s : subjects) compare(s, quick, verdicts);

@@ -43,20 +43,20 @@ Tree make_tree(std::size_t i) {
     DeriveOptions derive_options;
     std::string file;
     switch (i % 3) {
-    case 0:
-        file = "honda_monopodial.lsys";
-        parse.defines = {{"r1", vary(i, 1, 0.85, 0.95)}, {"r2", vary(i, 2, 0.55, 0.68)}, {"d", vary(i, 3, 130, 145)}};
-        derive_options.steps = 8;
-        break;
-    case 1:
-        file = "abop_ternary_tropism.lsys";
-        parse.defines = {{"a", vary(i, 4, 15, 25)}, {"d1", vary(i, 5, 85, 100)}};
-        derive_options.steps = 5;
-        break;
-    default:
-        file = "stochastic_bush.lsys";
-        derive_options.seed = i;
-        break;
+        case 0:
+            file = "honda_monopodial.lsys";
+            parse.defines = {{"r1", vary(i, 1, 0.85, 0.95)}, {"r2", vary(i, 2, 0.55, 0.68)}, {"d", vary(i, 3, 130, 145)}};
+            derive_options.steps = 8;
+            break;
+        case 1:
+            file = "abop_ternary_tropism.lsys";
+            parse.defines = {{"a", vary(i, 4, 15, 25)}, {"d1", vary(i, 5, 85, 100)}};
+            derive_options.steps = 5;
+            break;
+        default:
+            file = "stochastic_bush.lsys";
+            derive_options.seed = i;
+            break;
     }
     const LSystem system = load_lsystem(example(file), parse);
     Tree tree;

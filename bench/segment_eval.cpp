@@ -80,8 +80,13 @@ json score_json(const SegmentationScore& s) {
     json table = json::array();
     for (const auto& row : s.by_height)
         table.push_back({{"height", row.name}, {"reference", row.reference}, {"found", row.found}, {"matched", row.matched}});
-    return {{"reference_trees", s.reference_trees}, {"found_trees", s.found_trees}, {"matched", s.matched},
-            {"precision", s.precision}, {"recall", s.recall}, {"f1", s.f1}, {"points_right", s.points_right},
+    return {{"reference_trees", s.reference_trees},
+            {"found_trees", s.found_trees},
+            {"matched", s.matched},
+            {"precision", s.precision},
+            {"recall", s.recall},
+            {"f1", s.f1},
+            {"points_right", s.points_right},
             {"by_height", table}};
 }
 
@@ -91,22 +96,40 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
     if (equals == std::string::npos) throw Error::usage("--set needs name=value");
     const std::string name = assignment.substr(0, equals);
     const float v = std::stof(assignment.substr(equals + 1));
-    const std::map<std::string, float*> fields = {
-        {"chm_cell", &o.chm_cell},           {"point_radius", &o.point_radius},   {"pit_depth", &o.pit_depth},
-        {"window_base", &o.window_base},     {"window_per_metre", &o.window_per_metre}, {"max_window", &o.max_window}, {"min_top_prominence", &o.min_top_prominence}, {"top_prominence_ratio", &o.top_prominence_ratio}, {"merge_pass_ratio", &o.merge_pass_ratio}, {"chm_smoothing", &o.chm_smoothing}, {"max_stem_lean", &o.max_stem_lean}, {"graph_beta", &o.graph_beta},
-        {"seed_ratio", &o.seed_ratio},       {"crown_ratio", &o.crown_ratio},     {"max_crown_radius", &o.max_crown_radius},
-        {"min_tree_height", &o.min_tree_height}, {"max_gap", &o.max_gap},         {"graph_voxel", &o.graph_voxel},
-        {"stem_slice_low", &o.stem_slice_low}, {"stem_slice_high", &o.stem_slice_high},
-        {"min_circle_inliers", &o.min_circle_inliers}, {"min_arc_coverage", &o.min_arc_coverage},
-        {"circle_tolerance", &o.circle_tolerance}, {"ground_clearance", &o.ground_clearance}};
+    const std::map<std::string, float*> fields = {{"chm_cell", &o.chm_cell},
+                                                  {"point_radius", &o.point_radius},
+                                                  {"pit_depth", &o.pit_depth},
+                                                  {"window_base", &o.window_base},
+                                                  {"window_per_metre", &o.window_per_metre},
+                                                  {"max_window", &o.max_window},
+                                                  {"min_top_prominence", &o.min_top_prominence},
+                                                  {"top_prominence_ratio", &o.top_prominence_ratio},
+                                                  {"merge_pass_ratio", &o.merge_pass_ratio},
+                                                  {"chm_smoothing", &o.chm_smoothing},
+                                                  {"max_stem_lean", &o.max_stem_lean},
+                                                  {"graph_beta", &o.graph_beta},
+                                                  {"seed_ratio", &o.seed_ratio},
+                                                  {"crown_ratio", &o.crown_ratio},
+                                                  {"max_crown_radius", &o.max_crown_radius},
+                                                  {"min_tree_height", &o.min_tree_height},
+                                                  {"max_gap", &o.max_gap},
+                                                  {"graph_voxel", &o.graph_voxel},
+                                                  {"stem_slice_low", &o.stem_slice_low},
+                                                  {"stem_slice_high", &o.stem_slice_high},
+                                                  {"min_circle_inliers", &o.min_circle_inliers},
+                                                  {"min_arc_coverage", &o.min_arc_coverage},
+                                                  {"circle_tolerance", &o.circle_tolerance},
+                                                  {"ground_clearance", &o.ground_clearance}};
     const auto field = fields.find(name);
     if (field == fields.end()) throw Error::usage("--set: unknown option " + name);
     *field->second = v;
 }
 
 int run(int argc, char** argv) {
-    if (argc < 2) throw Error::usage("usage: segment_eval CLOUD [--mode auto|als|tls] [--reference ATTRIBUTE] [--min-height M] "
-                                     "[--ignore-classification] [--replicate N] [--trees] [--set name=value] [--dump FILE]");
+    if (argc < 2)
+        throw Error::usage(
+                "usage: segment_eval CLOUD [--mode auto|als|tls] [--reference ATTRIBUTE] [--min-height M] "
+                "[--ignore-classification] [--replicate N] [--trees] [--set name=value] [--dump FILE]");
     const std::string path = argv[1];
     SegmentOptions segment_options;
     TerrainOptions terrain_options;
@@ -121,15 +144,24 @@ int run(int argc, char** argv) {
             if (a + 1 >= argc) throw Error::usage(flag + " needs a value");
             return argv[++a];
         };
-        if (flag == "--mode") segment_options.mode = parse_scan_mode(value());
-        else if (flag == "--reference") reference_name = value();
-        else if (flag == "--min-height") min_height = std::stof(value());
-        else if (flag == "--ignore-classification") terrain_options.use_classification = false;
-        else if (flag == "--replicate") copies = std::stoi(value());
-        else if (flag == "--trees") list_trees = true;
-        else if (flag == "--set") set_option(segment_options, value());
-        else if (flag == "--dump") dump_path = value();
-        else throw Error::usage("unknown flag " + flag);
+        if (flag == "--mode")
+            segment_options.mode = parse_scan_mode(value());
+        else if (flag == "--reference")
+            reference_name = value();
+        else if (flag == "--min-height")
+            min_height = std::stof(value());
+        else if (flag == "--ignore-classification")
+            terrain_options.use_classification = false;
+        else if (flag == "--replicate")
+            copies = std::stoi(value());
+        else if (flag == "--trees")
+            list_trees = true;
+        else if (flag == "--set")
+            set_option(segment_options, value());
+        else if (flag == "--dump")
+            dump_path = value();
+        else
+            throw Error::usage("unknown flag " + flag);
     }
     const PointCloud input = read_point_cloud(path);
     std::vector<std::int32_t> reference = reference_name.empty() ? std::vector<std::int32_t>{} : reference_labels(input, reference_name);
@@ -163,7 +195,8 @@ int run(int argc, char** argv) {
             found += terrain.is_ground[i];
             squares += static_cast<double>(terrain.height_above_ground[i]) * terrain.height_above_ground[i];
         }
-        out["ground_check"] = {{"class2_points", count}, {"found_as_ground", static_cast<double>(found) / count},
+        out["ground_check"] = {{"class2_points", count},
+                               {"found_as_ground", static_cast<double>(found) / count},
                                {"rms_height_m", std::sqrt(squares / count)}};
     }
     if (!reference.empty())
@@ -171,8 +204,12 @@ int run(int argc, char** argv) {
     if (list_trees) {
         json list = json::array();
         for (const auto& t : trees.trees)
-            list.push_back({{"id", t.id}, {"x", t.base.x()}, {"y", t.base.y()}, {"height", t.top.z() - t.base.z()},
-                            {"stem_radius", t.stem_radius}, {"points", t.points}});
+            list.push_back({{"id", t.id},
+                            {"x", t.base.x()},
+                            {"y", t.base.y()},
+                            {"height", t.top.z() - t.base.z()},
+                            {"stem_radius", t.stem_radius},
+                            {"points", t.points}});
         out["tree_list"] = list;
     }
     if (!dump_path.empty()) {

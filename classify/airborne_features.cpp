@@ -25,13 +25,15 @@ namespace treelobes::classify::detail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr int kLayers = 5;            // density profile layers
-constexpr double kTopCell = 1.0;      // crown-top raster cell, m (ALS: a few points per m^2)
+constexpr int kLayers = 5;        // density profile layers
+constexpr double kTopCell = 1.0;  // crown-top raster cell, m (ALS: a few points per m^2)
 
 // Missing values stay NaN here (the other groups map an undefined ratio to 0).
 void emit(FeatureSink& out, const std::string& name, double value) {
-    if (std::isfinite(value)) out.add(name, value);
-    else out.missing(name);
+    if (std::isfinite(value))
+        out.add(name, value);
+    else
+        out.missing(name);
 }
 
 double median(std::vector<float> v) { return v.empty() ? kNaN : quantile(std::move(v), 0.5); }
@@ -51,7 +53,8 @@ CrownPoints crown_frame(const AirborneInput& in) {
     const PointCloud& c = *in.crown;
     CrownPoints p;
     float ground = std::numeric_limits<float>::max();
-    if (in.ground_z) ground = *in.ground_z;
+    if (in.ground_z)
+        ground = *in.ground_z;
     else
         for (const auto& q : c.positions) ground = std::min(ground, q.z());
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();
@@ -78,7 +81,8 @@ CrownPoints crown_frame(const AirborneInput& in) {
 // Area of the convex hull of the points (Andrew's monotone chain); 0 below 3 points.
 double hull_area(std::vector<Eigen::Vector2f> pts) {
     if (pts.size() < 3) return 0.0;
-    std::sort(pts.begin(), pts.end(), [](const Eigen::Vector2f& a, const Eigen::Vector2f& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+    std::sort(pts.begin(), pts.end(),
+              [](const Eigen::Vector2f& a, const Eigen::Vector2f& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
     const auto cross = [](const Eigen::Vector2f& o, const Eigen::Vector2f& a, const Eigen::Vector2f& b) {
         return double(a.x() - o.x()) * (b.y() - o.y()) - double(a.y() - o.y()) * (b.x() - o.x());
     };
@@ -168,7 +172,8 @@ void add_returns(const AirborneInput& in, const CrownPoints& p, FeatureSink& out
     emit(out, "als_last_share_middle", returns ? share(last[1], in_layer[1]) : kNaN);
     emit(out, "als_last_share_upper", returns ? share(last[2], in_layer[2]) : kNaN);
     emit(out, "als_mean_returns", total ? static_cast<double>(sum) / static_cast<double>(total) : kNaN);
-    emit(out, "als_ground_share", in.ground_returns + c.size() > 0 && in.ground_z ? share(in.ground_returns, in.ground_returns + c.size()) : kNaN);
+    emit(out, "als_ground_share",
+         in.ground_returns + c.size() > 0 && in.ground_z ? share(in.ground_returns, in.ground_returns + c.size()) : kNaN);
 }
 
 // The crown top on a 1 m raster in the crown frame: per cell the highest point. A dome (pines,
@@ -176,7 +181,8 @@ void add_returns(const AirborneInput& in, const CrownPoints& p, FeatureSink& out
 void add_top(const CrownPoints& p, FeatureSink& out) {
     std::map<std::pair<int, int>, float> cells;
     for (std::size_t i = 0; i < p.h.size(); ++i) {
-        const std::pair<int, int> key{static_cast<int>(std::floor(p.xy[i].x() / kTopCell)), static_cast<int>(std::floor(p.xy[i].y() / kTopCell))};
+        const std::pair<int, int> key{static_cast<int>(std::floor(p.xy[i].x() / kTopCell)),
+                                      static_cast<int>(std::floor(p.xy[i].y() / kTopCell))};
         auto [it, inserted] = cells.emplace(key, p.h[i]);
         if (!inserted) it->second = std::max(it->second, p.h[i]);
     }
@@ -232,14 +238,15 @@ void add_colour(const AirborneInput& in, const CrownPoints& p, FeatureSink& out)
 }  // namespace
 
 void describe_airborne(Catalogue& c) {
-    c.add("als_height", "m", "height of the highest crown point above the lowest ground return (without ground returns: above the lowest crown point)");
+    c.add("als_height", "m",
+          "height of the highest crown point above the lowest ground return (without ground returns: above the lowest crown point)");
     c.add("als_crown_radius", "m", "90 % quantile of the crown points' horizontal distances to their centroid");
     c.add("als_radius_height_ratio", "1", "als_crown_radius / als_height");
     c.add("als_crown_depth_ratio", "1", "(als_height - 10 % height quantile of the crown points) / als_height");
     for (int k = 0; k < kLayers; ++k)
         c.add(indexed("als_layer_share", k), "1",
               "density profile: share of the crown points with height / als_height in [" + std::to_string(k * 20) + ", " +
-                  std::to_string((k + 1) * 20) + ") %");
+                      std::to_string((k + 1) * 20) + ") %");
     c.add("als_height_cv", "1", "coefficient of variation of the crown points' heights above ground");
     c.add("als_height_q25", "m", "25 % quantile of the crown points' heights above ground");
     c.add("als_height_q50", "m", "median height of the crown points above ground");
@@ -255,7 +262,8 @@ void describe_airborne(Catalogue& c) {
     c.add("als_intensity_single_ratio", "1", "median intensity of single returns / median intensity of the crown; missing without returns");
     c.add("als_intensity_upper_first_ground_ratio", "1",
           "median intensity of the first returns above 2/3 of als_height (the sunlit top) / median intensity of the ground returns");
-    c.add("als_intensity_lower_ratio", "1", "median intensity of the points below 1/3 of als_height / median of the crown; missing when none");
+    c.add("als_intensity_lower_ratio", "1",
+          "median intensity of the points below 1/3 of als_height / median of the crown; missing when none");
     c.add("als_single_share", "1", "share of the crown points that are single returns (number of returns 1); missing without returns");
     c.add("als_first_share", "1", "share of the crown points that are first returns");
     c.add("als_second_share", "1", "share of the crown points that are second returns");
@@ -264,10 +272,14 @@ void describe_airborne(Catalogue& c) {
     c.add("als_last_share_middle", "1", "share of last returns among the crown points between 1/3 and 2/3 of als_height");
     c.add("als_last_share_upper", "1", "share of last returns among the crown points above 2/3 of als_height");
     c.add("als_mean_returns", "1", "mean number of returns of the pulses that gave the crown points");
-    c.add("als_ground_share", "1", "ground returns of the clip / (ground returns + crown points): how many pulses got through the crown; missing without ground returns");
-    c.add("als_top_drop_mean", "1", "crown top on a 1 m raster (crown frame, highest point per cell): mean of (als_height - cell top) / als_height");
+    c.add("als_ground_share", "1",
+          "ground returns of the clip / (ground returns + crown points): how many pulses got through the crown; missing without ground "
+          "returns");
+    c.add("als_top_drop_mean", "1",
+          "crown top on a 1 m raster (crown frame, highest point per cell): mean of (als_height - cell top) / als_height");
     c.add("als_top_flat_share", "1", "share of the raster cells whose top is above 90 % of als_height");
-    c.add("als_top_curvature", "1", "a R^2 / H of the least-squares fit top = c - a r^2 over the cells (dome > 0, flat 0); missing below 3 cells");
+    c.add("als_top_curvature", "1",
+          "a R^2 / H of the least-squares fit top = c - a r^2 over the cells (dome > 0, flat 0); missing below 3 cells");
     c.add("als_top_roughness", "1", "RMS residual of that fit / als_height");
     c.add("als_apex_offset", "1", "horizontal distance of the highest point to the crown centroid / als_crown_radius");
     c.add("als_rgb_red_chroma", "1", "mean R / (R + G + B) of the points above half the height; missing without colours");

@@ -49,9 +49,9 @@ std::string crown_counts_json(const std::vector<CrownCounts>& crowns) {
         input += c.input, noise += c.noise, ground += c.ground, outliers += c.high_outliers, understorey += c.understorey;
         without_ground += !c.ground_found, without_shape += !c.shape_features;
     }
-    return "{\"points\": " + std::to_string(input) + ", \"noise\": " + std::to_string(noise) + ", \"ground\": " +
-           std::to_string(ground) + ", \"high_outliers\": " + std::to_string(outliers) + ", \"understorey\": " +
-           std::to_string(understorey) + ", \"trees_without_ground_returns\": " + std::to_string(without_ground) +
+    return "{\"points\": " + std::to_string(input) + ", \"noise\": " + std::to_string(noise) + ", \"ground\": " + std::to_string(ground) +
+           ", \"high_outliers\": " + std::to_string(outliers) + ", \"understorey\": " + std::to_string(understorey) +
+           ", \"trees_without_ground_returns\": " + std::to_string(without_ground) +
            ", \"trees_without_shape_features\": " + std::to_string(without_shape) + "}";
 }
 
@@ -59,9 +59,9 @@ std::string crown_counts_csv(const FeatureBatch& batch) {
     std::string csv = "id,points,noise,ground,high_outliers,understorey,ground_found,shape_features\n";
     for (std::size_t r = 0; r < batch.crowns.size(); ++r) {
         const CrownCounts& c = batch.crowns[r];
-        csv += batch.table.ids[r] + "," + std::to_string(c.input) + "," + std::to_string(c.noise) + "," + std::to_string(c.ground) +
-               "," + std::to_string(c.high_outliers) + "," + std::to_string(c.understorey) + "," + (c.ground_found ? "1" : "0") +
-               "," + (c.shape_features ? "1" : "0") + "\n";
+        csv += batch.table.ids[r] + "," + std::to_string(c.input) + "," + std::to_string(c.noise) + "," + std::to_string(c.ground) + "," +
+               std::to_string(c.high_outliers) + "," + std::to_string(c.understorey) + "," + (c.ground_found ? "1" : "0") + "," +
+               (c.shape_features ? "1" : "0") + "\n";
     }
     return csv;
 }
@@ -92,7 +92,8 @@ FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const 
         try {
             PointCloud cloud = read_point_cloud(input.file);
             r.points = cloud.size();
-            if (input.tree_attribute.empty()) trees.push_back({input.id, std::move(cloud)});
+            if (input.tree_attribute.empty())
+                trees.push_back({input.id, std::move(cloud)});
             else
                 for (auto& [tree_id, tree] : split_trees(cloud, input.tree_attribute, input.file.string()))
                     trees.push_back({input.id + "/" + std::to_string(tree_id), std::move(tree)});

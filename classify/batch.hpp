@@ -33,9 +33,9 @@ struct FeatureBatch {
     std::vector<BatchFailure> failures;
     std::size_t points = 0;
     double seconds = 0;
-    double feature_seconds = 0;              // wall time summed over trees (without reading files); trees run in
-                                             // parallel, so on a loaded machine this exceeds the CPU time
-    double cpu_seconds = 0;                  // process CPU time of the whole batch, all threads (reading included)
+    double feature_seconds = 0;  // wall time summed over trees (without reading files); trees run in
+                                 // parallel, so on a loaded machine this exceeds the CPU time
+    double cpu_seconds = 0;      // process CPU time of the whole batch, all threads (reading included)
 };
 
 // Totals of the crown extraction over the rows, as JSON text ({"ground": ..., ...}) for summaries.

@@ -21,8 +21,7 @@ std::vector<std::size_t> by_height_descending(const PointCloud& cloud, const std
 // above the next lower point. At most half of the points: a crown is never taken for an outlier.
 std::size_t high_outlier_count(const PointCloud& cloud, const std::vector<std::size_t>& order, double gap) {
     std::size_t k = 0;
-    while (k + 1 < order.size() && 2 * (k + 1) <= order.size() &&
-           cloud.positions[order[k]].z() - cloud.positions[order[k + 1]].z() > gap)
+    while (k + 1 < order.size() && 2 * (k + 1) <= order.size() && cloud.positions[order[k]].z() - cloud.positions[order[k + 1]].z() > gap)
         ++k;
     return k;
 }

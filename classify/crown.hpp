@@ -34,8 +34,8 @@ struct CrownCounts {
 };
 
 struct CrownExtraction {
-    PointCloud crown;                     // the crown points with all their attributes
-    std::optional<float> ground_z;        // lowest ground return (local z), when the clip has class-2 points
+    PointCloud crown;               // the crown points with all their attributes
+    std::optional<float> ground_z;  // lowest ground return (local z), when the clip has class-2 points
     CrownCounts counts;
 };
 

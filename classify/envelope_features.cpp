@@ -59,8 +59,8 @@ void describe_envelope(Catalogue& c) {
     for (int k = 0; k < kLayers; ++k)
         c.add(indexed("env_area", k), "1",
               "crown outline area in height layer " + std::to_string(k + 1) + " of 10 (h in [" + std::to_string(k) + ", " +
-                  std::to_string(k + 1) + ") / 10): star polygon through the outermost voxel point of each of " + sectors +
-                  " azimuth sectors, / (pi R^2)");
+                      std::to_string(k + 1) + ") / 10): star polygon through the outermost voxel point of each of " + sectors +
+                      " azimuth sectors, / (pi R^2)");
     for (int k = 0; k < kLayers; ++k)
         c.add(indexed("env_volume_share", k), "1",
               "share of the envelope volume (sum of the layer outline areas) in height layer " + std::to_string(k + 1) + " of 10");
@@ -73,11 +73,14 @@ void describe_envelope(Catalogue& c) {
         c.add(indexed("occ_share", k), "1",
               "share of the occupied cells (size H/20, any point counts once) in height layer " + std::to_string(k + 1) + " of 10");
     for (int d = 1; d <= 9; ++d)
-        c.add(indexed("occ_decile", d), "1", std::to_string(10 * d) + " % quantile of the occupied cells' centre heights / H (cells of size H/20)");
+        c.add(indexed("occ_decile", d), "1",
+              std::to_string(10 * d) + " % quantile of the occupied cells' centre heights / H (cells of size H/20)");
     for (int k = 0; k < kRings; ++k) {
         const std::string ring = "ring " + std::to_string(k + 1) + " of " + std::to_string(kRings) + " (r / R in [" +
-                                 std::to_string(2 * k) + ", " + std::to_string(2 * k + 2) + ") / 10" + (k + 1 == kRings ? ", open" : "") + ")";
-        c.add(indexed("ring_top", k), "1", "95 % quantile of h of the voxel points in " + ring + " (the crown's upper surface seen from above)");
+                                 std::to_string(2 * k) + ", " + std::to_string(2 * k + 2) + ") / 10" + (k + 1 == kRings ? ", open" : "") +
+                                 ")";
+        c.add(indexed("ring_top", k), "1",
+              "95 % quantile of h of the voxel points in " + ring + " (the crown's upper surface seen from above)");
         c.add(indexed("ring_bottom", k), "1",
               "5 % quantile of h of the voxel points in " + ring + " above 0.05 H (how low the crown hangs: weeping branches)");
         c.add(indexed("ring_depth", k), "1", "ring_top - ring_bottom of " + ring);

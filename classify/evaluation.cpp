@@ -150,8 +150,12 @@ std::string site_split_obstacle(const LabelledSet& set, const std::vector<std::s
 class ScoreAccumulator {
 public:
     ScoreAccumulator(int classes, std::size_t rows)
-        : classes_(classes), rate_sum_(classes, 0), rate_count_(classes, 0), voted_sum_(classes, 0),
-          confusion_(classes, std::vector<double>(classes, 0)), row_predictions_(rows, std::vector<int>(classes, 0)) {}
+            : classes_(classes),
+              rate_sum_(classes, 0),
+              rate_count_(classes, 0),
+              voted_sum_(classes, 0),
+              confusion_(classes, std::vector<double>(classes, 0)),
+              row_predictions_(rows, std::vector<int>(classes, 0)) {}
 
     void add(const std::vector<std::size_t>& rows, const std::vector<int>& truth, const std::vector<int>& predicted,
              const std::vector<bool>& confident, const std::vector<int>* voted, const ClassifierRun& run) {
@@ -163,8 +167,10 @@ public:
             correct[truth[i]] += ok;
             confusion_[truth[i]][predicted[i]] += 1;
             tree_correct_ += ok, ++tree_total_;
-            if (confident[i]) confident_correct_ += ok, ++confident_total_;
-            else unconfident_correct_ += ok;
+            if (confident[i])
+                confident_correct_ += ok, ++confident_total_;
+            else
+                unconfident_correct_ += ok;
             if (voted) {
                 const bool v = (*voted)[i] == truth[i];
                 voted_correct[truth[i]] += v;
@@ -285,7 +291,7 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
     for (int c = 0; c < classes; ++c)
         if (count[c] < 2)
             throw Error::input("", "species '" + set.classes[c] + "' has " + std::to_string(count[c]) +
-                                       " tree(s); every species needs 2 or more to be trained and tested");
+                                           " tree(s); every species needs 2 or more to be trained and tested");
 
     EvaluationReport report;
     report.classes = set.classes;

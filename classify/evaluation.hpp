@@ -66,7 +66,7 @@ struct EvaluationOptions {
     double train_fraction = 0.5;
     std::uint64_t seed = 1;
     VotingOptions voting;
-    bool site_split = true;   // leave-one-group-out when the set has two or more groups
+    bool site_split = true;  // leave-one-group-out when the set has two or more groups
     // ... and when every group shares species with the others: at least this share of each
     // group's trees belongs to species that the other groups also have (otherwise a group's test
     // trees are of species never trained, and the split can only report 0 %).
@@ -74,11 +74,11 @@ struct EvaluationOptions {
 };
 
 struct Scores {
-    std::vector<double> species_rate;          // per class: mean over splits of its test accuracy
-    std::vector<int> species_trees;            // per class: trees in the set
-    std::vector<int> species_train;            // per class: training trees per split
-    double average_rate = 0;                   // mean of species_rate (paper's figure)
-    double tree_accuracy = 0;                  // correct / all test predictions
+    std::vector<double> species_rate;  // per class: mean over splits of its test accuracy
+    std::vector<int> species_trees;    // per class: trees in the set
+    std::vector<int> species_train;    // per class: training trees per split
+    double average_rate = 0;           // mean of species_rate (paper's figure)
+    double tree_accuracy = 0;          // correct / all test predictions
     // From the confusion matrix (all test trees of all splits): macro-F1 (mean over the species of
     // 2PR / (P + R)) and Cohen's kappa ((p_o - p_e) / (1 - p_e), agreement beyond chance).
     double macro_f1 = 0, kappa = 0;
@@ -90,13 +90,13 @@ struct Scores {
     std::vector<std::vector<double>> confusion;  // [true][predicted] counts over all splits
     // Confidence rule h1 > factor h2 on the classifier's own predictions.
     double confident_fraction = 0, confident_accuracy = 0, unconfident_accuracy = 0;
-    bool voted = false;                        // positions were available
+    bool voted = false;  // positions were available
     double voted_average_rate = 0, voted_tree_accuracy = 0;
     std::vector<double> voted_species_rate;
     double train_seconds = 0, predict_seconds = 0;  // totals over the splits
     double cpu_seconds = 0;                         // total CPU time of training + prediction
     double mean_rounds = 0;
-    int experiments = 0;                       // splits (or groups) evaluated
+    int experiments = 0;  // splits (or groups) evaluated
     // Per row of the set: [row][predicted class] = how often it was predicted so when tested.
     std::vector<std::vector<int>> row_predictions;
 };
@@ -104,7 +104,7 @@ struct Scores {
 struct ClassifierReport {
     std::string name;
     Scores random_splits;
-    Scores site_split;          // experiments == 0 when not run
+    Scores site_split;  // experiments == 0 when not run
 };
 
 struct EvaluationReport {
@@ -114,8 +114,8 @@ struct EvaluationReport {
     std::vector<std::string> tree_groups;  // per row, or empty
     std::vector<ClassifierReport> classifiers;
     std::vector<std::string> site_groups;
-    std::string site_split_note;           // why the site split did not run ("" when it ran or was not asked)
-    std::string mode = "random_splits";    // or "train_test": one experiment, a training set against a test set
+    std::string site_split_note;         // why the site split did not run ("" when it ran or was not asked)
+    std::string mode = "random_splits";  // or "train_test": one experiment, a training set against a test set
     double seconds = 0;
 };
 
@@ -137,8 +137,7 @@ std::string genus_of(const std::string& scientific_name);
 // as Livny et al. 2011, Fig. 7), per_tree_<name>.csv (how often each tree was tested, right, and its most
 // frequent wrong species), site_confusion_<name>.csv when a site split ran, report.md.
 // `extra_json` holds the summary.json fields the caller adds (the command and its options).
-void write_report(const EvaluationReport& report, const std::string& directory,
-                  const std::string& extra_json = "{}");
+void write_report(const EvaluationReport& report, const std::string& directory, const std::string& extra_json = "{}");
 
 // The human summary printed by `classify evaluate`.
 std::string report_summary(const EvaluationReport& report);

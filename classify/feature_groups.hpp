@@ -18,17 +18,17 @@ namespace treelobes::classify::detail {
 // One tree in its own frame: origin at the stem foot (axis x = y = 0, ground z = 0), x along
 // the crown's major horizontal axis, y along the minor one.
 struct TreeFrame {
-    std::vector<Eigen::Vector3f> points;  // one point per voxel (cleaned)
-    std::vector<Eigen::Vector3f> raw;     // input points, thinned to at most max_raw_points
-    std::vector<float> rel_height;        // per voxel point: z / height, clamped to [0, 1]
-    std::vector<float> radius;            // per voxel point: horizontal distance to the axis
-    float height = 0;                     // metres
-    float voxel = 0;                      // voxel size, metres
-    float crown_radius = 0;               // 95th percentile of `radius`
+    std::vector<Eigen::Vector3f> points;           // one point per voxel (cleaned)
+    std::vector<Eigen::Vector3f> raw;              // input points, thinned to at most max_raw_points
+    std::vector<float> rel_height;                 // per voxel point: z / height, clamped to [0, 1]
+    std::vector<float> radius;                     // per voxel point: horizontal distance to the axis
+    float height = 0;                              // metres
+    float voxel = 0;                               // voxel size, metres
+    float crown_radius = 0;                        // 95th percentile of `radius`
     float major_variance = 0, minor_variance = 0;  // variances of x and y (principal axes)
-    float trunk_diameter = 0;             // metres; 0 when no stem is visible (shape group sets it)
-    float crown_base = 0;                 // metres (shape group sets it)
-    std::size_t input_points = 0;         // points of the input cloud (before thinning and cleaning)
+    float trunk_diameter = 0;                      // metres; 0 when no stem is visible (shape group sets it)
+    float crown_base = 0;                          // metres (shape group sets it)
+    std::size_t input_points = 0;                  // points of the input cloud (before thinning and cleaning)
     const FeatureOptions* options = nullptr;
     // One neighbour search serves the normals and the skeleton: a kd-tree over `points` and
     // their kNN table (nearest first, at least normal_neighbours and skeleton_table_width wide),
@@ -91,11 +91,11 @@ void compute_scan(std::size_t input_points, float crown_radius, FeatureSink& out
 // The airborne group reads the crown with its attributes (intensity, returns, colours) and the
 // clip's ground returns: computed for every tree, however few points it has.
 struct AirborneInput {
-    const PointCloud* crown = nullptr;      // the crown, or `thinned` (see airborne_input in features.cpp)
+    const PointCloud* crown = nullptr;  // the crown, or `thinned` (see airborne_input in features.cpp)
     std::shared_ptr<const PointCloud> thinned;
-    std::optional<float> ground_z;          // lowest ground return, when the clip has ground returns
+    std::optional<float> ground_z;  // lowest ground return, when the clip has ground returns
     std::size_t ground_returns = 0;
-    double ground_intensity = 0;            // median intensity of the ground returns (0: none)
+    double ground_intensity = 0;  // median intensity of the ground returns (0: none)
 };
 void describe_airborne(Catalogue& c);
 void compute_airborne(const AirborneInput& in, FeatureSink& out);

@@ -15,8 +15,8 @@ namespace treelobes::classify {
 
 void FeatureTable::add_row(const std::string& id, std::span<const double> row) {
     if (row.size() != cols())
-        throw Error(ExitCode::Internal, "feature row '" + id + "' has " + std::to_string(row.size()) +
-                                            " values, the table has " + std::to_string(cols()) + " features");
+        throw Error(ExitCode::Internal, "feature row '" + id + "' has " + std::to_string(row.size()) + " values, the table has " +
+                                                std::to_string(cols()) + " features");
     ids.push_back(id);
     values.insert(values.end(), row.begin(), row.end());
 }
@@ -64,8 +64,10 @@ std::vector<std::string> split_csv_line(const std::string& line) {
         current.clear();
     };
     for (char ch : line) {
-        if (ch == ',') flush();
-        else current.push_back(ch);
+        if (ch == ',')
+            flush();
+        else
+            current.push_back(ch);
     }
     flush();
     return fields;
@@ -83,8 +85,7 @@ double parse_double(const std::string& text, const std::string& file, std::size_
     double v = 0;
     const auto result = std::from_chars(text.data(), text.data() + text.size(), v);
     if (result.ec != std::errc() || result.ptr != text.data() + text.size() || !std::isfinite(v))
-        throw Error::input(file, "line " + std::to_string(line) + ", column '" + column + "': '" + text +
-                                     "' is not a finite number");
+        throw Error::input(file, "line " + std::to_string(line) + ", column '" + column + "': '" + text + "' is not a finite number");
     return v;
 }
 
@@ -125,8 +126,7 @@ FeatureTable read_feature_csv(const std::filesystem::path& path) {
     const auto lines = read_lines(path);
     if (lines.empty()) throw Error::input(file, "empty feature table (expected a header 'id,<feature>,...')");
     const auto header = split_csv_line(lines.front());
-    if (header.size() < 2 || header.front() != "id")
-        throw Error::input(file, "line 1: expected a header 'id,<feature>,...'");
+    if (header.size() < 2 || header.front() != "id") throw Error::input(file, "line 1: expected a header 'id,<feature>,...'");
     FeatureTable table;
     table.feature_names.assign(header.begin() + 1, header.end());
     std::map<std::string, std::size_t> seen;
@@ -137,8 +137,8 @@ FeatureTable read_feature_csv(const std::filesystem::path& path) {
     for (std::size_t l = 1; l < lines.size(); ++l) {
         const auto fields = split_csv_line(lines[l]);
         if (fields.size() != header.size())
-            throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) +
-                                         " fields, the header has " + std::to_string(header.size()));
+            throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                                             std::to_string(header.size()));
         for (std::size_t c = 0; c < table.cols(); ++c) row[c] = parse_feature(fields[c + 1], file, l + 1, header[c + 1]);
         table.add_row(fields[0], row);
     }
@@ -167,8 +167,9 @@ std::vector<TreeLabel> read_labels_csv(const std::filesystem::path& path) {
     const auto id_col = find_column(header, {"id", "tree", "tree_id", "treeid", "file"});
     const auto species_col = find_column(header, {"species", "label", "class"});
     if (!id_col || !species_col)
-        throw Error::input(file, "line 1: the header needs an id column (id, tree, tree_id or file) and a species column "
-                                 "(species, label or class)");
+        throw Error::input(file,
+                           "line 1: the header needs an id column (id, tree, tree_id or file) and a species column "
+                           "(species, label or class)");
     const auto x_col = find_column(header, {"x", "base_x"});
     const auto y_col = find_column(header, {"y", "base_y"});
     const auto group_col = find_column(header, {"tile", "site", "group", "plot"});
@@ -177,13 +178,12 @@ std::vector<TreeLabel> read_labels_csv(const std::filesystem::path& path) {
     for (std::size_t l = 1; l < lines.size(); ++l) {
         const auto fields = split_csv_line(lines[l]);
         if (fields.size() != header.size())
-            throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) +
-                                         " fields, the header has " + std::to_string(header.size()));
+            throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                                             std::to_string(header.size()));
         TreeLabel label;
         label.id = fields[*id_col];
         label.species = fields[*species_col];
-        if (label.id.empty() || label.species.empty())
-            throw Error::input(file, "line " + std::to_string(l + 1) + ": empty id or species");
+        if (label.id.empty() || label.species.empty()) throw Error::input(file, "line " + std::to_string(l + 1) + ": empty id or species");
         if (x_col && y_col) {
             label.x = parse_double(fields[*x_col], file, l + 1, header[*x_col]);
             label.y = parse_double(fields[*y_col], file, l + 1, header[*y_col]);
@@ -209,16 +209,15 @@ std::vector<TreePosition> read_positions_csv(const std::filesystem::path& path) 
     for (std::size_t l = 1; l < lines.size(); ++l) {
         const auto fields = split_csv_line(lines[l]);
         if (fields.size() != header.size())
-            throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) +
-                                         " fields, the header has " + std::to_string(header.size()));
+            throw Error::input(file, "line " + std::to_string(l + 1) + ": " + std::to_string(fields.size()) + " fields, the header has " +
+                                             std::to_string(header.size()));
         out.push_back({fields[*id_col], parse_double(fields[*x_col], file, l + 1, header[*x_col]),
                        parse_double(fields[*y_col], file, l + 1, header[*y_col])});
     }
     return out;
 }
 
-std::vector<TreeLabel> labels_for_rows(const FeatureTable& table, const std::vector<TreeLabel>& labels,
-                                       const std::string& labels_file) {
+std::vector<TreeLabel> labels_for_rows(const FeatureTable& table, const std::vector<TreeLabel>& labels, const std::string& labels_file) {
     std::unordered_map<std::string, const TreeLabel*> by_id;
     for (const auto& label : labels) by_id.emplace(label.id, &label);
     std::vector<TreeLabel> out;

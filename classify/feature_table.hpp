@@ -20,8 +20,8 @@ namespace treelobes::classify {
 
 struct FeatureTable {
     std::vector<std::string> feature_names;
-    std::vector<std::string> ids;   // one per row
-    std::vector<double> values;     // row-major, rows() x cols()
+    std::vector<std::string> ids;  // one per row
+    std::vector<double> values;    // row-major, rows() x cols()
 
     std::size_t rows() const { return ids.size(); }
     std::size_t cols() const { return feature_names.size(); }
@@ -45,9 +45,9 @@ void write_feature_csv(const FeatureTable& table, const std::filesystem::path& p
 struct TreeLabel {
     std::string id;
     std::string species;
-    std::optional<double> x, y;     // position, metres (spatial voting)
-    std::string group;              // site or tile ("" when the file has none)
-    std::string scientific_name;    // optional column `scientific_name` (or `genus`): its first word is the genus
+    std::optional<double> x, y;   // position, metres (spatial voting)
+    std::string group;            // site or tile ("" when the file has none)
+    std::string scientific_name;  // optional column `scientific_name` (or `genus`): its first word is the genus
 };
 
 std::vector<TreeLabel> read_labels_csv(const std::filesystem::path& path);
@@ -61,8 +61,7 @@ std::vector<TreePosition> read_positions_csv(const std::filesystem::path& path);
 
 // Labels in the order of the table's rows; throws Error::input naming the first row whose id
 // has no label.
-std::vector<TreeLabel> labels_for_rows(const FeatureTable& table, const std::vector<TreeLabel>& labels,
-                                       const std::string& labels_file);
+std::vector<TreeLabel> labels_for_rows(const FeatureTable& table, const std::vector<TreeLabel>& labels, const std::string& labels_file);
 
 // Splits one CSV line at commas (no quoting: ids and names never contain commas). Trims spaces
 // and a trailing '\r'.

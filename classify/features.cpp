@@ -29,8 +29,8 @@ void FeatureSink::add(const std::string& name, double value) {
     const std::size_t index = values_.size();
     if (index >= catalogue.size() || catalogue[index].name != name)
         throw Error(ExitCode::Internal, "feature '" + name + "' emitted at position " + std::to_string(index) +
-                                            ", the catalogue expects '" +
-                                            (index < catalogue.size() ? catalogue[index].name : std::string("nothing")) + "'");
+                                                ", the catalogue expects '" +
+                                                (index < catalogue.size() ? catalogue[index].name : std::string("nothing")) + "'");
     // A degenerate tree can make a ratio undefined; 0 keeps the vector usable and is rare.
     values_.push_back(std::isfinite(value) ? value : 0.0);
 }
@@ -84,12 +84,12 @@ double seconds_since(Clock::time_point start) { return std::chrono::duration<dou
 std::vector<FeatureInfo> build_catalogue() {
     std::vector<FeatureInfo> list;
     const std::pair<const char*, void (*)(detail::Catalogue&)> groups[] = {
-        {"shape", detail::describe_shape},         {"vertical", detail::describe_vertical},
-        {"radial", detail::describe_radial},       {"horizontal", detail::describe_horizontal},
-        {"structure", detail::describe_structure}, {"normals", detail::describe_normals},
-        {"hull", detail::describe_hull},           {"skeleton", detail::describe_skeleton},
-        {"envelope", detail::describe_envelope},   {"scan", detail::describe_scan},
-        {"airborne", detail::describe_airborne},
+            {"shape", detail::describe_shape},         {"vertical", detail::describe_vertical},
+            {"radial", detail::describe_radial},       {"horizontal", detail::describe_horizontal},
+            {"structure", detail::describe_structure}, {"normals", detail::describe_normals},
+            {"hull", detail::describe_hull},           {"skeleton", detail::describe_skeleton},
+            {"envelope", detail::describe_envelope},   {"scan", detail::describe_scan},
+            {"airborne", detail::describe_airborne},
     };
     for (const auto& [group, describe] : groups) {
         detail::Catalogue catalogue(list, group);
@@ -176,8 +176,7 @@ Eigen::Vector2f principal_axis(const std::vector<Eigen::Vector3f>& points, const
 
 // The frame of the shape groups; `ground_z` (the lowest ground return of the clip) is the ground
 // level when known, else the ground plane found by the cleaning or the lowest points.
-TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, const std::string& name,
-                      std::optional<float> ground_z) {
+TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, const std::string& name, std::optional<float> ground_z) {
     TreeFrame frame;
     frame.options = &options;
     frame.input_points = cloud.size();
@@ -214,8 +213,10 @@ TreeFrame build_frame(const PointCloud& cloud, const FeatureOptions& options, co
 
     // Ground: the plane's height under the stem when the scan has ground, else the lowest points.
     float ground = detail::quantile(coordinate(pre.points, 2), 0.001);
-    if (ground_z) ground = *ground_z - base;
-    else if (pre.ground_found) ground = -pre.ground_plane.w() / pre.ground_plane.z();  // n.p + d = 0 at x = y = 0
+    if (ground_z)
+        ground = *ground_z - base;
+    else if (pre.ground_found)
+        ground = -pre.ground_plane.w() / pre.ground_plane.z();  // n.p + d = 0 at x = y = 0
     const Eigen::Vector3f shift(0, 0, ground);
     for (const auto& p : pre.points) frame.points.push_back(p - shift);
     for (const auto& p : local.positions) frame.raw.push_back(p - shift);
@@ -318,8 +319,10 @@ std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptio
     detail::compute_hull(frame, out);
     t.hull = seconds_since(start);
     start = Clock::now();
-    if (options.skeleton) detail::compute_skeleton(frame, out);
-    else detail::skip_skeleton(out);
+    if (options.skeleton)
+        detail::compute_skeleton(frame, out);
+    else
+        detail::skip_skeleton(out);
     t.skeleton = seconds_since(start);
     start = Clock::now();
     detail::compute_envelope(frame, out);
@@ -328,7 +331,7 @@ std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptio
     t.points += seconds_since(start);
     if (values.size() != feature_catalogue().size())
         throw Error(ExitCode::Internal, "feature extraction produced " + std::to_string(values.size()) + " of " +
-                                            std::to_string(feature_catalogue().size()) + " features");
+                                                std::to_string(feature_catalogue().size()) + " features");
     return values;
 }
 

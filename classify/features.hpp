@@ -25,13 +25,13 @@ struct FeatureOptions {
     double voxel_fraction = 0.01;
     double min_voxel = 0.03;
     double max_voxel = 0.25;
-    int normal_neighbours = 12;      // k of the local PCA (normals, curvature, eigen-features)
-    bool skeleton = true;            // false: the skeleton group is filled with zeros (faster)
+    int normal_neighbours = 12;           // k of the local PCA (normals, curvature, eigen-features)
+    bool skeleton = true;                 // false: the skeleton group is filled with zeros (faster)
     std::size_t max_raw_points = 400000;  // raw points read for the trunk and count features (evenly thinned above)
     // Crowns with fewer points (after the crown extraction) get only the airborne group and the
     // scan density; the shape groups need a frame, normals and a skeleton and are missing (NaN).
     std::size_t min_shape_points = 50;
-    CrownOptions crown;                   // ground, understorey, noise and outliers removed first
+    CrownOptions crown;  // ground, understorey, noise and outliers removed first
 };
 
 struct FeatureInfo {
@@ -54,9 +54,8 @@ struct FeatureTimings {
 // `crown` receives what was removed). Every tree with at least one point gets a vector: features
 // that cannot be computed are NaN (missing). Throws Error::input naming `name` when the cloud is
 // empty, or has enough points for the shape groups but is too flat to be a tree.
-std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptions& options = {},
-                                     const std::string& name = {}, FeatureTimings* timings = nullptr,
-                                     CrownCounts* crown = nullptr);
+std::vector<double> compute_features(const PointCloud& cloud, const FeatureOptions& options = {}, const std::string& name = {},
+                                     FeatureTimings* timings = nullptr, CrownCounts* crown = nullptr);
 
 // The scan group's feature: input points per m^2 of crown cover. It tells the scan kind (airborne
 // or terrestrial), changes with the point density by design, and is never a JointBoost stump

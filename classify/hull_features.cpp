@@ -37,8 +37,8 @@ void describe_hull(Catalogue& c) {
     c.add("hull_centroid_height", "1", "height of the convex hull's volume centroid / H");
     for (int d : kAlphaDivisors)
         c.add("alpha_hull_ratio_" + std::to_string(d), "1",
-              "alpha-shape volume / convex hull volume, alpha radius H/" + std::to_string(d) +
-                  " (Delaunay cells with circumradius <= H/" + std::to_string(d) + ")");
+              "alpha-shape volume / convex hull volume, alpha radius H/" + std::to_string(d) + " (Delaunay cells with circumradius <= H/" +
+                      std::to_string(d) + ")");
 }
 
 void compute_hull(const TreeFrame& f, FeatureSink& out) {

@@ -57,9 +57,7 @@ double fit_temperature(const std::vector<std::vector<double>>& scores, const std
     return best_t;
 }
 
-std::size_t JointBoostModel::part_index(const double* features) const {
-    return features[route_feature] <= route_threshold ? 0 : 1;
-}
+std::size_t JointBoostModel::part_index(const double* features) const { return features[route_feature] <= route_threshold ? 0 : 1; }
 
 std::vector<double> JointBoostModel::scores(const double* features) const {
     if (routed()) {
@@ -110,8 +108,8 @@ inline double term(double z, double w) { return w > 0 ? z * z / w : 0.0; }
 // Per class, max(separate stump gain, K_c) for one threshold from the side sums below (wl, zl)
 // and above (wg, zg). Written without branches so that the divisions vectorise: w = 0 means every
 // weight on that side is 0, hence z = 0, and 0 / 1 gives term()'s 0.
-void class_bounds(const double* __restrict wl, const double* __restrict zl, const double* __restrict wg,
-                  const double* __restrict zg, const double* __restrict k, double* __restrict out, std::size_t classes) {
+void class_bounds(const double* __restrict wl, const double* __restrict zl, const double* __restrict wg, const double* __restrict zg,
+                  const double* __restrict k, double* __restrict out, std::size_t classes) {
     for (std::size_t c = 0; c < classes; ++c) {
         const double dl = wl[c] > 0 ? wl[c] : 1.0, dg = wg[c] > 0 ? wg[c] : 1.0;
         const double v = zg[c] * zg[c] / dg + zl[c] * zl[c] / dl;
@@ -119,11 +117,10 @@ void class_bounds(const double* __restrict wl, const double* __restrict zl, cons
     }
 }
 
-void validate_training_input(const FeatureTable& table, const std::vector<int>& labels,
-                             const std::vector<std::string>& classes) {
+void validate_training_input(const FeatureTable& table, const std::vector<int>& labels, const std::vector<std::string>& classes) {
     if (labels.size() != table.rows())
-        throw Error(ExitCode::Internal, "JointBoost: " + std::to_string(labels.size()) + " labels for " +
-                                            std::to_string(table.rows()) + " rows");
+        throw Error(ExitCode::Internal,
+                    "JointBoost: " + std::to_string(labels.size()) + " labels for " + std::to_string(table.rows()) + " rows");
     if (classes.size() < 2) throw Error::input("", "JointBoost needs at least two classes, got " + std::to_string(classes.size()));
     if (table.cols() == 0) throw Error::input("", "JointBoost: the feature table has no features");
     std::vector<int> count(classes.size(), 0);
@@ -144,8 +141,8 @@ void validate_training_input(const FeatureTable& table, const std::vector<int>& 
 struct Candidate {
     double gain = -kInf;
     int feature = -1;
-    int position = -1;          // split between sorted positions position and position + 1
-    std::vector<int> sharing;   // ascending
+    int position = -1;         // split between sorted positions position and position + 1
+    std::vector<int> sharing;  // ascending
 };
 
 // One boosting run over a fixed training set.
@@ -153,7 +150,11 @@ class RoundFitter {
 public:
     // `initial_weights` (one per tree, empty = all 1) start every class's weight of that tree.
     RoundFitter(const FeatureTable& table, const std::vector<int>& labels, int classes, const std::vector<double>& initial_weights = {})
-        : table_(table), labels_(labels), n_(table.rows()), c_(classes), weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0) {
+            : table_(table),
+              labels_(labels),
+              n_(table.rows()),
+              c_(classes),
+              weights_(static_cast<std::size_t>(classes) * table.rows(), 1.0) {
         if (!initial_weights.empty())
             for (std::size_t i = 0; i < n_; ++i)
                 for (int c = 0; c < c_; ++c) weight(i, c) = initial_weights[i];
@@ -268,8 +269,8 @@ private:
     // The path is cut when no extension can reach `floor` (a gain already found): a superset T of
     // S gains at most pooled(S) + sum over c outside S of max(ind_c, K_c) (Cauchy-Schwarz again),
     // so the cut never changes the round's winner.
-    double greedy_sharing(const double* wl, const double* zl, const double* wg, const double* zg, double floor,
-                          std::vector<int>& path, int& best_size) const {
+    double greedy_sharing(const double* wl, const double* zl, const double* wg, const double* zg, double floor, std::vector<int>& path,
+                          int& best_size) const {
         double sum_wl = 0, sum_zl = 0, sum_wg = 0, sum_zg = 0, outside = k_gain_sum_;
         double individual[kMaxStackClasses], rest = 0;
         std::vector<double> heap_individual;
@@ -287,12 +288,13 @@ private:
             double chosen_gain = -kInf;
             for (int c = 0; c < c_; ++c) {
                 if (is_in(c)) continue;
-                const double g = term(sum_zg + zg[c], sum_wg + wg[c]) + term(sum_zl + zl[c], sum_wl + wl[c]) +
-                                 (outside - k_gain_[c]);
+                const double g = term(sum_zg + zg[c], sum_wg + wg[c]) + term(sum_zl + zl[c], sum_wl + wl[c]) + (outside - k_gain_[c]);
                 if (g > chosen_gain) chosen_gain = g, chosen = c;  // lowest class index wins a tie
             }
-            if (chosen < 64) in_small |= std::uint64_t(1) << chosen;
-            else in_large[chosen] = 1;
+            if (chosen < 64)
+                in_small |= std::uint64_t(1) << chosen;
+            else
+                in_large[chosen] = 1;
             path[step] = chosen;
             sum_wl += wl[chosen], sum_zl += zl[chosen], sum_wg += wg[chosen], sum_zg += zg[chosen];
             outside -= k_gain_[chosen];
@@ -413,8 +415,10 @@ private:
         for (int c : s.sharing)
             for (std::size_t i = 0; i < n_; ++i) {
                 const double w = weight(i, c), signed_w = labels_[i] == c ? w : -w;
-                if (s.goes_above(table_.at(i, s.feature))) wa += w, za += signed_w;
-                else wb += w, zb += signed_w;
+                if (s.goes_above(table_.at(i, s.feature)))
+                    wa += w, za += signed_w;
+                else
+                    wb += w, zb += signed_w;
             }
         s.a = wa > 0 ? za / wa : 0.0;
         s.b = wb > 0 ? zb / wb : 0.0;
@@ -426,15 +430,15 @@ private:
 
     const FeatureTable& table_;
     const std::vector<int>& labels_;
-    std::size_t n_, f_ = 0;                  // f_: candidate features (source_.size())
+    std::size_t n_, f_ = 0;  // f_: candidate features (source_.size())
     int c_;
-    std::vector<std::size_t> source_;        // per candidate feature: its column
-    std::vector<char> missing_above_;        // per candidate feature: missing values go above
-    std::vector<double> weights_;            // sample-major: weights_[i * classes + c]
-    std::vector<double> signed_weights_;     // z_i^c w_i^c, same layout
+    std::vector<std::size_t> source_;     // per candidate feature: its column
+    std::vector<char> missing_above_;     // per candidate feature: missing values go above
+    std::vector<double> weights_;         // sample-major: weights_[i * classes + c]
+    std::vector<double> signed_weights_;  // z_i^c w_i^c, same layout
     std::vector<std::vector<int>> order_;
-    std::vector<std::vector<int>> splits_;   // per feature: sorted positions t with value(t + 1) > value(t)
-    std::vector<double> priority_;           // per feature: its best bound in the previous round (visit order)
+    std::vector<std::vector<int>> splits_;  // per feature: sorted positions t with value(t + 1) > value(t)
+    std::vector<double> priority_;          // per feature: its best bound in the previous round (visit order)
     std::vector<double> total_w_, total_z_, k_gain_;
     double k_gain_sum_ = 0;
     double loss_ = 1.0;  // mean exp(-z H), H = 0 at the start
@@ -448,7 +452,7 @@ struct ValidationTracker {
     std::vector<std::vector<double>> scores;
 
     ValidationTracker(const FeatureTable& t, const std::vector<int>& y, int classes)
-        : table(t), labels(y), scores(t.rows(), std::vector<double>(classes, 0.0)) {}
+            : table(t), labels(y), scores(t.rows(), std::vector<double>(classes, 0.0)) {}
 
     void add(const Stump& s) {
         for (std::size_t i = 0; i < table.rows(); ++i) {
@@ -492,9 +496,8 @@ std::vector<int> subset_labels(const std::vector<int>& labels, const std::vector
 
 }  // namespace
 
-JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels,
-                                      const std::vector<std::string>& classes, int rounds,
-                                      std::vector<double>* training_loss, bool balance_classes) {
+JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels, const std::vector<std::string>& classes,
+                                      int rounds, std::vector<double>* training_loss, bool balance_classes) {
     validate_training_input(table, labels, classes);
     JointBoostModel model;
     model.classes = classes;
@@ -637,8 +640,8 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
     r = {};
     const int class_count = static_cast<int>(classes.size());
 
-    const std::vector<int> fold = options.folds >= 2 ? stratified_folds(labels, class_count, options.folds, options.seed)
-                                                     : std::vector<int>{};
+    const std::vector<int> fold =
+            options.folds >= 2 ? stratified_folds(labels, class_count, options.folds, options.seed) : std::vector<int>{};
     if (fold.empty() || *std::max_element(fold.begin(), fold.end()) < 1) {  // nothing to stop on: max_rounds
         auto model = fit_jointboost_rounds(table, labels, classes, options.max_rounds, &r.training_loss, options.balance_classes);
         r.rounds = r.rounds_tried = static_cast<int>(model.stumps.size());
@@ -652,8 +655,8 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
     // times the rounds to reach the same fit (measured: 98.2 % at 300 rounds against 97.4 % at the
     // ~170 rounds the folds chose, 480-tree set, 10 splits).
     JointBoostModel model = options.fold_ensemble
-                                ? fold_ensemble(runs, table, classes, best_rounds, options.average_probabilities)
-                                : fit_jointboost_rounds(table, labels, classes, best_rounds, nullptr, options.balance_classes);
+                                    ? fold_ensemble(runs, table, classes, best_rounds, options.average_probabilities)
+                                    : fit_jointboost_rounds(table, labels, classes, best_rounds, nullptr, options.balance_classes);
     model.temperature = r.temperature = temperature;
     r.rounds = options.fold_ensemble ? best_rounds : static_cast<int>(model.stumps.size());
     return model;
@@ -661,8 +664,7 @@ JointBoostModel train_single(const FeatureTable& table, const std::vector<int>& 
 
 }  // namespace
 
-std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std::vector<int>& labels,
-                                           const JointBoostOptions& options) {
+std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std::vector<int>& labels, const JointBoostOptions& options) {
     const auto column = std::find(table.feature_names.begin(), table.feature_names.end(), kScanDensityFeature);
     if (!options.route_by_scan || column == table.feature_names.end()) return {-1, 0.0};
     const auto f = static_cast<std::size_t>(column - table.feature_names.begin());
@@ -684,9 +686,8 @@ std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std:
     return {static_cast<int>(f), std::pow(10.0, (density[cut - 1].first + density[cut].first) / 2)};
 }
 
-JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels,
-                                 const std::vector<std::string>& classes, const JointBoostOptions& options,
-                                 JointBoostReport* report) {
+JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels, const std::vector<std::string>& classes,
+                                 const JointBoostOptions& options, JointBoostReport* report) {
     validate_training_input(table, labels, classes);
     JointBoostReport local;
     JointBoostReport& r = report ? *report : local;
@@ -729,8 +730,7 @@ constexpr const char* kProbabilityMapping = "p_c = sigma(2 H_c / T) / sum_c' sig
 nlohmann::json stumps_json(const JointBoostModel& model) {
     nlohmann::json stumps = nlohmann::json::array();
     for (const auto& s : model.stumps) {
-        stumps.push_back({{"feature", s.feature}, {"threshold", s.threshold}, {"a", s.a}, {"b", s.b},
-                          {"sharing", s.sharing}, {"k", s.k}});
+        stumps.push_back({{"feature", s.feature}, {"threshold", s.threshold}, {"a", s.a}, {"b", s.b}, {"sharing", s.sharing}, {"k", s.k}});
         if (s.missing_above) stumps.back()["missing_above"] = true;  // absent: missing values go below
     }
     return stumps;
@@ -749,11 +749,8 @@ void add_single(const JointBoostModel& model, nlohmann::json& doc) {
 
 void save_jointboost(const JointBoostModel& model, const std::filesystem::path& path) {
     nlohmann::json doc = {
-        {"format", "treelobes-jointboost"},
-        {"version", kJointBoostModelVersion},
-        {"probability", kProbabilityMapping},
-        {"classes", model.classes},
-        {"features", model.feature_names},
+            {"format", "treelobes-jointboost"}, {"version", kJointBoostModelVersion}, {"probability", kProbabilityMapping},
+            {"classes", model.classes},         {"features", model.feature_names},
     };
     if (!model.routed()) {
         add_single(model, doc);
@@ -789,8 +786,7 @@ Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const s
     if (s.sharing.empty()) throw Error::input(file, where + "empty sharing set");
     for (int c : s.sharing)
         if (c < 0 || c >= model.class_count()) throw Error::input(file, where + "class index out of range");
-    if (!std::isfinite(s.threshold) || !std::isfinite(s.a) || !std::isfinite(s.b))
-        throw Error::input(file, where + "non-finite value");
+    if (!std::isfinite(s.threshold) || !std::isfinite(s.a) || !std::isfinite(s.b)) throw Error::input(file, where + "non-finite value");
     s.finalise(model.class_count());
     return s;
 }
@@ -814,7 +810,8 @@ void parse_single(const nlohmann::json& j, int version, JointBoostModel& model, 
         const auto& list = members[k].at("stumps");
         if (!list.is_array()) throw Error::input(file, where + "member " + std::to_string(k) + ": \"stumps\" is not an array");
         for (std::size_t m = 0; m < list.size(); ++m)
-            member.stumps.push_back(parse_stump(list[m], member, file, where + "member " + std::to_string(k) + " stump " + std::to_string(m) + ": "));
+            member.stumps.push_back(
+                    parse_stump(list[m], member, file, where + "member " + std::to_string(k) + " stump " + std::to_string(m) + ": "));
         model.members.push_back(std::move(member));
     }
 }
@@ -861,19 +858,20 @@ JointBoostModel load_jointboost(const std::filesystem::path& path) {
     }
     if (!doc.is_object() || !doc.contains("format") || doc["format"] != "treelobes-jointboost")
         throw Error::input(file, "not a JointBoost model (expected \"format\": \"treelobes-jointboost\")");
-    if (!doc.contains("version") || !doc["version"].is_number_integer())
-        throw Error::input(file, "the model has no integer \"version\"");
+    if (!doc.contains("version") || !doc["version"].is_number_integer()) throw Error::input(file, "the model has no integer \"version\"");
     const int version = doc["version"].get<int>();
     if (version < 1 || version > kJointBoostModelVersion)
         throw Error::input(file, "model version " + std::to_string(version) + " is not supported (this build reads versions 1 to " +
-                                     std::to_string(kJointBoostModelVersion) + ")");
+                                         std::to_string(kJointBoostModelVersion) + ")");
     JointBoostModel model;
     try {
         model.classes = doc.at("classes").get<std::vector<std::string>>();
         model.feature_names = doc.at("features").get<std::vector<std::string>>();
         if (model.classes.size() < 2) throw Error::input(file, "fewer than two classes");
-        if (version >= 3 && doc.contains("routing")) parse_routing(doc, model, file);
-        else parse_single(doc, version, model, file, "");
+        if (version >= 3 && doc.contains("routing"))
+            parse_routing(doc, model, file);
+        else
+            parse_single(doc, version, model, file, "");
     } catch (const nlohmann::json::exception& e) {
         throw Error::input(file, std::string("malformed JointBoost model: ") + e.what());
     }

@@ -38,7 +38,7 @@
 namespace treelobes::classify {
 
 struct JointBoostOptions {
-    int max_rounds = 800;              // upper bound on the number of stumps
+    int max_rounds = 800;  // upper bound on the number of stumps
     // Early stopping by stratified, seeded K-fold cross-validation on the training trees: K
     // boosting runs, each on the other K-1 folds, advance round by round together; after every
     // round all training trees are scored out of fold (fewest errors, then lowest mean log-loss
@@ -79,7 +79,7 @@ struct JointBoostOptions {
     // class), so that each class weighs the same in total, and out-of-fold errors are counted
     // with the same weights. A balanced training set is unchanged (all weights 1).
     bool balance_classes = true;
-    std::uint64_t seed = 1;            // fold assignment
+    std::uint64_t seed = 1;  // fold assignment
 };
 
 struct Stump {
@@ -89,10 +89,10 @@ struct Stump {
     // tried with them below and above every threshold), false = below.
     bool missing_above = false;
     bool goes_above(double v) const { return std::isnan(v) ? missing_above : v > threshold; }
-    double a = 0;                      // value for classes in the set when v_f > threshold
-    double b = 0;                      // value for classes in the set when v_f <= threshold
-    std::vector<int> sharing;          // classes of S, ascending
-    std::vector<double> k;             // per class; used for classes outside S
+    double a = 0;              // value for classes in the set when v_f > threshold
+    double b = 0;              // value for classes in the set when v_f <= threshold
+    std::vector<int> sharing;  // classes of S, ascending
+    std::vector<double> k;     // per class; used for classes outside S
     // Per-class values above/below the threshold (derived from the above; used by evaluation).
     std::vector<double> above, below;
     void finalise(int classes);
@@ -102,7 +102,7 @@ struct JointBoostModel {
     std::vector<std::string> classes;        // class names, index = class id
     std::vector<std::string> feature_names;  // the columns the stumps index
     std::vector<Stump> stumps;
-    double temperature = 1.0;                // T of the probability mapping
+    double temperature = 1.0;  // T of the probability mapping
 
     // Routing by scan kind (empty `parts`: a single model). A tree whose feature route_feature is
     // <= route_threshold goes to parts[0] (the sparser scans: airborne), the others to parts[1].
@@ -136,9 +136,9 @@ std::vector<double> probabilities_from_scores(const std::vector<double>& scores,
 double fit_temperature(const std::vector<std::vector<double>>& scores, const std::vector<int>& labels);
 
 struct JointBoostReport {
-    int rounds = 0;                          // boosting rounds of the returned model (fold ensemble: of each member)
-    int rounds_tried = 0;                    // rounds run before early stopping
-    double temperature = 1.0;                // fitted T (1 without calibration; routed: the parts' mean)
+    int rounds = 0;            // boosting rounds of the returned model (fold ensemble: of each member)
+    int rounds_tried = 0;      // rounds run before early stopping
+    double temperature = 1.0;  // fitted T (1 without calibration; routed: the parts' mean)
     // After each round tried: mean exp(-z H) over trees and classes (the fold runs' mean with
     // cross-validation), and the out-of-fold error rate and mean log-loss (T = 1).
     std::vector<double> training_loss;
@@ -151,19 +151,16 @@ struct JointBoostReport {
 // Trains on `table` with class ids `labels` (0..classes.size()-1, one per row). Throws
 // Error::input when fewer than two classes are present, a value is not finite or labels and
 // rows disagree.
-JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels,
-                                 const std::vector<std::string>& classes, const JointBoostOptions& options,
-                                 JointBoostReport* report = nullptr);
+JointBoostModel train_jointboost(const FeatureTable& table, const std::vector<int>& labels, const std::vector<std::string>& classes,
+                                 const JointBoostOptions& options, JointBoostReport* report = nullptr);
 
 // The boosting rounds themselves, without early stopping (exposed for tests): `rounds` stumps.
-JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels,
-                                      const std::vector<std::string>& classes, int rounds,
-                                      std::vector<double>* training_loss = nullptr, bool balance_classes = false);
+JointBoostModel fit_jointboost_rounds(const FeatureTable& table, const std::vector<int>& labels, const std::vector<std::string>& classes,
+                                      int rounds, std::vector<double>* training_loss = nullptr, bool balance_classes = false);
 
 // The scan routing train_jointboost would choose for these training trees: the column of the scan
 // descriptor and the density threshold, or route_feature = -1 (one model).
-std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std::vector<int>& labels,
-                                           const JointBoostOptions& options);
+std::pair<int, double> choose_scan_routing(const FeatureTable& table, const std::vector<int>& labels, const JointBoostOptions& options);
 
 // Model file: JSON with "format": "treelobes-jointboost", "version": 3, the class and feature
 // names, the probability mapping, and either the temperature and stumps (and, for an ensemble

@@ -17,10 +17,10 @@ namespace treelobes::classify::detail {
 namespace {
 
 constexpr double kRadToDeg = 57.29577951308232;
-constexpr int kAngleBins = 9;        // 10 degree bins over 0..90
-constexpr int kLayerAngleBins = 6;   // 15 degree bins per crown third
-constexpr int kCurvatureBins = 8;    // over 0 .. 1/3 (the maximum of lambda_min / sum)
-constexpr int kDirectionBins = 6;    // 15 degree bins of linear directions
+constexpr int kAngleBins = 9;       // 10 degree bins over 0..90
+constexpr int kLayerAngleBins = 6;  // 15 degree bins per crown third
+constexpr int kCurvatureBins = 8;   // over 0 .. 1/3 (the maximum of lambda_min / sum)
+constexpr int kDirectionBins = 6;   // 15 degree bins of linear directions
 
 struct LocalShape {
     Eigen::Vector3f normal{0, 0, 1};
@@ -74,17 +74,17 @@ void describe_normals(Catalogue& c) {
     for (int k = 0; k < kAngleBins; ++k)
         c.add(indexed("normal_elevation", k), "1",
               "fraction of points whose normal line rises " + std::to_string(k * 10) + "-" + std::to_string(k * 10 + 10) +
-                  " deg above the horizontal plane (asin |n_z|); normals from PCA of the k nearest voxel points");
+                      " deg above the horizontal plane (asin |n_z|); normals from PCA of the k nearest voxel points");
     for (int k = 0; k < kAngleBins; ++k)
         c.add(indexed("normal_axis_angle", k), "1",
               "fraction of points (r > 1 voxel) whose normal line makes " + std::to_string(k * 10) + "-" + std::to_string(k * 10 + 10) +
-                  " deg with the horizontal direction away from the tree axis (acos |n . u_r|)");
+                      " deg with the horizontal direction away from the tree axis (acos |n . u_r|)");
     const char* thirds[] = {"lower", "middle", "upper"};
     for (int t = 0; t < 3; ++t)
         for (int k = 0; k < kLayerAngleBins; ++k)
             c.add(std::string("normal_elevation_") + thirds[t] + "_" + std::to_string(k), "1",
                   std::string("as normal_elevation, 15 deg bins (") + std::to_string(k * 15) + "-" + std::to_string(k * 15 + 15) +
-                      " deg), points of the " + thirds[t] + " third of the height");
+                          " deg), points of the " + thirds[t] + " third of the height");
     c.add("normal_vertical_mean", "1", "mean |n_z|");
     c.add("normal_vertical_sd", "1", "standard deviation of |n_z|");
     c.add("normal_axis_mean", "1", "mean |n . u_r| (1 = surfaces facing away from the axis)");
@@ -102,7 +102,7 @@ void describe_normals(Catalogue& c) {
     for (int k = 0; k < kDirectionBins; ++k)
         c.add(indexed("linear_direction", k), "1",
               "among linear points: fraction whose principal direction rises " + std::to_string(k * 15) + "-" +
-                  std::to_string(k * 15 + 15) + " deg above the horizontal (branch directions)");
+                      std::to_string(k * 15 + 15) + " deg above the horizontal (branch directions)");
     c.add("omnivariance_mean", "1", "mean cube root of l1 l2 l3 (eigenvalues normalised to sum 1)");
     c.add("anisotropy_mean", "1", "mean (l1 - l3) / l1");
     c.add("eigenentropy_mean", "1", "mean -sum l ln l");

@@ -62,8 +62,7 @@ int stem_count(const TreeFrame& f, double h) {
     for (auto i : layer(f, h - 0.02, h + 0.02)) pts.push_back(f.points[i].head<2>());
     if (pts.size() < 3) return 0;
     int count = 0;
-    for (int n : cluster_sizes_2d(pts, 2.5f * f.voxel))
-        count += n >= 3 && n >= 0.05 * static_cast<double>(pts.size());
+    for (int n : cluster_sizes_2d(pts, 2.5f * f.voxel)) count += n >= 3 && n >= 0.05 * static_cast<double>(pts.size());
     return count;
 }
 
@@ -111,12 +110,16 @@ void describe_shape(Catalogue& c) {
     c.add("crown_width_minor", "m", "extent along the minor horizontal axis (98 % minus 2 % quantile of y)");
     c.add("width_height_ratio", "1", "mean of the two crown widths divided by H");
     c.add("crown_elongation", "1", "minor over major crown width");
-    c.add("trunk_diameter", "m", "stem diameter at 1.1-1.5 m (15-25 % of H below 6 m): least-squares circle through the raw points near the axis; 0 when no stem is visible");
+    c.add("trunk_diameter", "m",
+          "stem diameter at 1.1-1.5 m (15-25 % of H below 6 m): least-squares circle through the raw points near the axis; 0 when no stem "
+          "is visible");
     c.add("trunk_diameter_ratio", "1", "trunk_diameter / H");
-    c.add("crown_base_height", "m", "trunk height: bottom of the lowest of 50 layers whose 90 % radius exceeds max(2.5 trunk radius, 0.25 R)");
+    c.add("crown_base_height", "m",
+          "trunk height: bottom of the lowest of 50 layers whose 90 % radius exceeds max(2.5 trunk radius, 0.25 R)");
     c.add("crown_base_ratio", "1", "crown_base_height / H");
     c.add("widest_layer_height", "1", "relative height of the layer (of 50) with the largest 90 % radius");
-    c.add("stems_at_05", "count", "main stems at 5 % of H: connected groups (link 2.5 voxels) of the layer's voxel points with >= 5 % of them");
+    c.add("stems_at_05", "count",
+          "main stems at 5 % of H: connected groups (link 2.5 voxels) of the layer's voxel points with >= 5 % of them");
     c.add("stems_at_10", "count", "main stems at 10 % of H (as stems_at_05)");
     c.add("stems_at_20", "count", "main stems at 20 % of H (as stems_at_05)");
     c.add("crown_offset_ratio", "1", "horizontal distance from the axis to the centroid of the points above the crown base, / R");
@@ -200,8 +203,8 @@ void describe_radial(Catalogue& c) {
         c.add(indexed("profile_shape", k), "1", "90 % quantile of r / R in " + span + " (crown outline, size-free)");
     }
     for (int k = 0; k < kRadialBins; ++k)
-        c.add(indexed("rhist", k), "1", "fraction of voxel points with r / R in [" + std::to_string(k) + ", " + std::to_string(k + 1) +
-                                            ") / 10 (last bin open)");
+        c.add(indexed("rhist", k), "1",
+              "fraction of voxel points with r / R in [" + std::to_string(k) + ", " + std::to_string(k + 1) + ") / 10 (last bin open)");
     c.add("r_mean", "1", "mean of r / R");
     c.add("r_sd", "1", "standard deviation of r / R");
     c.add("r_skewness", "1", "skewness of r / R");
@@ -243,11 +246,12 @@ void describe_horizontal(Catalogue& c) {
         for (int m = 1; m <= 3; ++m)
             c.add(std::string("azimuth_fourier_") + thirds[t] + "_" + std::to_string(m), "1",
                   "|mean of exp(i " + std::to_string(m) + " phi)| over the azimuths phi of the " + thirds[t] +
-                      " third's points with r > 0.2 R (crown asymmetry; 0 = round)");
+                          " third's points with r > 0.2 R (crown asymmetry; 0 = round)");
     for (int k = 0; k < kSectors; ++k)
         c.add(indexed("sector_radius_sorted", k + 1), "1",
               "crown outline: 90 % radius / R in each of 8 azimuth sectors (45 deg, from the major axis) of the crown, sorted "
-              "from the largest; this is rank " + std::to_string(k + 1));
+              "from the largest; this is rank " +
+                      std::to_string(k + 1));
     c.add("sector_radius_cv", "1", "coefficient of variation of the 8 sector radii");
     c.add("major_minor_sd_ratio", "1", "sqrt(var y / var x) of the voxel points (principal axes)");
     c.add("crown_eccentricity", "1", "sqrt(1 - var y / var x)");
@@ -310,9 +314,7 @@ struct CellKey {
     bool operator==(const CellKey&) const = default;
 };
 struct CellHash {
-    std::size_t operator()(const CellKey& k) const {
-        return static_cast<std::size_t>(k.x * 73856093L ^ k.y * 19349663L ^ k.z * 83492791L);
-    }
+    std::size_t operator()(const CellKey& k) const { return static_cast<std::size_t>(k.x * 73856093L ^ k.y * 19349663L ^ k.z * 83492791L); }
 };
 
 // Occupied cells of size `cell` (grid anchored at the points' minimum corner in the frame) and
@@ -430,7 +432,8 @@ void compute_structure(const TreeFrame& f, FeatureSink& out) {
         out.add("lacunarity_" + std::to_string(n), s1 > 0 ? (s2 / boxes) / ((s1 / boxes) * (s1 / boxes)) : 0.0);
     }
     std::vector<double> log_count;
-    for (int k = 1; k <= 6; ++k) log_count.push_back(std::log2(static_cast<double>(occupancy(f.points, lo, f.height / std::pow(2.0f, k)).size())));
+    for (int k = 1; k <= 6; ++k)
+        log_count.push_back(std::log2(static_cast<double>(occupancy(f.points, lo, f.height / std::pow(2.0f, k)).size())));
     for (int k = 1; k <= 5; ++k) out.add(indexed("boxcount_step", k), log_count[k] - log_count[k - 1]);
     {
         // Least squares of log2 N against k = 2..6 (sizes H/4 .. H/64).

@@ -61,7 +61,8 @@ void write_heatmap(const std::vector<std::vector<double>>& percent, const std::v
                 char text[16];
                 std::snprintf(text, sizeof text, "%.0f", percent[r][c]);
                 const render::Rgba ink = v > 0.5 ? render::Rgba{255, 255, 255, 255} : render::Rgba{0, 0, 0, 255};
-                draw_text(image, left + c * cell + (cell - text_width(text, scale)) / 2, top + r * cell + (cell - 5 * scale) / 2, text, scale, ink);
+                draw_text(image, left + c * cell + (cell - text_width(text, scale)) / 2, top + r * cell + (cell - 5 * scale) / 2, text,
+                          scale, ink);
             }
         }
     draw_text(image, left, top + n * cell + 6, "ROWS: TRUE SPECIES  COLUMNS: PREDICTED  (% OF ROW)", 1, {80, 80, 80, 255});
@@ -167,17 +168,16 @@ void write_per_tree_csv(const EvaluationReport& report, const Scores& scores, co
             if (static_cast<int>(c) != truth && counts[c] > 0 && (wrong_best < 0 || counts[c] > counts[wrong_best]))
                 wrong_best = static_cast<int>(c);
         }
-        csv << report.tree_ids[r] << ',' << report.classes[truth] << ',' << (report.tree_groups.empty() ? "" : report.tree_groups[r])
-            << ',' << tested << ',' << counts[truth] << ',' << (tested > 0 ? percent(counts[truth] / static_cast<double>(tested)) : "")
-            << ',' << (wrong_best < 0 ? "" : report.classes[wrong_best]) << '\n';
+        csv << report.tree_ids[r] << ',' << report.classes[truth] << ',' << (report.tree_groups.empty() ? "" : report.tree_groups[r]) << ','
+            << tested << ',' << counts[truth] << ',' << (tested > 0 ? percent(counts[truth] / static_cast<double>(tested)) : "") << ','
+            << (wrong_best < 0 ? "" : report.classes[wrong_best]) << '\n';
     }
     write_file_atomically(path, csv.str());
 }
 
 }  // namespace
 
-void write_report(const EvaluationReport& report, const std::string& directory,
-                  const std::string& extra_json) {
+void write_report(const EvaluationReport& report, const std::string& directory, const std::string& extra_json) {
     const std::filesystem::path dir(directory);
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
@@ -195,9 +195,10 @@ void write_report(const EvaluationReport& report, const std::string& directory,
         summary["classifiers"][c.name] = entry;
         const std::string stem = safe_name(c.name);
         write_confusion_csv(c.random_splits.confusion, report.classes, dir / ("confusion_" + stem + ".csv"));
-        write_heatmap(row_percentages(c.random_splits.confusion), report.classes,
-                      c.name + " " + std::to_string(c.random_splits.experiments) + " SPLITS: " + percent(c.random_splits.average_rate) + " %",
-                      dir / ("confusion_" + stem + ".png"));
+        write_heatmap(
+                row_percentages(c.random_splits.confusion), report.classes,
+                c.name + " " + std::to_string(c.random_splits.experiments) + " SPLITS: " + percent(c.random_splits.average_rate) + " %",
+                dir / ("confusion_" + stem + ".png"));
         if (c.site_split.experiments > 0)
             write_confusion_csv(c.site_split.confusion, report.classes, dir / ("site_confusion_" + stem + ".csv"));
         write_per_tree_csv(report, c.random_splits, dir / ("per_tree_" + stem + ".csv"));
@@ -229,14 +230,17 @@ void write_report(const EvaluationReport& report, const std::string& directory,
 std::string report_summary(const EvaluationReport& report) {
     std::ostringstream out;
     out << "Species classification: " << report.classes.size() << " species, ";
-    if (report.mode == "train_test") out << "trained on one set, tested on another";
-    else out << (report.classifiers.empty() ? 0 : report.classifiers.front().random_splits.experiments) << " random 50/50 splits";
+    if (report.mode == "train_test")
+        out << "trained on one set, tested on another";
+    else
+        out << (report.classifiers.empty() ? 0 : report.classifiers.front().random_splits.experiments) << " random 50/50 splits";
     if (!report.site_groups.empty()) out << ", site split over " << report.site_groups.size() << " groups";
     char line[256];
     std::snprintf(line, sizeof line, " (%.1f s)\n", report.seconds);
     out << line;
     if (!report.site_split_note.empty()) out << "Site split " << report.site_split_note << "\n";
-    out << "\n| classifier | average recognition rate | tree accuracy | macro-F1 | kappa | genus: tree accuracy / rate | confident: share / accuracy | unconfident accuracy | with voting: rate / trees | site split | train s/split | CPU s/split |\n"
+    out << "\n| classifier | average recognition rate | tree accuracy | macro-F1 | kappa | genus: tree accuracy / rate | confident: share "
+           "/ accuracy | unconfident accuracy | with voting: rate / trees | site split | train s/split | CPU s/split |\n"
         << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& c : report.classifiers) {
         const Scores& s = c.random_splits;
@@ -244,8 +248,8 @@ std::string report_summary(const EvaluationReport& report) {
         out << "| " << c.name << " | " << percent(s.average_rate) << " % | " << percent(s.tree_accuracy) << " % | " << line << " | "
             << (s.genus_level ? percent(s.genus_tree_accuracy) + " % / " + percent(s.genus_average_rate) + " %" : std::string("-")) << " | "
             << percent(s.confident_fraction) << " % / " << percent(s.confident_accuracy) << " % | " << percent(s.unconfident_accuracy)
-            << " % | " << (s.voted ? percent(s.voted_average_rate) + " % / " + percent(s.voted_tree_accuracy) + " %" : std::string("-")) << " | "
-            << (c.site_split.experiments > 0 ? percent(c.site_split.average_rate) + " %" : std::string("-")) << " | ";
+            << " % | " << (s.voted ? percent(s.voted_average_rate) + " % / " + percent(s.voted_tree_accuracy) + " %" : std::string("-"))
+            << " | " << (c.site_split.experiments > 0 ? percent(c.site_split.average_rate) + " %" : std::string("-")) << " | ";
         std::snprintf(line, sizeof line, "%.3f | %.3f", s.experiments ? s.train_seconds / s.experiments : 0.0,
                       s.experiments ? s.cpu_seconds / s.experiments : 0.0);
         out << line << " |\n";

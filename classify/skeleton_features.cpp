@@ -23,10 +23,10 @@ struct Axis {
     int fork = -1;           // node it grows from (-1 for the trunk)
     std::vector<int> nodes;  // first node of the axis .. tip
     int order = 0;
-    double length = 0;       // including the edge from the fork
-    double angle = 0;        // degrees between its start and the parent axis at the fork
-    double elevation = 0;    // degrees of its start direction above the horizontal
-    double radius = 0;       // allometric radius at its base / root radius
+    double length = 0;     // including the edge from the fork
+    double angle = 0;      // degrees between its start and the parent axis at the fork
+    double elevation = 0;  // degrees of its start direction above the horizontal
+    double radius = 0;     // allometric radius at its base / root radius
 };
 
 // Walks up the parents from `node` until the path length reaches `distance`.
@@ -134,8 +134,9 @@ void describe_skeleton(Catalogue& c) {
     for (const char* o : kOrderNames) {
         const std::string order = o[1] == '1' ? "first-order" : "second-order";
         c.add(std::string("skel_angle_") + o + "_mean", "deg",
-              "mean branching angle of " + order + " branches: between the branch start (over max(5 % H, 3 internodes), at most half "
-              "its length) and the parent axis before the fork");
+              "mean branching angle of " + order +
+                      " branches: between the branch start (over max(5 % H, 3 internodes), at most half "
+                      "its length) and the parent axis before the fork");
         c.add(std::string("skel_angle_") + o + "_sd", "deg", "standard deviation of those angles");
         c.add(std::string("skel_angle_") + o + "_q25", "deg", "25 % quantile of those angles");
         c.add(std::string("skel_angle_") + o + "_q50", "deg", "median of those angles");
@@ -165,7 +166,8 @@ void describe_skeleton(Catalogue& c) {
     c.add("skel_length_fraction_o3plus", "1", "fraction on branches of order 3 and higher");
     c.add("skel_max_order", "count", "highest branch order");
     c.add("skel_first_branch_height", "1", "height of the lowest first-order fork on the trunk / H");
-    c.add("skel_whorl_count", "count", "whorls: first-order forks on the trunk grouped when less than max(2 % H, 2 voxels) apart in height");
+    c.add("skel_whorl_count", "count",
+          "whorls: first-order forks on the trunk grouped when less than max(2 % H, 2 voxels) apart in height");
     c.add("skel_whorl_spacing_mean", "1", "mean height step between consecutive whorls / H");
     c.add("skel_whorl_spacing_cv", "1", "coefficient of variation of the whorl spacing");
     c.add("skel_branches_per_whorl", "1", "first-order branches on the trunk per whorl");
@@ -217,7 +219,7 @@ void add_axis_features(const TreeGraph& t, const std::vector<Axis>& axes, double
         const Summary s = summarise(angle[o]);
         const std::string p = std::string("skel_angle_") + kOrderNames[o];
         out.add(p + "_mean", s.mean), out.add(p + "_sd", s.sd), out.add(p + "_q25", s.q25), out.add(p + "_q50", s.q50),
-            out.add(p + "_q75", s.q75);
+                out.add(p + "_q75", s.q75);
     }
     for (int o = 0; o < 2; ++o) {
         const Summary s = summarise(elevation[o]);

@@ -18,8 +18,10 @@ void stratified_split(const std::vector<int>& labels, int classes, double fracti
         for (std::size_t i = members.size(); i > 1; --i) std::swap(members[i - 1], members[rng.below(i)]);  // Fisher-Yates
         const std::size_t n = members.size();
         std::size_t take = static_cast<std::size_t>(std::floor(fraction * static_cast<double>(n) + 1e-9));
-        if (n >= 2) take = std::clamp<std::size_t>(take, 1, n - 1);
-        else take = single_to_first ? n : 0;
+        if (n >= 2)
+            take = std::clamp<std::size_t>(take, 1, n - 1);
+        else
+            take = single_to_first ? n : 0;
         first.insert(first.end(), members.begin(), members.begin() + static_cast<std::ptrdiff_t>(take));
         second.insert(second.end(), members.begin() + static_cast<std::ptrdiff_t>(take), members.end());
     }

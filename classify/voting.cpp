@@ -41,8 +41,8 @@ VotingResult spatial_vote(const std::vector<std::vector<double>>& probabilities,
     if (!(options.confidence_factor >= 1.0)) throw Error::usage("voting: the confidence factor must be at least 1");
     if (!(options.radius_m >= 0.0)) throw Error::usage("voting: the radius must not be negative");
     if (probabilities.size() != positions.size())
-        throw Error(ExitCode::Internal, "voting: " + std::to_string(positions.size()) + " positions for " +
-                                            std::to_string(probabilities.size()) + " trees");
+        throw Error(ExitCode::Internal,
+                    "voting: " + std::to_string(positions.size()) + " positions for " + std::to_string(probabilities.size()) + " trees");
     const std::size_t n = probabilities.size();
     VotingResult r;
     r.species.resize(n);

@@ -22,9 +22,9 @@ struct VotingOptions {
 bool is_confident(const std::vector<double>& probabilities, double factor);
 
 struct VotingResult {
-    std::vector<int> species;        // voted class per tree
-    std::vector<bool> confident;     // per tree
-    std::vector<bool> changed;       // the vote replaced the tree's own most probable class
+    std::vector<int> species;     // voted class per tree
+    std::vector<bool> confident;  // per tree
+    std::vector<bool> changed;    // the vote replaced the tree's own most probable class
 };
 
 // Throws Error(Usage) for a factor below 1 or a negative radius; positions and probabilities

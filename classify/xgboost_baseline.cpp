@@ -30,8 +30,7 @@ struct Matrix {
         data.reserve(rows.size() * t.cols());
         for (auto r : rows)
             for (std::size_t c = 0; c < t.cols(); ++c) data.push_back(static_cast<float>(t.at(r, c)));
-        check(XGDMatrixCreateFromMat(data.data(), rows.size(), t.cols(), std::numeric_limits<float>::quiet_NaN(), &handle),
-              "matrix");
+        check(XGDMatrixCreateFromMat(data.data(), rows.size(), t.cols(), std::numeric_limits<float>::quiet_NaN(), &handle), "matrix");
         if (labels) {
             std::vector<float> y;
             for (auto r : rows) y.push_back(static_cast<float>((*labels)[r]));
@@ -55,14 +54,19 @@ struct Booster {
     BoosterHandle handle = nullptr;
     Booster(const Matrix& train, int classes, const XGBoostOptions& o) {
         check(XGBoosterCreate(&train.handle, 1, &handle), "booster");
-        const int threads = o.threads > 0 ? o.threads
-                                          : static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+        const int threads = o.threads > 0
+                                    ? o.threads
+                                    : static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
         // XGBoost parses "seed" as a signed integer: the split seeds are 64-bit, so keep 31 bits.
         const std::pair<const char*, std::string> params[] = {
-            {"objective", "multi:softprob"}, {"num_class", std::to_string(classes)},
-            {"eta", std::to_string(o.eta)},   {"max_depth", std::to_string(o.max_depth)},
-            {"seed", std::to_string(o.seed & 0x7fffffffu)}, {"nthread", std::to_string(threads)},
-            {"tree_method", "hist"},          {"verbosity", "0"},
+                {"objective", "multi:softprob"},
+                {"num_class", std::to_string(classes)},
+                {"eta", std::to_string(o.eta)},
+                {"max_depth", std::to_string(o.max_depth)},
+                {"seed", std::to_string(o.seed & 0x7fffffffu)},
+                {"nthread", std::to_string(threads)},
+                {"tree_method", "hist"},
+                {"verbosity", "0"},
         };
         for (const auto& [key, value] : params) check(XGBoosterSetParam(handle, key, value.c_str()), key);
     }

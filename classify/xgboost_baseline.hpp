@@ -19,8 +19,8 @@ struct XGBoostOptions {
     double validation_fraction = 0.2;  // as JointBoostOptions
     int patience = 30;
     std::uint64_t seed = 1;
-    int threads = 0;                   // 0 = as many as TBB may use
-    bool balance_classes = true;       // tree weights N / (K n_y), as JointBoostOptions
+    int threads = 0;              // 0 = as many as TBB may use
+    bool balance_classes = true;  // tree weights N / (K n_y), as JointBoostOptions
 };
 
 struct XGBoostRun {

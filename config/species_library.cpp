@@ -233,8 +233,7 @@ GrowthProfile read_growth(StrictMap map) {
     GrowthProfile g;
     g.shape = read_enum(map, "shape",
                         std::array{CrownShape::Conical, CrownShape::Spherical, CrownShape::Hemispherical, CrownShape::Cylindrical,
-                                   CrownShape::TaperedCylindrical, CrownShape::Flame, CrownShape::InverseConical,
-                                   CrownShape::TendFlame},
+                                   CrownShape::TaperedCylindrical, CrownShape::Flame, CrownShape::InverseConical, CrownShape::TendFlame},
                         crown_shape_name);
     map.number("base_size", g.base_size, 0, 0.98, true);
     map.number("base_size_v", g.base_size_v, 0, 0.5);
@@ -323,8 +322,8 @@ YAML::Node parse_yaml(const std::filesystem::path& file) {
     try {
         return YAML::LoadFile(file.string());
     } catch (const YAML::ParserException& e) {
-        throw Error::input(file.string(), "line " + std::to_string(e.mark.line + 1) + ", column " +
-                                              std::to_string(e.mark.column + 1) + ": " + e.msg);
+        throw Error::input(file.string(),
+                           "line " + std::to_string(e.mark.line + 1) + ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
     } catch (const YAML::Exception& e) {
         throw Error::input(file.string(), e.what());
     }
@@ -340,14 +339,22 @@ std::string normalise_name(const std::string& name) {
 
 const char* crown_shape_name(CrownShape shape) {
     switch (shape) {
-    case CrownShape::Conical: return "conical";
-    case CrownShape::Spherical: return "spherical";
-    case CrownShape::Hemispherical: return "hemispherical";
-    case CrownShape::Cylindrical: return "cylindrical";
-    case CrownShape::TaperedCylindrical: return "tapered_cylindrical";
-    case CrownShape::Flame: return "flame";
-    case CrownShape::InverseConical: return "inverse_conical";
-    case CrownShape::TendFlame: return "tend_flame";
+        case CrownShape::Conical:
+            return "conical";
+        case CrownShape::Spherical:
+            return "spherical";
+        case CrownShape::Hemispherical:
+            return "hemispherical";
+        case CrownShape::Cylindrical:
+            return "cylindrical";
+        case CrownShape::TaperedCylindrical:
+            return "tapered_cylindrical";
+        case CrownShape::Flame:
+            return "flame";
+        case CrownShape::InverseConical:
+            return "inverse_conical";
+        case CrownShape::TendFlame:
+            return "tend_flame";
     }
     return "?";
 }
@@ -356,23 +363,34 @@ double crown_shape_ratio(CrownShape shape, double r) {
     constexpr double pi = 3.14159265358979323846;
     r = std::clamp(r, 0.0, 1.0);
     switch (shape) {
-    case CrownShape::Conical: return 0.2 + 0.8 * r;
-    case CrownShape::Spherical: return 0.2 + 0.8 * std::sin(pi * r);
-    case CrownShape::Hemispherical: return 0.2 + 0.8 * std::sin(0.5 * pi * r);
-    case CrownShape::Cylindrical: return 1.0;
-    case CrownShape::TaperedCylindrical: return 0.5 + 0.5 * r;
-    case CrownShape::Flame: return r <= 0.7 ? r / 0.7 : (1.0 - r) / 0.3;
-    case CrownShape::InverseConical: return 1.0 - 0.8 * r;
-    case CrownShape::TendFlame: return r <= 0.7 ? 0.5 + 0.5 * r / 0.7 : 0.5 + 0.5 * (1.0 - r) / 0.3;
+        case CrownShape::Conical:
+            return 0.2 + 0.8 * r;
+        case CrownShape::Spherical:
+            return 0.2 + 0.8 * std::sin(pi * r);
+        case CrownShape::Hemispherical:
+            return 0.2 + 0.8 * std::sin(0.5 * pi * r);
+        case CrownShape::Cylindrical:
+            return 1.0;
+        case CrownShape::TaperedCylindrical:
+            return 0.5 + 0.5 * r;
+        case CrownShape::Flame:
+            return r <= 0.7 ? r / 0.7 : (1.0 - r) / 0.3;
+        case CrownShape::InverseConical:
+            return 1.0 - 0.8 * r;
+        case CrownShape::TendFlame:
+            return r <= 0.7 ? 0.5 + 0.5 * r / 0.7 : 0.5 + 0.5 * (1.0 - r) / 0.3;
     }
     return 1.0;
 }
 
 const char* leaf_shape_name(LeafShape shape) {
     switch (shape) {
-    case LeafShape::Broad: return "broad";
-    case LeafShape::Needle: return "needle";
-    case LeafShape::Leaflet: return "leaflet";
+        case LeafShape::Broad:
+            return "broad";
+        case LeafShape::Needle:
+            return "needle";
+        case LeafShape::Leaflet:
+            return "leaflet";
     }
     return "?";
 }

@@ -22,9 +22,9 @@ struct ReconstructionParameters {
 struct SpeciesProfile;  // full profile (growth, patches, variation): config/species_profile.hpp
 
 struct SpeciesEntry {
-    std::string name;        // canonical key, e.g. "pine", "ficus_virens"
+    std::string name;  // canonical key, e.g. "pine", "ficus_virens"
     std::string display_name;
-    int id = 0;              // stable 1-based id used in labels and LAS `species`
+    int id = 0;  // stable 1-based id used in labels and LAS `species`
     ReconstructionParameters reconstruction;
 };
 

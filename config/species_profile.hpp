@@ -41,16 +41,16 @@ struct ValueRange {
 // Angles in degrees; `*_v` are the half-widths of uniform random variation.
 struct StemLevel {
     // Placement on the parent (ignored for the trunk).
-    double branches = 0;       // stems of this level per parent stem (level 1: on the trunk)
-    double down_angle = 45;    // angle between the parent's and this stem's direction
-    double down_angle_v = 0;   // < 0 (level 1 only): varies with the position along the trunk
-    double rotate = 137.5;     // phyllotaxis: azimuth step between siblings; < 0 = alternate (180 ± |rotate|)
+    double branches = 0;      // stems of this level per parent stem (level 1: on the trunk)
+    double down_angle = 45;   // angle between the parent's and this stem's direction
+    double down_angle_v = 0;  // < 0 (level 1 only): varies with the position along the trunk
+    double rotate = 137.5;    // phyllotaxis: azimuth step between siblings; < 0 = alternate (180 ± |rotate|)
     double rotate_v = 0;
-    int whorl = 1;             // stems per node (pine, Terminalia: tiers of 3-6 branches)
-    double start = 0.1;        // levels >= 2: stems sit on the parent from this fraction of its length
-                               // (bare inner crowns of pines); level 1 uses base_size
+    int whorl = 1;       // stems per node (pine, Terminalia: tiers of 3-6 branches)
+    double start = 0.1;  // levels >= 2: stems sit on the parent from this fraction of its length
+                         // (bare inner crowns of pines); level 1 uses base_size
     // The stem itself.
-    double length = 1.0;       // trunk: fraction of the tree height; others: max length relative to the parent
+    double length = 1.0;  // trunk: fraction of the tree height; others: max length relative to the parent
     double length_v = 0;
     double taper = 1.0;        // 0 = cylinder, 1 = cone to a point
     double taper_power = 1.0;  // radius ~ (1 - taper z)^taper_power: 1 cone, 0.5 paraboloid (forestry
@@ -62,34 +62,34 @@ struct StemLevel {
     double seg_splits = 0;     // dichotomous forks per segment (decurrent crowns)
     double split_angle = 0;
     double split_angle_v = 0;
-    double tropism = 0;        // pull of the direction toward +z per stem (< 0: weeping, gravitropism)
+    double tropism = 0;  // pull of the direction toward +z per stem (< 0: weeping, gravitropism)
 };
 
 struct LeafProfile {
     LeafShape shape = LeafShape::Broad;
-    double per_branch = 0;     // leaf nodes on a last-level stem of maximum length (Weber & Penn Leaves)
-    int cluster = 1;           // leaves per leaf node (needle fascicles, opposite leaflets, trifoliate)
+    double per_branch = 0;  // leaf nodes on a last-level stem of maximum length (Weber & Penn Leaves)
+    int cluster = 1;        // leaves per leaf node (needle fascicles, opposite leaflets, trifoliate)
     double length_m = 0.1;
     double width_m = 0.05;
-    double size_v = 0.2;       // relative size variation
-    double down_angle = 45;    // angle between twig and leaf
+    double size_v = 0.2;     // relative size variation
+    double down_angle = 45;  // angle between twig and leaf
     double down_angle_v = 10;
-    double face_up = 0.5;      // 0..1: how far the blade turns to face the sky (Livny et al. 2011, Appendix A: #FaceUp)
-    double start = 0.3;        // leaves cover the stem from this fraction of its length to the tip
-    int levels = 1;            // how many of the deepest stem levels carry leaves (pine shoots: 2)
-    double lai = 0;            // leaf area index over the crown projection; 0 = as many leaves as per_branch says
+    double face_up = 0.5;  // 0..1: how far the blade turns to face the sky (Livny et al. 2011, Appendix A: #FaceUp)
+    double start = 0.3;    // leaves cover the stem from this fraction of its length to the tip
+    int levels = 1;        // how many of the deepest stem levels carry leaves (pine shoots: 2)
+    double lai = 0;        // leaf area index over the crown projection; 0 = as many leaves as per_branch says
 };
 
 struct GrowthProfile {
     CrownShape shape = CrownShape::Spherical;
-    double base_size = 0.3;    // fraction of the height below the crown: no first-order branches there
+    double base_size = 0.3;  // fraction of the height below the crown: no first-order branches there
     double base_size_v = 0.05;
-    int base_splits = 0;       // trunks from the ground (multi-stemmed Lagerstroemia)
-    double ratio_power = 1.5;  // child radius = parent radius at the fork * (child/parent length)^ratio_power
-    double flare = 0.4;        // extra radius at the root collar
-    double lean_v = 3;         // random lean of the trunk (degrees)
-    double dead_crown = 0;     // lowest fraction of the crown with dead first-order branches: no
-                               // leaves, half their side branches (self-pruning of stand-grown pines)
+    int base_splits = 0;            // trunks from the ground (multi-stemmed Lagerstroemia)
+    double ratio_power = 1.5;       // child radius = parent radius at the fork * (child/parent length)^ratio_power
+    double flare = 0.4;             // extra radius at the root collar
+    double lean_v = 3;              // random lean of the trunk (degrees)
+    double dead_crown = 0;          // lowest fraction of the crown with dead first-order branches: no
+                                    // leaves, half their side branches (self-pruning of stand-grown pines)
     std::vector<StemLevel> levels;  // levels[0] = trunk; 2..4 levels
     LeafProfile leaves;
     double bark_reflectance = 0.45;  // at 1064 nm / 1550 nm, for scan intensities

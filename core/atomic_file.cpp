@@ -13,16 +13,13 @@ namespace treelobes {
 
 namespace {
 
-fs::path temporary_path_for(const fs::path& path) {
-    return fs::path(path.string() + ".tmp." + std::to_string(::getpid()));
-}
+fs::path temporary_path_for(const fs::path& path) { return fs::path(path.string() + ".tmp." + std::to_string(::getpid())); }
 
 void check_destination(const fs::path& path) {
     if (path.empty()) throw Error::usage("output path is empty");
     if (fs::is_directory(path)) throw Error::input(path.string(), "is a directory, expected a file path to write");
     const fs::path parent = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-    if (!fs::is_directory(parent))
-        throw Error::input(path.string(), "cannot write: folder " + parent.string() + " does not exist");
+    if (!fs::is_directory(parent)) throw Error::input(path.string(), "cannot write: folder " + parent.string() + " does not exist");
 }
 
 // Runs `produce` to create `temporary`, then renames it onto `path`; on any failure the
@@ -58,8 +55,8 @@ void write_atomically(const fs::path& path, const std::function<void(std::ostrea
 void write_atomically_via_path(const fs::path& path, const std::function<void(const fs::path&)>& write) {
     check_destination(path);
     // Keep the extension last: these libraries pick the format from it.
-    const fs::path temporary = path.parent_path() / (path.stem().string() + ".tmp." + std::to_string(::getpid()) +
-                                                     path.extension().string());
+    const fs::path temporary =
+            path.parent_path() / (path.stem().string() + ".tmp." + std::to_string(::getpid()) + path.extension().string());
     replace_with(path, temporary, [&] { write(temporary); });
 }
 

@@ -16,8 +16,7 @@ void write_atomically(const std::filesystem::path& path, const std::function<voi
 
 // For libraries that only write to a file name (PCL, OpenMesh): `write` receives the temporary
 // path (same folder and extension as `path`) and must create that file.
-void write_atomically_via_path(const std::filesystem::path& path,
-                               const std::function<void(const std::filesystem::path& temporary)>& write);
+void write_atomically_via_path(const std::filesystem::path& path, const std::function<void(const std::filesystem::path& temporary)>& write);
 
 // Convenience for small text or binary payloads.
 void write_file_atomically(const std::filesystem::path& path, const std::string& contents);

@@ -15,8 +15,8 @@ namespace treelobes {
 namespace {
 
 constexpr double kTextBytesPerPoint = 24.0;
-constexpr std::size_t kLasHeaderBytes = 375;      // LAS 1.4; older versions are shorter
-constexpr std::size_t kLasMinimumHeader = 227;    // LAS 1.0-1.2
+constexpr std::size_t kLasHeaderBytes = 375;    // LAS 1.4; older versions are shorter
+constexpr std::size_t kLasMinimumHeader = 227;  // LAS 1.0-1.2
 constexpr std::size_t kLegacyCountOffset = 107, kBoundsOffset = 179, kCountOffset = 247, kLas14CountEnd = 255;
 
 bool is_las_family(const fs::path& path) {

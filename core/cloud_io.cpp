@@ -18,9 +18,7 @@ std::string file_extension(const fs::path& path) {
 
 namespace {
 
-bool is_text_extension(const std::string& ext) {
-    return ext == "xyz" || ext == "txt" || ext == "csv" || ext == "pts" || ext == "asc";
-}
+bool is_text_extension(const std::string& ext) { return ext == "xyz" || ext == "txt" || ext == "csv" || ext == "pts" || ext == "asc"; }
 
 // Identifies files by their first bytes when the extension is unknown.
 std::string sniff_format(const fs::path& path) {

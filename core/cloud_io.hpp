@@ -48,8 +48,7 @@ void write_point_cloud(const PointCloud& cloud, const std::filesystem::path& pat
 // Per-format entry points (used by the dispatchers above and by tests).
 PointCloud read_las(const std::filesystem::path& path, const CloudReadOptions& options = {});
 // The same from bytes in memory (`name` labels error messages); e.g. for fuzzing the reader.
-PointCloud read_las_buffer(std::span<const std::uint8_t> bytes, const std::string& name,
-                           const CloudReadOptions& options = {});
+PointCloud read_las_buffer(std::span<const std::uint8_t> bytes, const std::string& name, const CloudReadOptions& options = {});
 void write_las(const PointCloud& cloud, const std::filesystem::path& path);
 PointCloud read_ply_cloud(const std::filesystem::path& path);
 void write_ply_cloud(const PointCloud& cloud, const std::filesystem::path& path, bool binary = true);

@@ -12,10 +12,10 @@ namespace treelobes {
 
 enum class ExitCode : int {
     Ok = 0,
-    Usage = 1,         // bad flags, bad configuration values
-    InvalidInput = 2,  // unreadable, truncated or malformed input
-    PartialFailure = 3,// batch finished but some items failed
-    Internal = 4,      // a bug: should never happen
+    Usage = 1,           // bad flags, bad configuration values
+    InvalidInput = 2,    // unreadable, truncated or malformed input
+    PartialFailure = 3,  // batch finished but some items failed
+    Internal = 4,        // a bug: should never happen
 };
 
 class Error : public std::runtime_error {

@@ -86,7 +86,8 @@ FileInfo describe_cloud(const fs::path& path, const std::optional<Box3d>& bounds
     if (info.format == "las") snap_to_las_grid(info);
     if (cloud.source.laz) info.format = "laz";
     info.crs = cloud.georef.crs_wkt;
-    if (info.crs.empty() && !cloud.georef.las_vlrs.empty()) info.crs = "GeoTIFF keys (" + std::to_string(cloud.georef.las_vlrs.size()) + " VLRs)";
+    if (info.crs.empty() && !cloud.georef.las_vlrs.empty())
+        info.crs = "GeoTIFF keys (" + std::to_string(cloud.georef.las_vlrs.size()) + " VLRs)";
     return info;
 }
 
@@ -152,10 +153,13 @@ nlohmann::json glb_json(const fs::path& path) {
     const std::string name = path.string();
     const std::string bytes = read_file(path);
     if (bytes.size() < 20 || little_endian_u32(bytes, 0) != 0x46546C67) throw Error::input(name, "not a glTF binary (no glTF header)");
-    if (little_endian_u32(bytes, 4) != 2) throw Error::input(name, "glTF binary version " + std::to_string(little_endian_u32(bytes, 4)) + ", expected 2");
-    if (little_endian_u32(bytes, 8) != bytes.size()) throw Error::input(name, "glTF binary length does not match the file size (truncated?)");
+    if (little_endian_u32(bytes, 4) != 2)
+        throw Error::input(name, "glTF binary version " + std::to_string(little_endian_u32(bytes, 4)) + ", expected 2");
+    if (little_endian_u32(bytes, 8) != bytes.size())
+        throw Error::input(name, "glTF binary length does not match the file size (truncated?)");
     const std::size_t json_length = little_endian_u32(bytes, 12);
-    if (little_endian_u32(bytes, 16) != 0x4E4F534A || 20 + json_length > bytes.size()) throw Error::input(name, "glTF binary has no valid JSON chunk");
+    if (little_endian_u32(bytes, 16) != 0x4E4F534A || 20 + json_length > bytes.size())
+        throw Error::input(name, "glTF binary has no valid JSON chunk");
     try {
         return nlohmann::json::parse(bytes.substr(20, json_length));
     } catch (const nlohmann::json::exception& e) {
@@ -179,11 +183,13 @@ FileInfo describe_glb(const fs::path& path) {
             ++info.object_count;
             if (!node.contains("mesh")) continue;
             Eigen::Vector3d shift = Eigen::Vector3d::Zero();
-            if (node.contains("translation")) shift = {node["translation"][0].get<double>(), node["translation"][1].get<double>(), node["translation"][2].get<double>()};
+            if (node.contains("translation"))
+                shift = {node["translation"][0].get<double>(), node["translation"][1].get<double>(), node["translation"][2].get<double>()};
             for (const auto& primitive : doc.at("meshes").at(node.at("mesh").get<std::size_t>()).at("primitives")) {
                 const auto& position = doc.at("accessors").at(primitive.at("attributes").at("POSITION").get<std::size_t>());
                 info.point_count += position.at("count").get<std::size_t>();
-                if (primitive.contains("indices")) info.face_count += doc.at("accessors").at(primitive["indices"].get<std::size_t>()).at("count").get<std::size_t>() / 3;
+                if (primitive.contains("indices"))
+                    info.face_count += doc.at("accessors").at(primitive["indices"].get<std::size_t>()).at("count").get<std::size_t>() / 3;
                 for (int k = 0; k < 3; ++k) {
                     lo[k] = std::min(lo[k], shift[k] + position.at("min").at(k).get<double>());
                     hi[k] = std::max(hi[k], shift[k] + position.at("max").at(k).get<double>());
@@ -269,14 +275,19 @@ bool is_qsm_text(const fs::path& path) {
 FileInfo describe_file(const fs::path& path, const std::optional<Box3d>& bounds) {
     const std::string ext = file_extension(path);
     FileInfo info;
-    if (ext == "obj" || ext == "off" || ext == "stl") info = describe_mesh(path);
-    else if (ext == "glb") info = describe_glb(path);
-    else if (is_cityjson(path)) info = describe_cityjson(path);
-    else if (is_qsm_text(path)) info = describe_qsm(path);
+    if (ext == "obj" || ext == "off" || ext == "stl")
+        info = describe_mesh(path);
+    else if (ext == "glb")
+        info = describe_glb(path);
+    else if (is_cityjson(path))
+        info = describe_cityjson(path);
+    else if (is_qsm_text(path))
+        info = describe_qsm(path);
     else if (ext == "ply" && fs::is_regular_file(path)) {
         const std::string kind = ply_kind(path);
         info = kind == "mesh" ? describe_mesh(path) : kind == "skeleton" ? describe_skeleton(path) : describe_cloud(path, bounds);
-    } else info = describe_cloud(path, bounds);
+    } else
+        info = describe_cloud(path, bounds);
     info.path = path.string();
     return info;
 }

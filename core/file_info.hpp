@@ -25,12 +25,12 @@ struct FileInfo {
     Eigen::Vector3d las_scale{0, 0, 0}, las_offset{0, 0, 0};
     std::size_t point_count = 0;  // points, mesh vertices or skeleton nodes
     std::size_t dropped_non_finite = 0;
-    Eigen::Vector3d bounds_min{0, 0, 0}, bounds_max{0, 0, 0};  // original coordinates
+    Eigen::Vector3d bounds_min{0, 0, 0}, bounds_max{0, 0, 0};     // original coordinates
     std::vector<std::pair<std::string, std::string>> attributes;  // name, storage type
     std::string crs;
-    std::size_t face_count = 0;  // meshes
-    std::size_t tip_count = 0;   // skeletons
-    double total_length = 0.0;   // skeletons and QSMs, metres
+    std::size_t face_count = 0;    // meshes
+    std::size_t tip_count = 0;     // skeletons
+    double total_length = 0.0;     // skeletons and QSMs, metres
     std::size_t object_count = 0;  // QSM cylinders, glTF scene nodes (trees), CityJSON city objects
     double volume = 0.0;           // QSMs: sum of cylinder volumes, cubic metres
     // LAZ input: format is "laz"; chunk size (0xFFFFFFFF = variable) and chunk count.

@@ -19,8 +19,7 @@ std::optional<Eigen::Vector3d> read_origin_comment(const std::vector<std::string
         std::istringstream words(comment);
         std::string tag;
         Eigen::Vector3d origin;
-        if (words >> tag && tag == kOriginTag && words >> origin.x() >> origin.y() >> origin.z() && origin.allFinite())
-            return origin;
+        if (words >> tag && tag == kOriginTag && words >> origin.x() >> origin.y() >> origin.z() && origin.allFinite()) return origin;
     }
     return std::nullopt;
 }

@@ -36,7 +36,7 @@ public:
 
     // Reads from `bytes`, which must outlive the InputFile; `name` labels the messages.
     InputFile(std::span<const std::uint8_t> bytes, std::string name)
-        : name_(std::move(name)), size_(bytes.size()), memory_(bytes), in_memory_(true) {}
+            : name_(std::move(name)), size_(bytes.size()), memory_(bytes), in_memory_(true) {}
 
     std::uint64_t size() const { return size_; }
     const std::string& name() const { return name_; }

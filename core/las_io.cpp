@@ -60,9 +60,7 @@ std::string load_string(const std::uint8_t* p, std::size_t size) {
     return {reinterpret_cast<const char*>(p), length};
 }
 
-void store_string(std::uint8_t* p, std::size_t size, std::string_view text) {
-    std::memcpy(p, text.data(), std::min(size, text.size()));
-}
+void store_string(std::uint8_t* p, std::size_t size, std::string_view text) { std::memcpy(p, text.data(), std::min(size, text.size())); }
 
 // Rounds and clamps a double into an integer type; NaN becomes 0. Out-of-range casts are
 // undefined behaviour, so the comparison happens in double before the cast.
@@ -91,17 +89,15 @@ constexpr double kMaxCoordinate = 1e30;
 
 // Byte offsets of public header fields.
 namespace field {
-constexpr std::size_t global_encoding = 6, version_major = 24, version_minor = 25, system_id = 26,
-                      software = 58, creation_day = 90, creation_year = 92, header_size = 94,
-                      offset_to_points = 96, vlr_count = 100, point_format = 104, record_length = 105,
+constexpr std::size_t global_encoding = 6, version_major = 24, version_minor = 25, system_id = 26, software = 58, creation_day = 90,
+                      creation_year = 92, header_size = 94, offset_to_points = 96, vlr_count = 100, point_format = 104, record_length = 105,
                       legacy_point_count = 107, legacy_by_return = 111, scale = 131, offset = 155,
                       bounds = 179,  // max x, min x, max y, min y, max z, min z
-                      waveform_start = 227, evlr_start = 235, evlr_count = 243, point_count = 247,
-                      by_return = 255;
+        waveform_start = 227, evlr_start = 235, evlr_count = 243, point_count = 247, by_return = 255;
 }  // namespace field
 
 constexpr std::uint16_t kGpsAdjustedStandardTime = 1;  // global encoding bit 0
-constexpr std::uint16_t kWktCrs = 16;                   // global encoding bit 4 (LAS 1.4)
+constexpr std::uint16_t kWktCrs = 16;                  // global encoding bit 4 (LAS 1.4)
 
 constexpr std::string_view kProjectionUser = "LASF_Projection";
 constexpr std::string_view kSpecUser = "LASF_Spec";
@@ -110,7 +106,7 @@ constexpr std::uint16_t kWktRecord = 2112;
 constexpr std::uint16_t kGeoKeyDirectoryRecord = 34735;
 constexpr std::string_view kLaszipUser = "laszip encoded";  // LAZ specification 1.4, "LASzip VLR"
 constexpr std::uint16_t kLaszipRecord = 22204;
-constexpr std::string_view kCopcUser = "copc";              // COPC 1.0: info VLR 1, hierarchy EVLR 1000
+constexpr std::string_view kCopcUser = "copc";  // COPC 1.0: info VLR 1, hierarchy EVLR 1000
 constexpr std::uint16_t kCopcInfoRecord = 1;
 constexpr std::uint16_t kCopcHierarchyRecord = 1000;
 
@@ -124,17 +120,17 @@ struct PointFormat {
 };
 
 constexpr std::array<PointFormat, 11> kFormats = {{
-    {0, 20, false, -1, -1},
-    {1, 28, false, 20, -1},
-    {2, 26, false, -1, 20},
-    {3, 34, false, 20, 28},
-    {4, 57, false, 20, -1},  // 1 + wave packet
-    {5, 63, false, 20, 28},  // 3 + wave packet
-    {6, 30, true, 22, -1},
-    {7, 36, true, 22, 30},
-    {8, 38, true, 22, 30},   // 7 + NIR
-    {9, 59, true, 22, -1},   // 6 + wave packet
-    {10, 67, true, 22, 30},  // 8 + wave packet
+        {0, 20, false, -1, -1},
+        {1, 28, false, 20, -1},
+        {2, 26, false, -1, 20},
+        {3, 34, false, 20, 28},
+        {4, 57, false, 20, -1},  // 1 + wave packet
+        {5, 63, false, 20, 28},  // 3 + wave packet
+        {6, 30, true, 22, -1},
+        {7, 36, true, 22, 30},
+        {8, 38, true, 22, 30},   // 7 + NIR
+        {9, 59, true, 22, -1},   // 6 + wave packet
+        {10, 67, true, 22, 30},  // 8 + wave packet
 }};
 
 // The first LAS minor version that defines a point format.
@@ -215,8 +211,7 @@ Bytes read_header_bytes(InputFile& file) {
     const std::size_t available = static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), kHeaderSize14));
     Bytes bytes = file.read(0, available, "header");
     if (available < 4 || std::memcmp(bytes.data(), "LASF", 4) != 0)
-        file.fail("not a LAS file: signature is '" + printable(bytes.data(), std::min<std::size_t>(available, 4)) +
-                  "', expected 'LASF'");
+        file.fail("not a LAS file: signature is '" + printable(bytes.data(), std::min<std::size_t>(available, 4)) + "', expected 'LASF'");
     if (available < kHeaderSize12)
         file.fail("file is " + std::to_string(available) + " bytes, shorter than the 227-byte LAS header (truncated?)");
     bytes.resize(kHeaderSize14, 0);  // fields beyond the declared header size are never read
@@ -232,14 +227,13 @@ void check_version(const InputFile& file, const Bytes& h) {
 void check_layout(const InputFile& file, const LasHeader& h) {
     const std::size_t required = header_size_for(h.minor);
     if (h.header_size < required)
-        file.fail("header size " + std::to_string(h.header_size) + " is smaller than the " + std::to_string(required) +
-                  " bytes LAS 1." + std::to_string(h.minor) + " requires");
+        file.fail("header size " + std::to_string(h.header_size) + " is smaller than the " + std::to_string(required) + " bytes LAS 1." +
+                  std::to_string(h.minor) + " requires");
     if (h.header_size > file.size())
-        file.fail("header size " + std::to_string(h.header_size) + " exceeds the file size (" + std::to_string(file.size()) +
-                  " bytes)");
+        file.fail("header size " + std::to_string(h.header_size) + " exceeds the file size (" + std::to_string(file.size()) + " bytes)");
     if (h.offset_to_points < h.header_size)
-        file.fail("offset to point data " + std::to_string(h.offset_to_points) + " lies inside the " +
-                  std::to_string(h.header_size) + "-byte header");
+        file.fail("offset to point data " + std::to_string(h.offset_to_points) + " lies inside the " + std::to_string(h.header_size) +
+                  "-byte header");
     if (h.offset_to_points > file.size())
         file.fail("offset to point data " + std::to_string(h.offset_to_points) + " lies beyond the end of the file (" +
                   std::to_string(file.size()) + " bytes; truncated?)");
@@ -249,8 +243,8 @@ void check_point_format(const InputFile& file, int format_byte, std::uint16_t re
     if (format_byte > 10) file.fail("unsupported point data format " + std::to_string(format_byte) + ", expected 0-10");
     const PointFormat& format = kFormats[static_cast<std::size_t>(format_byte)];
     if (record_length < format.size)
-        file.fail("point record length " + std::to_string(record_length) + " is shorter than the " +
-                  std::to_string(format.size) + " bytes point format " + std::to_string(format_byte) + " requires");
+        file.fail("point record length " + std::to_string(record_length) + " is shorter than the " + std::to_string(format.size) +
+                  " bytes point format " + std::to_string(format_byte) + " requires");
 }
 
 void check_scale_offset(const InputFile& file, const LasHeader& h) {
@@ -259,12 +253,11 @@ void check_scale_offset(const InputFile& file, const LasHeader& h) {
         if (!std::isfinite(h.scale[k]) || h.scale[k] == 0)
             file.fail(std::string(axes[k]) + " scale factor is " + number_text(h.scale[k]) +
                       ", expected a non-zero finite number such as 0.01 or 0.001");
-        if (!std::isfinite(h.offset[k]))
-            file.fail(std::string(axes[k]) + " offset is not a finite number");
+        if (!std::isfinite(h.offset[k])) file.fail(std::string(axes[k]) + " offset is not a finite number");
         // Any 32-bit record must give a coordinate that float local positions can hold.
         if (std::abs(h.scale[k]) * 2147483648.0 + std::abs(h.offset[k]) > kMaxCoordinate)
-            file.fail(std::string(axes[k]) + " scale " + number_text(h.scale[k]) + " and offset " +
-                      number_text(h.offset[k]) + " give coordinates beyond 1e30, expected metre-range values");
+            file.fail(std::string(axes[k]) + " scale " + number_text(h.scale[k]) + " and offset " + number_text(h.offset[k]) +
+                      " give coordinates beyond 1e30, expected metre-range values");
     }
 }
 
@@ -339,8 +332,7 @@ std::vector<RawVlr> read_vlrs(InputFile& file, const LasHeader& h, bool keep_all
     for (std::size_t i = 0; i < h.vlr_count; ++i) {
         if (region_size - pos < kVlrHeaderSize)
             file.fail("VLR " + std::to_string(i + 1) + " of " + std::to_string(h.vlr_count) + " starts at byte " +
-                      std::to_string(h.header_size + pos) + ", past the start of point data at byte " +
-                      std::to_string(h.offset_to_points));
+                      std::to_string(h.header_size + pos) + ", past the start of point data at byte " + std::to_string(h.offset_to_points));
         const std::uint8_t* p = region.data() + pos;
         RawVlr record{load_string(p + 2, 16), load<std::uint16_t>(p + 18), load_string(p + 22, 32), {}};
         const std::size_t length = load<std::uint16_t>(p + 20);
@@ -362,16 +354,13 @@ std::vector<RawVlr> read_vlrs(InputFile& file, const LasHeader& h, bool keep_all
 std::vector<RawVlr> read_evlrs(InputFile& file, const LasHeader& h, bool keep_all = false) {
     std::vector<RawVlr> records;
     if (h.minor < 4 || h.evlr_count == 0) return records;
-    if (h.evlr_start < h.header_size || h.evlr_start > file.size() ||
-        h.evlr_count > (file.size() - h.evlr_start) / kEvlrHeaderSize)
-        file.fail("header declares " + std::to_string(h.evlr_count) + " extended VLRs from byte " +
-                  std::to_string(h.evlr_start) + ", which does not fit in the file (" + std::to_string(file.size()) +
-                  " bytes; truncated?)");
+    if (h.evlr_start < h.header_size || h.evlr_start > file.size() || h.evlr_count > (file.size() - h.evlr_start) / kEvlrHeaderSize)
+        file.fail("header declares " + std::to_string(h.evlr_count) + " extended VLRs from byte " + std::to_string(h.evlr_start) +
+                  ", which does not fit in the file (" + std::to_string(file.size()) + " bytes; truncated?)");
     std::uint64_t pos = h.evlr_start;
     for (std::size_t i = 0; i < h.evlr_count; ++i) {
         const Bytes head = file.read(pos, kEvlrHeaderSize, "extended VLR header");
-        RawVlr record{load_string(head.data() + 2, 16), load<std::uint16_t>(head.data() + 18),
-                      load_string(head.data() + 28, 32), {}};
+        RawVlr record{load_string(head.data() + 2, 16), load<std::uint16_t>(head.data() + 18), load_string(head.data() + 28, 32), {}};
         const std::uint64_t length = load<std::uint64_t>(head.data() + 20);
         if (length > file.size() - pos - kEvlrHeaderSize)
             file.fail("extended VLR " + record_label(i, h.evlr_count, record.user_id, record.record_id) + " at byte " +
@@ -397,17 +386,28 @@ struct ExtraField {
 
 double load_raw_extra(const std::uint8_t* p, int data_type) {
     switch (data_type) {
-        case 1: return p[0];
-        case 2: return static_cast<std::int8_t>(p[0]);
-        case 3: return load<std::uint16_t>(p);
-        case 4: return load<std::int16_t>(p);
-        case 5: return load<std::uint32_t>(p);
-        case 6: return load<std::int32_t>(p);
-        case 7: return static_cast<double>(load<std::uint64_t>(p));
-        case 8: return static_cast<double>(load<std::int64_t>(p));
-        case 9: return load<float>(p);
-        case 10: return load<double>(p);
-        default: return 0;
+        case 1:
+            return p[0];
+        case 2:
+            return static_cast<std::int8_t>(p[0]);
+        case 3:
+            return load<std::uint16_t>(p);
+        case 4:
+            return load<std::int16_t>(p);
+        case 5:
+            return load<std::uint32_t>(p);
+        case 6:
+            return load<std::int32_t>(p);
+        case 7:
+            return static_cast<double>(load<std::uint64_t>(p));
+        case 8:
+            return static_cast<double>(load<std::int64_t>(p));
+        case 9:
+            return load<float>(p);
+        case 10:
+            return load<double>(p);
+        default:
+            return 0;
     }
 }
 
@@ -474,20 +474,19 @@ std::vector<ExtraField> parse_extra_bytes(const InputFile& file, const RawVlr& r
         if (size > record_length - offset)
             file.fail("Extra Bytes attribute '" + load_string(d + 4, 32) + "' ends at byte " + std::to_string(offset + size) +
                       " of the point record, but records are only " + std::to_string(record_length) + " bytes long");
-        if (data_type >= 1 && data_type <= 10) fields.push_back(parse_descriptor(file, d, i, offset));
+        if (data_type >= 1 && data_type <= 10)
+            fields.push_back(parse_descriptor(file, d, i, offset));
         else if (data_type > 10)
-            log_warn(file.name() + ": Extra Bytes attribute '" + load_string(d + 4, 32) +
-                     "' uses a deprecated array type and is skipped");
+            log_warn(file.name() + ": Extra Bytes attribute '" + load_string(d + 4, 32) + "' uses a deprecated array type and is skipped");
         offset += size;
     }
     return fields;
 }
 
-std::vector<ExtraField> find_extra_fields(const InputFile& file, const std::vector<RawVlr>& records,
-                                          const PointFormat& format, std::size_t record_length) {
+std::vector<ExtraField> find_extra_fields(const InputFile& file, const std::vector<RawVlr>& records, const PointFormat& format,
+                                          std::size_t record_length) {
     for (const RawVlr& r : records)
-        if (r.user_id == kSpecUser && r.record_id == kExtraBytesRecord)
-            return parse_extra_bytes(file, r, format, record_length);
+        if (r.user_id == kSpecUser && r.record_id == kExtraBytesRecord) return parse_extra_bytes(file, r, format, record_length);
     return {};
 }
 
@@ -515,8 +514,7 @@ Georeference georeference_from(const std::vector<RawVlr>& records) {
     for (const RawVlr& r : records) {
         if (r.user_id != kProjectionUser) continue;
         georef.las_vlrs.push_back(r);
-        if (r.record_id == kWktRecord && georef.crs_wkt.empty())
-            georef.crs_wkt = load_string(r.data.data(), r.data.size());
+        if (r.record_id == kWktRecord && georef.crs_wkt.empty()) georef.crs_wkt = load_string(r.data.data(), r.data.size());
     }
     if (georef.crs_wkt.empty())
         for (const RawVlr& r : georef.las_vlrs)
@@ -544,8 +542,7 @@ Eigen::Vector3d choose_origin(InputFile& file, const LasHeader& h, std::uint64_t
                         lo.cwiseAbs().maxCoeff() <= kMaxCoordinate && hi.cwiseAbs().maxCoeff() <= kMaxCoordinate;
     if (!usable) {
         const Bytes first = file.read(first_record, 12, "first point record");
-        for (int k = 0; k < 3; ++k)
-            lo[k] = hi[k] = load<std::int32_t>(first.data() + 4 * k) * h.scale[k] + h.offset[k];
+        for (int k = 0; k < 3; ++k) lo[k] = hi[k] = load<std::int32_t>(first.data() + 4 * k) * h.scale[k] + h.offset[k];
     }
     Eigen::Vector3d origin;
     for (int k = 0; k < 3; ++k) origin[k] = choose_origin_axis(h.offset[k], lo[k], hi[k]);
@@ -563,8 +560,8 @@ std::uint64_t cloud_bytes_per_point(const PointFormat& format, const std::vector
 
 // Sizes the attribute vectors the point format has (and only those).
 // With `all_fields` false only positions, return numbers, classification and extras.
-void allocate_attributes(PointCloud& cloud, const PointFormat& format, const std::vector<ExtraField>& fields,
-                         std::size_t n, bool all_fields) {
+void allocate_attributes(PointCloud& cloud, const PointFormat& format, const std::vector<ExtraField>& fields, std::size_t n,
+                         bool all_fields) {
     cloud.positions.resize(n);
     cloud.return_number.resize(n);
     cloud.number_of_returns.resize(n);
@@ -585,7 +582,7 @@ struct PointDecoder {
     Eigen::Vector3d scale, offset, origin;
     const std::vector<ExtraField>& fields;
     bool all_fields = true;
-    const Box3d* bounds = nullptr;           // when set, inside[i] says whether point i lies in it
+    const Box3d* bounds = nullptr;  // when set, inside[i] says whether point i lies in it
     std::vector<std::uint8_t>* inside = nullptr;
 
     void decode(const std::uint8_t* record, std::size_t i, PointCloud& cloud) const {
@@ -638,8 +635,7 @@ const RawVlr* find_record(const std::vector<RawVlr>& records, std::string_view u
 
 // Point data ends where the EVLRs start (LAS 1.4) or at the end of the file.
 std::uint64_t point_data_end(const InputFile& file, const LasHeader& h) {
-    if (h.minor >= 4 && h.evlr_count > 0 && h.evlr_start > h.offset_to_points && h.evlr_start <= file.size())
-        return h.evlr_start;
+    if (h.minor >= 4 && h.evlr_count > 0 && h.evlr_start > h.offset_to_points && h.evlr_start <= file.size()) return h.evlr_start;
     return file.size();
 }
 
@@ -652,13 +648,10 @@ LasSource open_las(InputFile& file, bool keep_all_records) {
     for (RawVlr& r : read_evlrs(file, h, keep_all_records)) src.records.push_back(std::move(r));
     if (!h.compressed) return src;
     const RawVlr* laszip = find_record(src.records, kLaszipUser, kLaszipRecord);
-    if (!laszip)
-        file.fail("the point format byte marks LAZ compression, but there is no LASzip VLR ('laszip encoded', record 22204)");
+    if (!laszip) file.fail("the point format byte marks LAZ compression, but there is no LASzip VLR ('laszip encoded', record 22204)");
     src.laz = laz::parse_laszip_vlr(laszip->data, h.point_format, h.record_length, file.name());
-    src.chunks = laz::read_chunk_table(file, *src.laz, h.offset_to_points, point_data_end(file, h), h.point_count,
-                                       h.record_length);
-    if (const RawVlr* info = find_record(src.records, kCopcUser, kCopcInfoRecord))
-        src.copc = laz::parse_copc_info(info->data, file.name());
+    src.chunks = laz::read_chunk_table(file, *src.laz, h.offset_to_points, point_data_end(file, h), h.point_count, h.record_length);
+    if (const RawVlr* info = find_record(src.records, kCopcUser, kCopcInfoRecord)) src.copc = laz::parse_copc_info(info->data, file.name());
     return src;
 }
 
@@ -685,8 +678,8 @@ void read_uncompressed_records(InputFile& file, const LasHeader& h, const Record
 
 // Chunks are independent: TBB decodes them in parallel, each task holding one chunk's
 // compressed and decoded bytes, so memory stays bounded by (threads x chunk size).
-void decode_laz_chunks(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks,
-                       const laz::LayerSelection& selection, const RecordSink& sink) {
+void decode_laz_chunks(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks, const laz::LayerSelection& selection,
+                       const RecordSink& sink) {
     const std::uint16_t record_length = src.header.record_length;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
         Bytes compressed, records;
@@ -695,23 +688,24 @@ void decode_laz_chunks(InputFile& file, const LasSource& src, const std::vector<
             compressed.resize(static_cast<std::size_t>(chunk.bytes));
             file.read(chunk.offset, compressed.size(), compressed.data(), "LAZ chunk " + std::to_string(i));
             records.resize(static_cast<std::size_t>(chunk.count) * record_length);
-            laz::decode_chunk(*src.laz, record_length, compressed, static_cast<std::size_t>(chunk.count), records.data(),
-                              selection, file.name(), i);
+            laz::decode_chunk(*src.laz, record_length, compressed, static_cast<std::size_t>(chunk.count), records.data(), selection,
+                              file.name(), i);
             sink(static_cast<std::size_t>(chunk.first_point), static_cast<std::size_t>(chunk.count), records.data());
         }
     });
 }
 
-void read_records(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks,
-                  const laz::LayerSelection& selection, const RecordSink& sink) {
-    if (src.header.compressed) decode_laz_chunks(file, src, chunks, selection, sink);
-    else read_uncompressed_records(file, src.header, sink);
+void read_records(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks, const laz::LayerSelection& selection,
+                  const RecordSink& sink) {
+    if (src.header.compressed)
+        decode_laz_chunks(file, src, chunks, selection, sink);
+    else
+        read_uncompressed_records(file, src.header, sink);
 }
 
 // The COPC octree: levels and nodes for `info`, and the nodes a bounds query must decode
 // (renumbered so that their points are consecutive).
-std::vector<laz::Chunk> describe_copc(InputFile& file, const LasSource& src, const std::optional<Box3d>& bounds,
-                                      SourceFormat& source) {
+std::vector<laz::Chunk> describe_copc(InputFile& file, const LasSource& src, const std::optional<Box3d>& bounds, SourceFormat& source) {
     const std::vector<laz::CopcNode> nodes = laz::read_copc_hierarchy(file, *src.copc);
     std::vector<laz::Chunk> selected;
     std::uint64_t first = 0;
@@ -771,10 +765,10 @@ PointCloud read_las_from(InputFile& file, const CloudReadOptions& options) {
     allocate_attributes(cloud, format, fields, static_cast<std::size_t>(n), all_fields);
     std::vector<std::uint8_t> inside;
     if (options.bounds) inside.assign(static_cast<std::size_t>(n), 0);
-    const PointDecoder decoder{format, header.scale, header.offset, cloud.origin, fields, all_fields,
-                               options.bounds ? &*options.bounds : nullptr, &inside};
+    const PointDecoder decoder{
+            format, header.scale, header.offset, cloud.origin, fields, all_fields, options.bounds ? &*options.bounds : nullptr, &inside};
     const laz::LayerSelection selection =
-        all_fields ? laz::LayerSelection::all() : laz::LayerSelection::xyz_classification(!fields.empty());
+            all_fields ? laz::LayerSelection::all() : laz::LayerSelection::xyz_classification(!fields.empty());
     read_records(file, src, chunks, selection, [&](std::size_t first, std::size_t count, const std::uint8_t* records) {
         for (std::size_t j = 0; j < count; ++j) decoder.decode(records + j * header.record_length, first + j, cloud);
     });
@@ -797,10 +791,9 @@ LasRecords read_records_from(InputFile& file) {
     out.vlrs.assign(src.records.begin(), src.records.begin() + static_cast<std::ptrdiff_t>(src.vlr_count));
     out.evlrs.assign(src.records.begin() + static_cast<std::ptrdiff_t>(src.vlr_count), src.records.end());
     out.points.resize(static_cast<std::size_t>(h.point_count) * h.record_length);
-    read_records(file, src, src.chunks, laz::LayerSelection::all(),
-                 [&](std::size_t first, std::size_t count, const std::uint8_t* records) {
-                     std::memcpy(out.points.data() + first * h.record_length, records, count * h.record_length);
-                 });
+    read_records(file, src, src.chunks, laz::LayerSelection::all(), [&](std::size_t first, std::size_t count, const std::uint8_t* records) {
+        std::memcpy(out.points.data() + first * h.record_length, records, count * h.record_length);
+    });
     return out;
 }
 
@@ -824,8 +817,7 @@ bool needs_extended_fields(const PointCloud& cloud) {
     auto any_above = [](const std::vector<std::uint8_t>& v, int limit) {
         return std::any_of(v.begin(), v.end(), [&](std::uint8_t x) { return x > limit; });
     };
-    return any_above(cloud.classification, 31) || any_above(cloud.return_number, 7) ||
-           any_above(cloud.number_of_returns, 7);
+    return any_above(cloud.classification, 31) || any_above(cloud.return_number, 7) || any_above(cloud.number_of_returns, 7);
 }
 
 // The input's format, with waveform formats mapped to their base (waveform packets are not
@@ -867,15 +859,17 @@ int choose_minor_version(const PointCloud& cloud, int format, bool has_evlrs) {
 }
 
 void store_anytype(std::uint8_t* p, AttributeType type, double value) {
-    if (is_float_type(type)) store<double>(p, value);
-    else if (is_unsigned_type(type)) store<std::uint64_t>(p, saturate<std::uint64_t>(value));
-    else store<std::int64_t>(p, saturate<std::int64_t>(value));
+    if (is_float_type(type))
+        store<double>(p, value);
+    else if (is_unsigned_type(type))
+        store<std::uint64_t>(p, saturate<std::uint64_t>(value));
+    else
+        store<std::int64_t>(p, saturate<std::int64_t>(value));
 }
 
 Bytes extra_bytes_descriptor(const ExtraAttribute& attribute, const std::string& file) {
     if (attribute.name.empty() || attribute.name.size() > 32)
-        throw Error::input(file, "extra attribute name '" + attribute.name +
-                                     "' cannot be stored in LAS Extra Bytes (1-32 bytes expected)");
+        throw Error::input(file, "extra attribute name '" + attribute.name + "' cannot be stored in LAS Extra Bytes (1-32 bytes expected)");
     Bytes d(kExtraBytesDescriptorSize, 0);
     d[2] = static_cast<std::uint8_t>(las_data_type(attribute.type));
     store_string(d.data() + 4, 32, attribute.name);
@@ -920,8 +914,10 @@ std::vector<RawVlr> records_to_write(const PointCloud& cloud, const std::string&
 // Records too long for a VLR's 16-bit length become LAS 1.4 extended VLRs.
 void split_records(std::vector<RawVlr> records, WritePlan& plan) {
     for (RawVlr& r : records) {
-        if (r.data.size() > std::numeric_limits<std::uint16_t>::max()) plan.evlrs.push_back(std::move(r));
-        else plan.vlrs.push_back(std::move(r));
+        if (r.data.size() > std::numeric_limits<std::uint16_t>::max())
+            plan.evlrs.push_back(std::move(r));
+        else
+            plan.vlrs.push_back(std::move(r));
     }
 }
 
@@ -965,7 +961,7 @@ void choose_frame(const PointCloud& cloud, const std::string& file, WritePlan& p
         plan.offset[k] = std::round((lo[k] + hi[k]) / 2);
         if (!fits_int32(lo[k], hi[k], plan.offset[k], plan.scale[k]))
             throw Error::input(file, std::string("coordinates span ") + std::to_string(hi[k] - lo[k]) + " m in " + axes[k] +
-                                         ", too much for LAS 32-bit integers at scale " + std::to_string(plan.scale[k]));
+                                             ", too much for LAS 32-bit integers at scale " + std::to_string(plan.scale[k]));
     }
 }
 
@@ -982,7 +978,7 @@ WritePlan plan_write(const PointCloud& cloud, const std::string& file) {
     }
     if (plan.record_length > std::numeric_limits<std::uint16_t>::max())
         throw Error::input(file, "point records of " + std::to_string(plan.record_length) +
-                                     " bytes exceed the LAS limit of 65535 (too many extra attributes)");
+                                         " bytes exceed the LAS limit of 65535 (too many extra attributes)");
     if (uses_adjusted_gps_time(cloud)) plan.global_encoding |= kGpsAdjustedStandardTime;
     if (plan.minor >= 4 && (has_record(plan.vlrs, kProjectionUser, kWktRecord) || has_record(plan.evlrs, kProjectionUser, kWktRecord)))
         plan.global_encoding |= kWktCrs;
@@ -1111,8 +1107,10 @@ Bytes record_header(const RawVlr& r, bool extended) {
     Bytes h(extended ? kEvlrHeaderSize : kVlrHeaderSize, 0);
     store_string(h.data() + 2, 16, r.user_id);
     store<std::uint16_t>(h.data() + 18, r.record_id);
-    if (extended) store<std::uint64_t>(h.data() + 20, r.data.size());
-    else store<std::uint16_t>(h.data() + 20, static_cast<std::uint16_t>(r.data.size()));
+    if (extended)
+        store<std::uint64_t>(h.data() + 20, r.data.size());
+    else
+        store<std::uint16_t>(h.data() + 20, static_cast<std::uint16_t>(r.data.size()));
     store_string(h.data() + (extended ? 28 : 22), 32, r.description);
     return h;
 }
@@ -1132,14 +1130,30 @@ void store_extra_value(std::uint8_t* p, const ExtraAttribute& attribute, double 
     // Integer types cannot hold NaN: the declared no-data value stands in for it.
     if (std::isnan(value) && attribute.no_data && !is_float_type(attribute.type)) value = *attribute.no_data;
     switch (attribute.type) {
-        case AttributeType::UInt8: store<std::uint8_t>(p, saturate<std::uint8_t>(value)); break;
-        case AttributeType::Int8: store<std::int8_t>(p, saturate<std::int8_t>(value)); break;
-        case AttributeType::UInt16: store<std::uint16_t>(p, saturate<std::uint16_t>(value)); break;
-        case AttributeType::Int16: store<std::int16_t>(p, saturate<std::int16_t>(value)); break;
-        case AttributeType::UInt32: store<std::uint32_t>(p, saturate<std::uint32_t>(value)); break;
-        case AttributeType::Int32: store<std::int32_t>(p, saturate<std::int32_t>(value)); break;
-        case AttributeType::UInt64: store<std::uint64_t>(p, saturate<std::uint64_t>(value)); break;
-        case AttributeType::Int64: store<std::int64_t>(p, saturate<std::int64_t>(value)); break;
+        case AttributeType::UInt8:
+            store<std::uint8_t>(p, saturate<std::uint8_t>(value));
+            break;
+        case AttributeType::Int8:
+            store<std::int8_t>(p, saturate<std::int8_t>(value));
+            break;
+        case AttributeType::UInt16:
+            store<std::uint16_t>(p, saturate<std::uint16_t>(value));
+            break;
+        case AttributeType::Int16:
+            store<std::int16_t>(p, saturate<std::int16_t>(value));
+            break;
+        case AttributeType::UInt32:
+            store<std::uint32_t>(p, saturate<std::uint32_t>(value));
+            break;
+        case AttributeType::Int32:
+            store<std::int32_t>(p, saturate<std::int32_t>(value));
+            break;
+        case AttributeType::UInt64:
+            store<std::uint64_t>(p, saturate<std::uint64_t>(value));
+            break;
+        case AttributeType::Int64:
+            store<std::int64_t>(p, saturate<std::int64_t>(value));
+            break;
         case AttributeType::Float32: {
             // double -> float outside float's range is undefined; IEEE overflow gives infinity.
             constexpr double max = std::numeric_limits<float>::max();
@@ -1148,7 +1162,9 @@ void store_extra_value(std::uint8_t* p, const ExtraAttribute& attribute, double 
             store<float>(p, f);
             break;
         }
-        case AttributeType::Float64: store<double>(p, value); break;
+        case AttributeType::Float64:
+            store<double>(p, value);
+            break;
     }
 }
 
@@ -1225,8 +1241,10 @@ void write_las_records(const LasRecords& records, const fs::path& path) {
         return (r.user_id == kLaszipUser && r.record_id == kLaszipRecord) || r.user_id == kCopcUser;
     };
     std::vector<RawVlr> vlrs, evlrs;
-    std::copy_if(records.vlrs.begin(), records.vlrs.end(), std::back_inserter(vlrs), [&](const RawVlr& r) { return !describes_compression(r); });
-    std::copy_if(records.evlrs.begin(), records.evlrs.end(), std::back_inserter(evlrs), [&](const RawVlr& r) { return !describes_compression(r); });
+    std::copy_if(records.vlrs.begin(), records.vlrs.end(), std::back_inserter(vlrs),
+                 [&](const RawVlr& r) { return !describes_compression(r); });
+    std::copy_if(records.evlrs.begin(), records.evlrs.end(), std::back_inserter(evlrs),
+                 [&](const RawVlr& r) { return !describes_compression(r); });
     Bytes header = records.header;
     std::uint64_t offset = header.size();
     for (const RawVlr& r : vlrs) offset += kVlrHeaderSize + r.data.size();

@@ -16,7 +16,7 @@ namespace treelobes {
 struct LasRecords {
     std::vector<std::uint8_t> header;  // the public header as stored (compression bits included)
     int minor = 0;
-    int point_format = 0;              // 0-10, without the LAZ bits
+    int point_format = 0;  // 0-10, without the LAZ bits
     std::uint16_t record_length = 0;
     std::uint64_t point_count = 0;
     bool compressed = false;

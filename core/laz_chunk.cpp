@@ -122,8 +122,11 @@ constexpr int kMaxSequenceSwitches = 8;
 class GpsTimeDecoder {
 public:
     GpsTimeDecoder(ArithmeticDecoder& decoder, bool layered)
-        : decoder_(decoder), layered_(layered), multi_(layered ? kGpsV3Symbols : kGpsV2Symbols),
-          zero_diff_(layered ? 5 : 6), ic_(decoder, 32, 9) {}
+            : decoder_(decoder),
+              layered_(layered),
+              multi_(layered ? kGpsV3Symbols : kGpsV2Symbols),
+              zero_diff_(layered ? 5 : 6),
+              ic_(decoder, 32, 9) {}
 
     void reset(std::uint64_t first) {
         last_ = next_ = 0;
@@ -239,11 +242,10 @@ private:
 struct RgbModels {
     SymbolModel byte_used{128};
     std::array<SymbolModel, 6> diff{SymbolModel(256), SymbolModel(256), SymbolModel(256),
-                                     SymbolModel(256), SymbolModel(256), SymbolModel(256)};
+                                    SymbolModel(256), SymbolModel(256), SymbolModel(256)};
 };
 
-void decode_rgb(ArithmeticDecoder& dec, RgbModels& m, const std::array<std::uint16_t, 3>& last,
-                std::array<std::uint16_t, 3>& out) {
+void decode_rgb(ArithmeticDecoder& dec, RgbModels& m, const std::array<std::uint16_t, 3>& last, std::array<std::uint16_t, 3>& out) {
     const std::uint32_t sym = dec.decode_symbol(m.byte_used);
     auto low = [](std::uint16_t v) { return static_cast<std::int32_t>(v & 0xFF); };
     auto high = [](std::uint16_t v) { return static_cast<std::int32_t>(v >> 8); };
@@ -296,20 +298,23 @@ public:
 
 // Return map m and return level l for (number of returns n, return number r), completed for
 // invalid combinations (spec: "POINT10 v2").
-constexpr std::uint8_t kReturnMap[8][8] = {
-    {15, 14, 13, 12, 11, 10, 9, 8}, {14, 0, 1, 3, 6, 10, 10, 9},   {13, 1, 2, 4, 7, 11, 11, 10},
-    {12, 3, 4, 5, 8, 12, 12, 11},   {11, 6, 7, 8, 9, 13, 13, 12},  {10, 10, 11, 12, 13, 14, 14, 13},
-    {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
-constexpr std::uint8_t kReturnLevel[8][8] = {
-    {0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 1, 2, 3, 4, 5, 6}, {2, 1, 0, 1, 2, 3, 4, 5}, {3, 2, 1, 0, 1, 2, 3, 4},
-    {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2}, {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
+constexpr std::uint8_t kReturnMap[8][8] = {{15, 14, 13, 12, 11, 10, 9, 8},  {14, 0, 1, 3, 6, 10, 10, 9},   {13, 1, 2, 4, 7, 11, 11, 10},
+                                           {12, 3, 4, 5, 8, 12, 12, 11},    {11, 6, 7, 8, 9, 13, 13, 12},  {10, 10, 11, 12, 13, 14, 14, 13},
+                                           {9, 10, 11, 12, 13, 14, 15, 14}, {8, 9, 10, 11, 12, 13, 14, 15}};
+constexpr std::uint8_t kReturnLevel[8][8] = {{0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 1, 2, 3, 4, 5, 6}, {2, 1, 0, 1, 2, 3, 4, 5},
+                                             {3, 2, 1, 0, 1, 2, 3, 4}, {4, 3, 2, 1, 0, 1, 2, 3}, {5, 4, 3, 2, 1, 0, 1, 2},
+                                             {6, 5, 4, 3, 2, 1, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0}};
 
 // The 20 bytes common to formats 0-5 (spec: "POINT10 v2").
 class Point10Item final : public PointwiseItem {
 public:
     explicit Point10Item(ArithmeticDecoder& dec)
-        : dec_(dec), ic_intensity_(dec, 16, 4), ic_point_source_(dec, 16), ic_dx_(dec, 32, 2), ic_dy_(dec, 32, 22),
-          ic_z_(dec, 32, 20) {}
+            : dec_(dec),
+              ic_intensity_(dec, 16, 4),
+              ic_point_source_(dec, 16),
+              ic_dx_(dec, 32, 2),
+              ic_dy_(dec, 32, 22),
+              ic_z_(dec, 32, 20) {}
 
     void init(const std::uint8_t* first) override {
         std::memcpy(last_.data(), first, 20);
@@ -344,8 +349,7 @@ public:
         store<std::int32_t>(last, wrapping_add(load<std::int32_t>(last), dx));
         x_median_[m].add(dx);
         std::uint32_t k_bits = ic_dx_.k();
-        const std::int32_t dy =
-            ic_dy_.decompress(y_median_[m].get(), (n == 1) + (k_bits < 20 ? zero_bit_0(k_bits) : 20));
+        const std::int32_t dy = ic_dy_.decompress(y_median_[m].get(), (n == 1) + (k_bits < 20 ? zero_bit_0(k_bits) : 20));
         store<std::int32_t>(last + 4, wrapping_add(load<std::int32_t>(last + 4), dy));
         y_median_[m].add(dy);
         // z: predicted by the last z at the same return level.
@@ -425,8 +429,7 @@ public:
     virtual std::size_t layer_count() const = 0;
     // `layers[i]` is layer i's bytes (empty when the layer is unchanged in this chunk or not
     // wanted, in which case the field keeps the first point's value).
-    virtual void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers,
-                      std::uint32_t context) = 0;
+    virtual void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers, std::uint32_t context) = 0;
     virtual void decode(std::uint8_t* out, std::uint32_t& context) = 0;
     // Largest read-ahead past the end of any layer stream.
     virtual std::size_t overrun() const = 0;
@@ -487,14 +490,14 @@ struct Point14 {
 // 6 return-map contexts and 8 return-level contexts for 4-bit (n, r) (spec: "number_return_map_6ctx",
 // "number_return_level_8ctx").
 constexpr std::uint8_t kReturnMap6[16][16] = {
-    {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
-    {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
-    {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
-    {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
-    {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
-    {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
+        {0, 1, 2, 3, 4, 5, 3, 4, 4, 5, 5, 5, 5, 5, 5, 5}, {1, 0, 1, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3, 3},
+        {2, 1, 2, 4, 4, 4, 4, 4, 4, 4, 4, 3, 3, 3, 3, 3}, {3, 3, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+        {4, 3, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4},
+        {3, 3, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4, 4}, {4, 3, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4, 4},
+        {4, 3, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4, 4}, {5, 3, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4, 4},
+        {5, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 4, 4, 4, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 4, 4, 4},
+        {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4, 4}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5, 4},
+        {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5, 5}, {5, 3, 3, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 4, 5, 5}};
 
 std::uint8_t return_level_8(std::uint32_t n, std::uint32_t r) {
     // |n - r| capped at 7: the table of the spec written as the rule it encodes.
@@ -520,8 +523,7 @@ public:
     std::size_t layer_count() const override { return kPoint14Layers; }
     std::size_t overrun() const override { return max_overrun(decoders_); }
 
-    void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers,
-              std::uint32_t) override {
+    void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers, std::uint32_t) override {
         for (std::size_t i = 0; i < kPoint14Layers; ++i) {
             changed_[i] = wanted_[i] && !layers[i].empty();
             // The XY layer is always decoded (an empty one then reads as zeros and is reported).
@@ -538,8 +540,7 @@ public:
         ArithmeticDecoder& xy = decoders_[XY];
         // Context of the previous point's return: single / first / last / intermediate, and
         // whether its GPS time had changed.
-        std::uint32_t lpr = (c->last.return_number == 1 ? 1 : 0) +
-                            (c->last.return_number >= c->last.number_of_returns ? 2 : 0) +
+        std::uint32_t lpr = (c->last.return_number == 1 ? 1 : 0) + (c->last.return_number >= c->last.number_of_returns ? 2 : 0) +
                             (c->last.gps_time_change ? 4 : 0);
         const std::uint32_t changed = xy.decode_symbol(c->changed_values[lpr]);
         if (changed & (1 << 6)) {  // another scanner channel: switch context (spec: "scanner channel")
@@ -564,12 +565,19 @@ public:
         }
         std::uint32_t r = last_r;
         switch (changed & 3) {
-            case 0: break;
-            case 1: r = (last_r + 1) % 16; break;
-            case 2: r = (last_r + 15) % 16; break;
+            case 0:
+                break;
+            case 1:
+                r = (last_r + 1) % 16;
+                break;
+            case 2:
+                r = (last_r + 15) % 16;
+                break;
             default:
-                if (gps_time_change) r = xy.decode_symbol(c->return_number[last_r].get(16));
-                else r = (last_r + xy.decode_symbol(c->return_number_gps_same) + 2) % 16;
+                if (gps_time_change)
+                    r = xy.decode_symbol(c->return_number[last_r].get(16));
+                else
+                    r = (last_r + xy.decode_symbol(c->return_number_gps_same) + 2) % 16;
         }
         last.return_number = static_cast<std::uint8_t>(r);
 
@@ -581,8 +589,7 @@ public:
         last.x = wrapping_add(last.x, dx);
         c->x_median[median].add(dx);
         std::uint32_t k_bits = c->ic_dx.k();
-        const std::int32_t dy =
-            c->ic_dy.decompress(c->y_median[median].get(), (n == 1) + (k_bits < 20 ? zero_bit_0(k_bits) : 20));
+        const std::int32_t dy = c->ic_dy.decompress(c->y_median[median].get(), (n == 1) + (k_bits < 20 ? zero_bit_0(k_bits) : 20));
         last.y = wrapping_add(last.y, dy);
         c->y_median[median].add(dy);
 
@@ -593,8 +600,7 @@ public:
         }
         if (changed_[Classification]) {
             const std::size_t ccc = ((last.classification & 0x1Fu) << 1) + (cpr == 3 ? 1 : 0);
-            last.classification =
-                static_cast<std::uint8_t>(decoders_[Classification].decode_symbol(c->classification[ccc].get(256)));
+            last.classification = static_cast<std::uint8_t>(decoders_[Classification].decode_symbol(c->classification[ccc].get(256)));
         }
         if (changed_[Flags]) {
             const std::size_t previous = (last.edge << 5) | (last.scan_direction << 4) | last.class_flags;
@@ -611,8 +617,7 @@ public:
         if (changed_[ScanAngle] && scan_angle_change)
             last.scan_angle = static_cast<std::int16_t>(c->ic_scan_angle.decompress(last.scan_angle, gps_time_change));
         if (changed_[UserData])
-            last.user_data =
-                static_cast<std::uint8_t>(decoders_[UserData].decode_symbol(c->user_data[last.user_data / 4].get(256)));
+            last.user_data = static_cast<std::uint8_t>(decoders_[UserData].decode_symbol(c->user_data[last.user_data / 4].get(256)));
         if (changed_[PointSource] && point_source_change)
             last.point_source = static_cast<std::uint16_t>(c->ic_point_source.decompress(last.point_source));
         if (changed_[GpsTime] && gps_time_change) last.gps_time = c->gps.decode();
@@ -624,8 +629,13 @@ public:
 private:
     struct Context {
         explicit Context(std::array<ArithmeticDecoder, kPoint14Layers>& d)
-            : ic_dx(d[XY], 32, 2), ic_dy(d[XY], 32, 22), ic_z(d[Z], 32, 20), ic_intensity(d[Intensity], 16, 4),
-              ic_scan_angle(d[ScanAngle], 16, 2), ic_point_source(d[PointSource], 16), gps(d[GpsTime], true) {
+                : ic_dx(d[XY], 32, 2),
+                  ic_dy(d[XY], 32, 22),
+                  ic_z(d[Z], 32, 20),
+                  ic_intensity(d[Intensity], 16, 4),
+                  ic_scan_angle(d[ScanAngle], 16, 2),
+                  ic_point_source(d[PointSource], 16),
+                  gps(d[GpsTime], true) {
             changed_values.reserve(8);
             for (int i = 0; i < 8; ++i) changed_values.emplace_back(128);
         }
@@ -667,8 +677,7 @@ public:
     std::size_t layer_count() const override { return nir_ ? 2 : 1; }
     std::size_t overrun() const override { return max_overrun(decoders_); }
 
-    void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers,
-              std::uint32_t context) override {
+    void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers, std::uint32_t context) override {
         changed_rgb_ = want_rgb_ && !layers[0].empty();
         if (changed_rgb_) decoders_[0].init(layers[0].data(), layers[0].size());
         changed_nir_ = nir_ && want_nir_ && !layers[1].empty();
@@ -695,9 +704,9 @@ public:
             const std::uint32_t used = decoders_[1].decode_symbol(c.nir_used);
             const std::int32_t low = last->nir & 0xFF, high = last->nir >> 8;
             const std::int32_t new_low =
-                (used & 1) ? fold_u8(static_cast<std::int32_t>(decoders_[1].decode_symbol(c.nir_diff[0])) + low) : low;
+                    (used & 1) ? fold_u8(static_cast<std::int32_t>(decoders_[1].decode_symbol(c.nir_diff[0])) + low) : low;
             const std::int32_t new_high =
-                (used & 2) ? fold_u8(static_cast<std::int32_t>(decoders_[1].decode_symbol(c.nir_diff[1])) + high) : high;
+                    (used & 2) ? fold_u8(static_cast<std::int32_t>(decoders_[1].decode_symbol(c.nir_diff[1])) + high) : high;
             last->nir = static_cast<std::uint16_t>(new_low | (new_high << 8));
         }
         store<std::uint16_t>(out + 6, last->nir);
@@ -742,12 +751,11 @@ private:
 class Byte14Item final : public LayeredItem {
 public:
     Byte14Item(std::size_t count, const LayerSelection& selection)
-        : count_(count), wanted_(selection.extra_bytes), decoders_(count), changed_(count, false) {}
+            : count_(count), wanted_(selection.extra_bytes), decoders_(count), changed_(count, false) {}
     std::size_t layer_count() const override { return count_; }
     std::size_t overrun() const override { return max_overrun(decoders_); }
 
-    void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers,
-              std::uint32_t context) override {
+    void init(const std::uint8_t* first, const std::vector<std::span<const std::uint8_t>>& layers, std::uint32_t context) override {
         for (std::size_t i = 0; i < count_; ++i) {
             changed_[i] = wanted_ && !layers[i].empty();
             if (changed_[i]) decoders_[i].init(layers[i].data(), layers[i].size());
@@ -803,16 +811,26 @@ constexpr std::size_t kItemRecordSize = 6;
 
 const char* item_name(ItemType type) {
     switch (type) {
-        case ItemType::Byte: return "BYTE";
-        case ItemType::Point10: return "POINT10";
-        case ItemType::GpsTime11: return "GPSTIME11";
-        case ItemType::Rgb12: return "RGB12";
-        case ItemType::WavePacket13: return "WAVEPACKET13";
-        case ItemType::Point14: return "POINT14";
-        case ItemType::Rgb14: return "RGB14";
-        case ItemType::RgbNir14: return "RGBNIR14";
-        case ItemType::WavePacket14: return "WAVEPACKET14";
-        case ItemType::Byte14: return "BYTE14";
+        case ItemType::Byte:
+            return "BYTE";
+        case ItemType::Point10:
+            return "POINT10";
+        case ItemType::GpsTime11:
+            return "GPSTIME11";
+        case ItemType::Rgb12:
+            return "RGB12";
+        case ItemType::WavePacket13:
+            return "WAVEPACKET13";
+        case ItemType::Point14:
+            return "POINT14";
+        case ItemType::Rgb14:
+            return "RGB14";
+        case ItemType::RgbNir14:
+            return "RGBNIR14";
+        case ItemType::WavePacket14:
+            return "WAVEPACKET14";
+        case ItemType::Byte14:
+            return "BYTE14";
     }
     return "unknown";
 }
@@ -820,8 +838,8 @@ const char* item_name(ItemType type) {
 std::string item_label(const Item& item) {
     const auto type = static_cast<std::uint16_t>(item.type);
     const bool known = type == 0 || (type >= 6 && type <= 14);
-    return std::string(known ? item_name(item.type) : ("type " + std::to_string(type)).c_str()) + " v" +
-           std::to_string(item.version) + " (" + std::to_string(item.size) + " bytes)";
+    return std::string(known ? item_name(item.type) : ("type " + std::to_string(type)).c_str()) + " v" + std::to_string(item.version) +
+           " (" + std::to_string(item.size) + " bytes)";
 }
 
 // The items LASzip writes for a point format, in order, without the extra-bytes item.
@@ -848,8 +866,7 @@ std::string describe_items(const std::vector<Item>& items) {
 
 }  // namespace
 
-LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format, std::uint16_t record_length,
-                           const std::string& file) {
+LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format, std::uint16_t record_length, const std::string& file) {
     auto fail = [&](const std::string& what) { throw Error::input(file, "LASzip VLR: " + what); };
     if (data.size() < kVlrFixedSize) fail(std::to_string(data.size()) + " bytes, expected at least 34");
     const std::uint8_t* p = data.data();
@@ -880,7 +897,8 @@ LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format,
 
     // The items must be exactly those of the point format, then optional extra bytes.
     const std::vector<Item> expected = expected_items(point_format);
-    std::vector<Item> standard(vlr.items.begin(), vlr.items.begin() + static_cast<std::ptrdiff_t>(std::min(expected.size(), vlr.items.size())));
+    std::vector<Item> standard(vlr.items.begin(),
+                               vlr.items.begin() + static_cast<std::ptrdiff_t>(std::min(expected.size(), vlr.items.size())));
     bool matches = standard.size() == expected.size();
     for (std::size_t i = 0; matches && i < expected.size(); ++i)
         matches = standard[i].type == expected[i].type && standard[i].size == expected[i].size;
@@ -889,8 +907,8 @@ LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format,
     if (matches && extra_items > 1) matches = false;
     if (matches && extra_items == 1 && vlr.items.back().type != extra_type) matches = false;
     if (!matches)
-        fail("items [" + describe_items(vlr.items) + "] do not match point format " + std::to_string(point_format) +
-             ", which needs [" + describe_items(expected) + "] plus optional " + item_name(extra_type));
+        fail("items [" + describe_items(vlr.items) + "] do not match point format " + std::to_string(point_format) + ", which needs [" +
+             describe_items(expected) + "] plus optional " + item_name(extra_type));
     std::size_t total = 0;
     for (const Item& item : vlr.items) {
         total += item.size;
@@ -898,9 +916,8 @@ LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format,
             fail("waveform packets (" + item_label(item) + ") are not supported");
         const std::uint16_t wanted_version = point_format >= 6 ? 3 : 2;
         if (item.version != wanted_version)
-            fail(item_label(item) + ": only version " + std::to_string(wanted_version) +
-                 " is supported for point format " + std::to_string(point_format) +
-                 (item.version < wanted_version ? " (written by a LASzip older than 2.0?)" : ""));
+            fail(item_label(item) + ": only version " + std::to_string(wanted_version) + " is supported for point format " +
+                 std::to_string(point_format) + (item.version < wanted_version ? " (written by a LASzip older than 2.0?)" : ""));
     }
     if (total != record_length)
         fail("items [" + describe_items(vlr.items) + "] add up to " + std::to_string(total) +
@@ -916,15 +933,16 @@ namespace {
 
 void check_overrun(std::size_t overrun, const std::string& file, std::size_t chunk) {
     if (overrun > kOverrunSlack)
-        chunk_fail(file, chunk, "compressed data ends " + std::to_string(overrun) +
-                                    " bytes before its points do (truncated or corrupt chunk)");
+        chunk_fail(file, chunk,
+                   "compressed data ends " + std::to_string(overrun) + " bytes before its points do (truncated or corrupt chunk)");
 }
 
-void decode_pointwise_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data,
-                            std::size_t count, std::uint8_t* out, const std::string& file, std::size_t chunk) {
+void decode_pointwise_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data, std::size_t count,
+                            std::uint8_t* out, const std::string& file, std::size_t chunk) {
     if (data.size() < record_length)
-        chunk_fail(file, chunk, std::to_string(data.size()) + " bytes cannot hold its first point (" +
-                                    std::to_string(record_length) + " bytes stored raw)");
+        chunk_fail(file, chunk,
+                   std::to_string(data.size()) + " bytes cannot hold its first point (" + std::to_string(record_length) +
+                           " bytes stored raw)");
     // The first point is stored raw; the arithmetic stream follows it.
     std::memcpy(out, data.data(), record_length);
     ArithmeticDecoder decoder;
@@ -933,10 +951,18 @@ void decode_pointwise_chunk(const LaszipVlr& vlr, std::uint16_t record_length, s
     std::size_t offset = 0;
     for (const Item& item : vlr.items) {
         switch (item.type) {
-            case ItemType::Point10: items.push_back(std::make_unique<Point10Item>(decoder)); break;
-            case ItemType::GpsTime11: items.push_back(std::make_unique<GpsTime11Item>(decoder)); break;
-            case ItemType::Rgb12: items.push_back(std::make_unique<Rgb12Item>(decoder)); break;
-            default: items.push_back(std::make_unique<ByteItem>(decoder, item.size)); break;
+            case ItemType::Point10:
+                items.push_back(std::make_unique<Point10Item>(decoder));
+                break;
+            case ItemType::GpsTime11:
+                items.push_back(std::make_unique<GpsTime11Item>(decoder));
+                break;
+            case ItemType::Rgb12:
+                items.push_back(std::make_unique<Rgb12Item>(decoder));
+                break;
+            default:
+                items.push_back(std::make_unique<ByteItem>(decoder, item.size));
+                break;
         }
         items.back()->init(out + offset);
         offsets.push_back(offset);
@@ -951,22 +977,30 @@ void decode_pointwise_chunk(const LaszipVlr& vlr, std::uint16_t record_length, s
     check_overrun(decoder.overrun(), file, chunk);
 }
 
-void decode_layered_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data,
-                          std::size_t count, std::uint8_t* out, const LayerSelection& selection,
-                          const std::string& file, std::size_t chunk) {
+void decode_layered_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data, std::size_t count,
+                          std::uint8_t* out, const LayerSelection& selection, const std::string& file, std::size_t chunk) {
     if (data.size() < record_length)
-        chunk_fail(file, chunk, std::to_string(data.size()) + " bytes cannot hold its first point (" +
-                                    std::to_string(record_length) + " bytes stored raw)");
+        chunk_fail(file, chunk,
+                   std::to_string(data.size()) + " bytes cannot hold its first point (" + std::to_string(record_length) +
+                           " bytes stored raw)");
     std::memcpy(out, data.data(), record_length);
     if (count <= 1) return;
 
     std::vector<std::unique_ptr<LayeredItem>> items;
     for (const Item& item : vlr.items) {
         switch (item.type) {
-            case ItemType::Point14: items.push_back(std::make_unique<Point14Item>(selection)); break;
-            case ItemType::Rgb14: items.push_back(std::make_unique<Rgb14Item>(false, selection)); break;
-            case ItemType::RgbNir14: items.push_back(std::make_unique<Rgb14Item>(true, selection)); break;
-            default: items.push_back(std::make_unique<Byte14Item>(item.size, selection)); break;
+            case ItemType::Point14:
+                items.push_back(std::make_unique<Point14Item>(selection));
+                break;
+            case ItemType::Rgb14:
+                items.push_back(std::make_unique<Rgb14Item>(false, selection));
+                break;
+            case ItemType::RgbNir14:
+                items.push_back(std::make_unique<Rgb14Item>(true, selection));
+                break;
+            default:
+                items.push_back(std::make_unique<Byte14Item>(item.size, selection));
+                break;
         }
     }
     // After the raw point: the point count (4 bytes), every layer's byte count (4 bytes each, in
@@ -989,8 +1023,9 @@ void decode_layered_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std
         std::vector<std::span<const std::uint8_t>> layers;
         for (std::size_t k = 0; k < items[i]->layer_count(); ++k, ++layer) {
             if (sizes[layer] > data.size() - pos)
-                chunk_fail(file, chunk, "layer " + std::to_string(layer + 1) + " declares " + std::to_string(sizes[layer]) +
-                                            " bytes, only " + std::to_string(data.size() - pos) + " remain in the chunk");
+                chunk_fail(file, chunk,
+                           "layer " + std::to_string(layer + 1) + " declares " + std::to_string(sizes[layer]) + " bytes, only " +
+                                   std::to_string(data.size() - pos) + " remain in the chunk");
             layers.push_back(data.subspan(pos, sizes[layer]));
             pos += sizes[layer];
         }
@@ -1007,13 +1042,14 @@ void decode_layered_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std
 
 }  // namespace
 
-void decode_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data,
-                  std::size_t count, std::uint8_t* out, const LayerSelection& selection, const std::string& file,
-                  std::size_t chunk_index) {
+void decode_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data, std::size_t count,
+                  std::uint8_t* out, const LayerSelection& selection, const std::string& file, std::size_t chunk_index) {
     if (count == 0) return;
     try {
-        if (vlr.compressor == 3) decode_layered_chunk(vlr, record_length, data, count, out, selection, file, chunk_index);
-        else decode_pointwise_chunk(vlr, record_length, data, count, out, file, chunk_index);
+        if (vlr.compressor == 3)
+            decode_layered_chunk(vlr, record_length, data, count, out, selection, file, chunk_index);
+        else
+            decode_pointwise_chunk(vlr, record_length, data, count, out, file, chunk_index);
     } catch (const Error& e) {
         if (e.code() != ExitCode::InvalidInput || std::string_view(e.what()).starts_with(file)) throw;
         chunk_fail(file, chunk_index, e.what());  // errors raised inside the models lack the file name

@@ -56,8 +56,7 @@ struct LaszipVlr {
 // Parses the VLR payload and checks that its items are the ones `point_format` needs (in the
 // LASzip order, with the supported versions) and that their sizes add up to `record_length`.
 // Throws Error(InvalidInput) naming `file` and the mismatch.
-LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format, std::uint16_t record_length,
-                           const std::string& file);
+LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format, std::uint16_t record_length, const std::string& file);
 
 // Which parts of a point a reader needs. x, y and return numbers are always decoded (they are
 // the first layer); for formats 6-10 the other layers can be skipped, their fields then keep
@@ -65,7 +64,7 @@ LaszipVlr parse_laszip_vlr(std::span<const std::uint8_t> data, int point_format,
 struct LayerSelection {
     bool z = true;
     bool classification = true;
-    bool flags = true;          // classification flags, scan direction, edge of flight line
+    bool flags = true;  // classification flags, scan direction, edge of flight line
     bool intensity = true;
     bool scan_angle = true;
     bool user_data = true;
@@ -88,8 +87,7 @@ struct LayerSelection {
 // Decodes one chunk of `count` points from `data` (the chunk's bytes) into `out`, which holds
 // count * record_length bytes. Throws Error(InvalidInput) (naming `file` and `chunk_index`)
 // when the data ends before the points do or a layer size does not fit.
-void decode_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data,
-                  std::size_t count, std::uint8_t* out, const LayerSelection& selection, const std::string& file,
-                  std::size_t chunk_index);
+void decode_chunk(const LaszipVlr& vlr, std::uint16_t record_length, std::span<const std::uint8_t> data, std::size_t count,
+                  std::uint8_t* out, const LayerSelection& selection, const std::string& file, std::size_t chunk_index);
 
 }  // namespace treelobes::laz

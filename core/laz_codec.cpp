@@ -14,9 +14,9 @@ namespace {
 
 constexpr std::uint32_t kMinLength = 0x01000000u;  // renormalise when the interval drops below 2^24
 constexpr std::uint32_t kMaxLength = 0xFFFFFFFFu;
-constexpr std::uint32_t kBitLengthShift = 13;       // binary probabilities have 13 bits
+constexpr std::uint32_t kBitLengthShift = 13;  // binary probabilities have 13 bits
 constexpr std::uint32_t kBitMaxCount = 1u << kBitLengthShift;
-constexpr std::uint32_t kSymbolLengthShift = 15;    // symbol distributions have 15 bits
+constexpr std::uint32_t kSymbolLengthShift = 15;  // symbol distributions have 15 bits
 constexpr std::uint32_t kSymbolMaxCount = 1u << kSymbolLengthShift;
 
 }  // namespace
@@ -24,8 +24,7 @@ constexpr std::uint32_t kSymbolMaxCount = 1u << kSymbolLengthShift;
 // ---------------------------------------------------------------------------------------------
 // Models
 
-BitModel::BitModel()
-    : bit0_prob_(1u << (kBitLengthShift - 1)), bit0_count_(1), bit_count_(2), update_cycle_(4), bits_until_update_(4) {}
+BitModel::BitModel() : bit0_prob_(1u << (kBitLengthShift - 1)), bit0_count_(1), bit_count_(2), update_cycle_(4), bits_until_update_(4) {}
 
 void BitModel::update() {
     // Halve the counts when they grow too large, so the model keeps adapting.
@@ -129,8 +128,10 @@ std::uint32_t ArithmeticDecoder::decode_symbol(SymbolModel& m) {
         std::uint32_t n = m.table_[t + 1] + 1;
         while (n > symbol + 1) {  // bisection inside the table's bracket
             const std::uint32_t k = (symbol + n) >> 1;
-            if (m.distribution_[k] > dv) n = k;
-            else symbol = k;
+            if (m.distribution_[k] > dv)
+                n = k;
+            else
+                symbol = k;
         }
         x = m.distribution_[symbol] * length_;
         if (symbol != m.last_symbol_) y = m.distribution_[symbol + 1] * length_;
@@ -186,9 +187,9 @@ std::uint32_t ArithmeticDecoder::read_int() {
 // ---------------------------------------------------------------------------------------------
 // Integer decompressor
 
-IntegerDecompressor::IntegerDecompressor(ArithmeticDecoder& decoder, std::uint32_t bits, std::uint32_t contexts,
-                                         std::uint32_t bits_high, std::uint32_t range)
-    : decoder_(&decoder), bits_high_(bits_high) {
+IntegerDecompressor::IntegerDecompressor(ArithmeticDecoder& decoder, std::uint32_t bits, std::uint32_t contexts, std::uint32_t bits_high,
+                                         std::uint32_t range)
+        : decoder_(&decoder), bits_high_(bits_high) {
     if (range != 0) {  // explicit range: as many bits as it takes
         corr_range_ = range;
         while (range != 0) {
@@ -222,8 +223,10 @@ std::int32_t IntegerDecompressor::decompress(std::int32_t pred, std::uint32_t co
     // Wrap pred + corrector into [0, range) (the whole 32-bit circle when range is 0).
     std::int64_t real = std::int64_t{pred} + corrector;
     if (corr_range_ != 0) {
-        if (real < 0) real += corr_range_;
-        else if (real >= std::int64_t{corr_range_}) real -= corr_range_;
+        if (real < 0)
+            real += corr_range_;
+        else if (real >= std::int64_t{corr_range_})
+            real -= corr_range_;
     }
     return static_cast<std::int32_t>(static_cast<std::uint32_t>(real));
 }
@@ -242,8 +245,10 @@ std::int32_t IntegerDecompressor::read_corrector(SymbolModel& model) {
     }
     // Class k holds the correctors with |c| in [2^(k-1), 2^k): offsets below 2^(k-1) are the
     // negative ones, the others the positive ones.
-    if (c >= (std::int64_t{1} << (k_ - 1))) c += 1;
-    else c -= (std::int64_t{1} << k_) - 1;
+    if (c >= (std::int64_t{1} << (k_ - 1)))
+        c += 1;
+    else
+        c -= (std::int64_t{1} << k_) - 1;
     return static_cast<std::int32_t>(c);
 }
 

@@ -82,8 +82,8 @@ private:
 // compressor"; `bits` is the value width, `range` an optional explicit value range.
 class IntegerDecompressor {
 public:
-    IntegerDecompressor(ArithmeticDecoder& decoder, std::uint32_t bits = 16, std::uint32_t contexts = 1,
-                        std::uint32_t bits_high = 8, std::uint32_t range = 0);
+    IntegerDecompressor(ArithmeticDecoder& decoder, std::uint32_t bits = 16, std::uint32_t contexts = 1, std::uint32_t bits_high = 8,
+                        std::uint32_t range = 0);
 
     std::int32_t decompress(std::int32_t pred, std::uint32_t context = 0);
     // Bit length class of the last corrector: LAZ uses it as context for the next coordinate.
@@ -96,8 +96,8 @@ private:
     std::uint32_t bits_high_, corr_bits_ = 0, corr_range_ = 0;
     std::int32_t corr_min_ = 0;
     std::uint32_t k_ = 0;
-    std::vector<SymbolModel> k_models_;      // one per context, corr_bits + 1 symbols
-    BitModel zero_corrector_;                // k == 0: the corrector is 0 or 1
+    std::vector<SymbolModel> k_models_;  // one per context, corr_bits + 1 symbols
+    BitModel zero_corrector_;            // k == 0: the corrector is 0 or 1
     // Class k = 1..corr_bits at index k - 1, created on first use: a fresh model's state is
     // fixed, so creating it late decodes the same, and small chunks (COPC nodes) skip building
     // models for classes they never see.

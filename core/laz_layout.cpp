@@ -32,8 +32,8 @@ std::uint64_t locate_chunk_table(InputFile& file, std::uint64_t offset_to_points
 
 }  // namespace
 
-std::vector<Chunk> read_chunk_table(InputFile& file, const LaszipVlr& vlr, std::uint64_t offset_to_points,
-                                    std::uint64_t data_end, std::uint64_t point_count, std::uint16_t record_length) {
+std::vector<Chunk> read_chunk_table(InputFile& file, const LaszipVlr& vlr, std::uint64_t offset_to_points, std::uint64_t data_end,
+                                    std::uint64_t point_count, std::uint16_t record_length) {
     std::vector<Chunk> chunks;
     if (point_count == 0) return chunks;
     if (!vlr.chunked()) {
@@ -78,17 +78,18 @@ std::vector<Chunk> read_chunk_table(InputFile& file, const LaszipVlr& vlr, std::
         }
         if (decoder.overrun() > 4) file.fail("LAZ chunk table is truncated");
         if (offset > table)
-            file.fail("LAZ chunk table: the chunks end at byte " + std::to_string(offset) +
-                      ", past the chunk table at byte " + std::to_string(table) + " (corrupt table)");
+            file.fail("LAZ chunk table: the chunks end at byte " + std::to_string(offset) + ", past the chunk table at byte " +
+                      std::to_string(table) + " (corrupt table)");
     }
     std::uint64_t total = 0;
     for (std::size_t i = 0; i < chunks.size(); ++i) {
         const Chunk& c = chunks[i];
         if (c.count == 0 && i + 1 < chunks.size()) file.fail("LAZ chunk " + std::to_string(i) + " holds no points");
-        if (c.bytes == 0 && c.count > 0) file.fail("LAZ chunk " + std::to_string(i) + " is empty but holds " + std::to_string(c.count) + " points");
+        if (c.bytes == 0 && c.count > 0)
+            file.fail("LAZ chunk " + std::to_string(i) + " is empty but holds " + std::to_string(c.count) + " points");
         if (c.count > c.bytes * kMaxPointsPerByte)
-            file.fail("LAZ chunk " + std::to_string(i) + " claims " + std::to_string(c.count) + " points in " +
-                      std::to_string(c.bytes) + " bytes (corrupt chunk table)");
+            file.fail("LAZ chunk " + std::to_string(i) + " claims " + std::to_string(c.count) + " points in " + std::to_string(c.bytes) +
+                      " bytes (corrupt chunk table)");
         total += c.count;
     }
     if (total != point_count)
@@ -150,8 +151,8 @@ std::vector<CopcNode> read_copc_hierarchy(InputFile& file, const CopcInfo& info)
             }
             if (point_count <= 0) continue;  // a node without points
             if (byte_size <= 0 || entry_offset > file.size() || static_cast<std::uint64_t>(byte_size) > file.size() - entry_offset)
-                file.fail("COPC node " + std::to_string(node.level) + "-" + std::to_string(node.x) + "-" +
-                          std::to_string(node.y) + "-" + std::to_string(node.z) + " points outside the file");
+                file.fail("COPC node " + std::to_string(node.level) + "-" + std::to_string(node.x) + "-" + std::to_string(node.y) + "-" +
+                          std::to_string(node.z) + " points outside the file");
             const double side = 2 * info.halfsize / std::ldexp(1.0, node.level);
             const Eigen::Vector3d corner = info.center.array() - info.halfsize;
             node.min = corner + side * Eigen::Vector3d(node.x, node.y, node.z);

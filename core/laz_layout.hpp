@@ -16,7 +16,7 @@
 namespace treelobes::laz {
 
 struct Chunk {
-    std::uint64_t offset = 0;       // absolute file offset of the chunk's bytes
+    std::uint64_t offset = 0;  // absolute file offset of the chunk's bytes
     std::uint64_t bytes = 0;
     std::uint64_t first_point = 0;  // index of its first point in the file
     std::uint64_t count = 0;        // points in the chunk
@@ -25,8 +25,8 @@ struct Chunk {
 // Reads and checks the chunk table of the point data in [offset_to_points, data_end): every chunk
 // must lie inside that region, the counts must add up to `point_count`, and no chunk may claim
 // more points than its bytes could plausibly hold. Throws Error(InvalidInput) naming the file.
-std::vector<Chunk> read_chunk_table(InputFile& file, const LaszipVlr& vlr, std::uint64_t offset_to_points,
-                                    std::uint64_t data_end, std::uint64_t point_count, std::uint16_t record_length);
+std::vector<Chunk> read_chunk_table(InputFile& file, const LaszipVlr& vlr, std::uint64_t offset_to_points, std::uint64_t data_end,
+                                    std::uint64_t point_count, std::uint16_t record_length);
 
 // COPC 1.0 "copc info" VLR (user "copc", record 1, 160 bytes).
 struct CopcInfo {

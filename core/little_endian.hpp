@@ -9,11 +9,24 @@
 namespace treelobes {
 
 namespace detail {
-template <std::size_t N> struct UnsignedOfSize;
-template <> struct UnsignedOfSize<1> { using type = std::uint8_t; };
-template <> struct UnsignedOfSize<2> { using type = std::uint16_t; };
-template <> struct UnsignedOfSize<4> { using type = std::uint32_t; };
-template <> struct UnsignedOfSize<8> { using type = std::uint64_t; };
+template <std::size_t N>
+struct UnsignedOfSize;
+template <>
+struct UnsignedOfSize<1> {
+    using type = std::uint8_t;
+};
+template <>
+struct UnsignedOfSize<2> {
+    using type = std::uint16_t;
+};
+template <>
+struct UnsignedOfSize<4> {
+    using type = std::uint32_t;
+};
+template <>
+struct UnsignedOfSize<8> {
+    using type = std::uint64_t;
+};
 }  // namespace detail
 
 template <typename T>

@@ -37,8 +37,11 @@ void log_info(const std::string& message) { emit(LogLevel::Info, "", message); }
 void log_debug(const std::string& message) { emit(LogLevel::Debug, "debug: ", message); }
 
 Progress::Progress(std::string label, std::size_t total)
-    : label_(std::move(label)), total_(total), terminal_(::isatty(STDERR_FILENO) != 0),
-      start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
+        : label_(std::move(label)),
+          total_(total),
+          terminal_(::isatty(STDERR_FILENO) != 0),
+          start_(std::chrono::steady_clock::now()),
+          last_draw_(start_) {}
 
 Progress::~Progress() {
     if (!finished_ && done_ > 0) finish();

@@ -34,11 +34,24 @@ double parse_memory_size(const std::string& text, const std::string& setting) {
     double factor = 1;
     if (fields == 2) {
         switch (unit) {
-            case 'k': case 'K': factor = 1024.0; break;
-            case 'm': case 'M': factor = 1024.0 * 1024; break;
-            case 'g': case 'G': factor = 1024.0 * 1024 * 1024; break;
-            case 't': case 'T': factor = 1024.0 * 1024 * 1024 * 1024; break;
-            default: factor = 0;
+            case 'k':
+            case 'K':
+                factor = 1024.0;
+                break;
+            case 'm':
+            case 'M':
+                factor = 1024.0 * 1024;
+                break;
+            case 'g':
+            case 'G':
+                factor = 1024.0 * 1024 * 1024;
+                break;
+            case 't':
+            case 'T':
+                factor = 1024.0 * 1024 * 1024 * 1024;
+                break;
+            default:
+                factor = 0;
         }
     }
     if (fields < 1 || fields > 2 || factor == 0 || !std::isfinite(value) || value <= 0 || value * factor > 1.8e19)
@@ -60,8 +73,9 @@ void check_memory_estimate(std::uint64_t bytes, const std::string& file, const s
     if (bytes <= limit) return;
     const bool capped = std::getenv("TREELOBES_MAX_MEMORY") && limit < physical_memory();
     throw Error::input(file, what + " needs about " + gibibytes(static_cast<double>(bytes)) + " of memory, more than the " +
-                                 gibibytes(static_cast<double>(limit)) + (capped ? " TREELOBES_MAX_MEMORY allows" : " this machine has") +
-                                 "; split the file into tiles (`treelobes retile --size METRES`) or thin it first");
+                                     gibibytes(static_cast<double>(limit)) +
+                                     (capped ? " TREELOBES_MAX_MEMORY allows" : " this machine has") +
+                                     "; split the file into tiles (`treelobes retile --size METRES`) or thin it first");
 }
 
 std::optional<std::string> memory_refusal(std::size_t points, double bytes_per_point, double budget_bytes) {

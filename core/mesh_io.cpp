@@ -30,9 +30,7 @@ struct DoubleTraits : OpenMesh::DefaultTraits {
 };
 using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
 
-bool is_mesh_extension(const std::string& ext) {
-    return ext == "ply" || ext == "obj" || ext == "off" || ext == "stl" || ext == "om";
-}
+bool is_mesh_extension(const std::string& ext) { return ext == "ply" || ext == "obj" || ext == "off" || ext == "stl" || ext == "om"; }
 
 // OpenMesh reports problems on its own error stream; we turn them into one Error line.
 void silence_openmesh() {
@@ -68,8 +66,7 @@ NamedMesh read_with_openmesh(const fs::path& path) {
     silence_openmesh();
     PolyMesh mesh;
     OpenMesh::IO::Options options;
-    if (!OpenMesh::IO::read_mesh(mesh, name, options))
-        throw Error::input(name, "cannot read mesh (malformed or truncated file)");
+    if (!OpenMesh::IO::read_mesh(mesh, name, options)) throw Error::input(name, "cannot read mesh (malformed or truncated file)");
 
     NamedMesh named;
     named.report.format = file_extension(path);
@@ -107,8 +104,10 @@ NamedMesh read_named_mesh(const fs::path& path) {
 TriangleMesh read_mesh(const fs::path& path) { return read_named_mesh(path).mesh; }
 
 void write_named_mesh(const NamedMesh& mesh, const fs::path& path) {
-    if (file_extension(path) == "obj") write_obj(mesh, path);
-    else write_mesh(mesh.mesh, path);
+    if (file_extension(path) == "obj")
+        write_obj(mesh, path);
+    else
+        write_mesh(mesh.mesh, path);
 }
 
 void write_mesh(const TriangleMesh& mesh, const fs::path& path) {
@@ -136,8 +135,7 @@ void write_mesh(const TriangleMesh& mesh, const fs::path& path) {
     OpenMesh::IO::Options options;
     if (ext == "ply") options += OpenMesh::IO::Options::Binary;
     write_atomically_via_path(path, [&](const fs::path& temporary) {
-        if (!OpenMesh::IO::write_mesh(out, temporary.string(), options, 10))
-            throw Error::input(path.string(), "cannot write mesh");
+        if (!OpenMesh::IO::write_mesh(out, temporary.string(), options, 10)) throw Error::input(path.string(), "cannot write mesh");
     });
     write_georef_sidecar(path, mesh.origin, {});
 }

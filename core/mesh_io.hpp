@@ -23,15 +23,15 @@ struct FaceNames {
 
 // What the reader repaired or dropped on the way.
 struct MeshReadReport {
-    std::string format;                 // "obj", "ply", "off", "stl"
-    std::size_t polygons_split = 0;     // faces with more than three corners, fan-triangulated
-    std::size_t degenerate_faces = 0;   // dropped: a corner repeated (no area, nothing to sample)
-    std::size_t normals_ignored = 0;    // normal records in the file (normals are recomputed where needed)
+    std::string format;                // "obj", "ply", "off", "stl"
+    std::size_t polygons_split = 0;    // faces with more than three corners, fan-triangulated
+    std::size_t degenerate_faces = 0;  // dropped: a corner repeated (no area, nothing to sample)
+    std::size_t normals_ignored = 0;   // normal records in the file (normals are recomputed where needed)
 };
 
 struct NamedMesh {
-    TriangleMesh mesh;                   // local coordinates + double origin (UTM-sized input keeps its precision)
-    std::vector<FaceNames> names;        // distinct name combinations, in order of first use
+    TriangleMesh mesh;                      // local coordinates + double origin (UTM-sized input keeps its precision)
+    std::vector<FaceNames> names;           // distinct name combinations, in order of first use
     std::vector<std::uint32_t> face_names;  // per face an index into `names`; empty when the file names no face
     MeshReadReport report;
 };

@@ -38,10 +38,10 @@ std::string_view next_token(std::string_view& line) {
 
 // Records that carry nothing a tree rebuild needs.
 bool is_skipped_record(std::string_view keyword) {
-    static constexpr std::string_view kSkipped[] = {"vt", "vp", "s", "l", "p", "mtllib", "usemap", "maplib", "lod", "bevel",
-                                                     "c_interp", "d_interp", "shadow_obj", "trace_obj", "ctech", "stech", "mg",
-                                                     "cstype", "deg", "bmat", "step", "curv", "curv2", "surf", "parm", "trim",
-                                                     "hole", "scrv", "sp", "end", "con", "call", "csh"};
+    static constexpr std::string_view kSkipped[] = {
+            "vt",       "vp",         "s",         "l",     "p",     "mtllib", "usemap", "maplib", "lod",  "bevel", "c_interp",
+            "d_interp", "shadow_obj", "trace_obj", "ctech", "stech", "mg",     "cstype", "deg",    "bmat", "step",  "curv",
+            "curv2",    "surf",       "parm",      "trim",  "hole",  "scrv",   "sp",     "end",    "con",  "call",  "csh"};
     for (const auto s : kSkipped)
         if (keyword == s) return true;
     return false;
@@ -174,8 +174,10 @@ private:
         for (const auto& p : positions_) vertices.push_back((p - result_.mesh.origin).cast<float>());
         bool named = false;
         for (const auto& n : result_.names) named = named || !n.empty();
-        if (named) result_.face_names = std::move(face_names_);
-        else result_.names.clear();
+        if (named)
+            result_.face_names = std::move(face_names_);
+        else
+            result_.names.clear();
         return std::move(result_);
     }
 
@@ -206,16 +208,14 @@ Eigen::Vector3d mesh_origin_for(const Eigen::Vector3d& first) {
     return origin;
 }
 
-NamedMesh read_obj(const fs::path& path) {
-    return ObjParser(path.string()).parse(read_file(path));
-}
+NamedMesh read_obj(const fs::path& path) { return ObjParser(path.string()).parse(read_file(path)); }
 
 void write_obj(const NamedMesh& named, const fs::path& path) {
     const TriangleMesh& mesh = named.mesh;
     const bool has_names = !named.face_names.empty();
     if (has_names && named.face_names.size() != mesh.faces.size())
         throw Error(ExitCode::Internal, "write_obj: " + std::to_string(named.face_names.size()) + " face names for " +
-                                            std::to_string(mesh.faces.size()) + " faces");
+                                                std::to_string(mesh.faces.size()) + " faces");
     std::string out = "# treelobes\n";
     out.reserve(40 * mesh.vertices.size() + 30 * mesh.faces.size());
     for (const auto& v : mesh.vertices) {

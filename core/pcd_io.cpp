@@ -33,27 +33,43 @@ double field_value(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f,
         return static_cast<double>(v);
     };
     switch (f.datatype) {
-        case pcl::PCLPointField::INT8: return get(std::int8_t{});
-        case pcl::PCLPointField::UINT8: return get(std::uint8_t{});
-        case pcl::PCLPointField::INT16: return get(std::int16_t{});
-        case pcl::PCLPointField::UINT16: return get(std::uint16_t{});
-        case pcl::PCLPointField::INT32: return get(std::int32_t{});
-        case pcl::PCLPointField::UINT32: return get(std::uint32_t{});
-        case pcl::PCLPointField::FLOAT32: return get(float{});
-        default: return get(double{});
+        case pcl::PCLPointField::INT8:
+            return get(std::int8_t{});
+        case pcl::PCLPointField::UINT8:
+            return get(std::uint8_t{});
+        case pcl::PCLPointField::INT16:
+            return get(std::int16_t{});
+        case pcl::PCLPointField::UINT16:
+            return get(std::uint16_t{});
+        case pcl::PCLPointField::INT32:
+            return get(std::int32_t{});
+        case pcl::PCLPointField::UINT32:
+            return get(std::uint32_t{});
+        case pcl::PCLPointField::FLOAT32:
+            return get(float{});
+        default:
+            return get(double{});
     }
 }
 
 AttributeType attribute_type(std::uint8_t datatype) {
     switch (datatype) {
-        case pcl::PCLPointField::INT8: return AttributeType::Int8;
-        case pcl::PCLPointField::UINT8: return AttributeType::UInt8;
-        case pcl::PCLPointField::INT16: return AttributeType::Int16;
-        case pcl::PCLPointField::UINT16: return AttributeType::UInt16;
-        case pcl::PCLPointField::INT32: return AttributeType::Int32;
-        case pcl::PCLPointField::UINT32: return AttributeType::UInt32;
-        case pcl::PCLPointField::FLOAT32: return AttributeType::Float32;
-        default: return AttributeType::Float64;
+        case pcl::PCLPointField::INT8:
+            return AttributeType::Int8;
+        case pcl::PCLPointField::UINT8:
+            return AttributeType::UInt8;
+        case pcl::PCLPointField::INT16:
+            return AttributeType::Int16;
+        case pcl::PCLPointField::UINT16:
+            return AttributeType::UInt16;
+        case pcl::PCLPointField::INT32:
+            return AttributeType::Int32;
+        case pcl::PCLPointField::UINT32:
+            return AttributeType::UInt32;
+        case pcl::PCLPointField::FLOAT32:
+            return AttributeType::Float32;
+        default:
+            return AttributeType::Float64;
     }
 }
 
@@ -63,8 +79,7 @@ const pcl::PCLPointField* find_field(const pcl::PCLPointCloud2& blob, const std:
     return nullptr;
 }
 
-void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, const std::vector<std::size_t>& kept,
-                 PointCloud& cloud) {
+void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, const std::vector<std::size_t>& kept, PointCloud& cloud) {
     if (f.count != 1 || f.name == "x" || f.name == "y" || f.name == "z" || f.name == "_") return;
     if (f.name == "rgb" || f.name == "rgba") {
         for (std::size_t i : kept) {

@@ -22,9 +22,7 @@ std::string lower(std::string s) {
     return s;
 }
 
-std::string strip_scalar_prefix(const std::string& name) {
-    return lower(name).starts_with("scalar_") ? name.substr(7) : name;
-}
+std::string strip_scalar_prefix(const std::string& name) { return lower(name).starts_with("scalar_") ? name.substr(7) : name; }
 
 bool is_coordinate(const std::string& name) { return name == "x" || name == "y" || name == "z"; }
 
@@ -40,13 +38,20 @@ std::vector<T> cast_values(const std::vector<double>& values, const std::vector<
 void store_property(const ply::Property& p, const std::vector<std::size_t>& kept, PointCloud& cloud,
                     std::vector<const ply::Property*>& colour) {
     const std::string base = lower(strip_scalar_prefix(p.name));
-    if (base == "red" || base == "r") colour[0] = &p;
-    else if (base == "green" || base == "g") colour[1] = &p;
-    else if (base == "blue" || base == "b") colour[2] = &p;
-    else if (base == "intensity") cloud.intensity = cast_values<std::uint16_t>(p.values, kept);
-    else if (base == "classification") cloud.classification = cast_values<std::uint8_t>(p.values, kept);
-    else if (base == "return_number") cloud.return_number = cast_values<std::uint8_t>(p.values, kept);
-    else if (base == "number_of_returns") cloud.number_of_returns = cast_values<std::uint8_t>(p.values, kept);
+    if (base == "red" || base == "r")
+        colour[0] = &p;
+    else if (base == "green" || base == "g")
+        colour[1] = &p;
+    else if (base == "blue" || base == "b")
+        colour[2] = &p;
+    else if (base == "intensity")
+        cloud.intensity = cast_values<std::uint16_t>(p.values, kept);
+    else if (base == "classification")
+        cloud.classification = cast_values<std::uint8_t>(p.values, kept);
+    else if (base == "return_number")
+        cloud.return_number = cast_values<std::uint8_t>(p.values, kept);
+    else if (base == "number_of_returns")
+        cloud.number_of_returns = cast_values<std::uint8_t>(p.values, kept);
     else if (base == "gps_time") {
         for (std::size_t i : kept) cloud.gps_time.push_back(p.values[i]);
     } else {
@@ -99,8 +104,7 @@ PointCloud read_ply_cloud(const fs::path& path) {
         const Eigen::Vector3d p(axis[0]->values[i], axis[1]->values[i], axis[2]->values[i]);
         if (p.allFinite()) kept.push_back(i);
     }
-    if (kept.empty())
-        throw Error::input(name, vertex->count ? "all points have NaN/inf coordinates" : "PLY has no vertices");
+    if (kept.empty()) throw Error::input(name, vertex->count ? "all points have NaN/inf coordinates" : "PLY has no vertices");
 
     // Our writers store local coordinates plus an origin comment. Other files may hold
     // georeferenced doubles: then the origin is taken from the data so that float local
@@ -115,8 +119,7 @@ PointCloud read_ply_cloud(const fs::path& path) {
     cloud.origin = stored_origin ? *stored_origin : shift;
     cloud.positions.reserve(kept.size());
     for (std::size_t i : kept)
-        cloud.positions.push_back(
-            (Eigen::Vector3d(axis[0]->values[i], axis[1]->values[i], axis[2]->values[i]) - shift).cast<float>());
+        cloud.positions.push_back((Eigen::Vector3d(axis[0]->values[i], axis[1]->values[i], axis[2]->values[i]) - shift).cast<float>());
 
     std::vector<const ply::Property*> colour(3, nullptr);
     for (const auto& p : vertex->properties)
@@ -145,19 +148,25 @@ void write_ply_cloud(const PointCloud& cloud, const fs::path& path, bool binary)
         vertex.properties.push_back(scalar(std::string(1, "xyz"[k]), AttributeType::Float32, std::move(values)));
     }
     if (!cloud.rgb.empty()) {
-        const bool eight_bit = std::all_of(cloud.rgb.begin(), cloud.rgb.end(),
-                                           [](const auto& c) { return c[0] < 256 && c[1] < 256 && c[2] < 256; });
+        const bool eight_bit =
+                std::all_of(cloud.rgb.begin(), cloud.rgb.end(), [](const auto& c) { return c[0] < 256 && c[1] < 256 && c[2] < 256; });
         for (int c = 0; c < 3; ++c) {
             std::vector<double> values;
             for (const auto& colour : cloud.rgb) values.push_back(colour[c]);
-            vertex.properties.push_back(scalar(c == 0 ? "red" : c == 1 ? "green" : "blue",
+            vertex.properties.push_back(scalar(c == 0   ? "red"
+                                               : c == 1 ? "green"
+                                                        : "blue",
                                                eight_bit ? AttributeType::UInt8 : AttributeType::UInt16, std::move(values)));
         }
     }
-    if (!cloud.intensity.empty()) vertex.properties.push_back(scalar("scalar_intensity", AttributeType::UInt16, as_doubles(cloud.intensity)));
-    if (!cloud.return_number.empty()) vertex.properties.push_back(scalar("scalar_return_number", AttributeType::UInt8, as_doubles(cloud.return_number)));
-    if (!cloud.number_of_returns.empty()) vertex.properties.push_back(scalar("scalar_number_of_returns", AttributeType::UInt8, as_doubles(cloud.number_of_returns)));
-    if (!cloud.classification.empty()) vertex.properties.push_back(scalar("scalar_classification", AttributeType::UInt8, as_doubles(cloud.classification)));
+    if (!cloud.intensity.empty())
+        vertex.properties.push_back(scalar("scalar_intensity", AttributeType::UInt16, as_doubles(cloud.intensity)));
+    if (!cloud.return_number.empty())
+        vertex.properties.push_back(scalar("scalar_return_number", AttributeType::UInt8, as_doubles(cloud.return_number)));
+    if (!cloud.number_of_returns.empty())
+        vertex.properties.push_back(scalar("scalar_number_of_returns", AttributeType::UInt8, as_doubles(cloud.number_of_returns)));
+    if (!cloud.classification.empty())
+        vertex.properties.push_back(scalar("scalar_classification", AttributeType::UInt8, as_doubles(cloud.classification)));
     if (!cloud.gps_time.empty()) vertex.properties.push_back(scalar("scalar_gps_time", AttributeType::Float64, cloud.gps_time));
     for (const auto& attribute : cloud.extras)
         vertex.properties.push_back(scalar("scalar_" + attribute.name, attribute.type, attribute.values));

@@ -35,12 +35,12 @@ namespace {
 
 bool parse_type(const std::string& word, AttributeType& type) {
     static const std::pair<const char*, AttributeType> names[] = {
-        {"char", AttributeType::Int8},     {"int8", AttributeType::Int8},       {"uchar", AttributeType::UInt8},
-        {"uint8", AttributeType::UInt8},   {"short", AttributeType::Int16},     {"int16", AttributeType::Int16},
-        {"ushort", AttributeType::UInt16}, {"uint16", AttributeType::UInt16},   {"int", AttributeType::Int32},
-        {"int32", AttributeType::Int32},   {"uint", AttributeType::UInt32},     {"uint32", AttributeType::UInt32},
-        {"float", AttributeType::Float32}, {"float32", AttributeType::Float32}, {"double", AttributeType::Float64},
-        {"float64", AttributeType::Float64}};
+            {"char", AttributeType::Int8},      {"int8", AttributeType::Int8},       {"uchar", AttributeType::UInt8},
+            {"uint8", AttributeType::UInt8},    {"short", AttributeType::Int16},     {"int16", AttributeType::Int16},
+            {"ushort", AttributeType::UInt16},  {"uint16", AttributeType::UInt16},   {"int", AttributeType::Int32},
+            {"int32", AttributeType::Int32},    {"uint", AttributeType::UInt32},     {"uint32", AttributeType::UInt32},
+            {"float", AttributeType::Float32},  {"float32", AttributeType::Float32}, {"double", AttributeType::Float64},
+            {"float64", AttributeType::Float64}};
     for (const auto& [name, t] : names)
         if (word == name) {
             type = t;
@@ -51,14 +51,22 @@ bool parse_type(const std::string& word, AttributeType& type) {
 
 const char* type_word(AttributeType type) {
     switch (type) {
-        case AttributeType::Int8: return "char";
-        case AttributeType::UInt8: return "uchar";
-        case AttributeType::Int16: return "short";
-        case AttributeType::UInt16: return "ushort";
-        case AttributeType::Int32: return "int";
-        case AttributeType::UInt32: return "uint";
-        case AttributeType::Float32: return "float";
-        default: return "double";  // PLY has no 64-bit integers: stored as double
+        case AttributeType::Int8:
+            return "char";
+        case AttributeType::UInt8:
+            return "uchar";
+        case AttributeType::Int16:
+            return "short";
+        case AttributeType::UInt16:
+            return "ushort";
+        case AttributeType::Int32:
+            return "int";
+        case AttributeType::UInt32:
+            return "uint";
+        case AttributeType::Float32:
+            return "float";
+        default:
+            return "double";  // PLY has no 64-bit integers: stored as double
     }
 }
 
@@ -135,7 +143,7 @@ Header parse_header(const std::string& data, const std::string& name) {
 class BinaryCursor {
 public:
     BinaryCursor(const std::string& data, std::size_t offset, bool big_endian, const std::string& name)
-        : data_(data), pos_(offset), swap_(big_endian != (std::endian::native == std::endian::big)), name_(name) {}
+            : data_(data), pos_(offset), swap_(big_endian != (std::endian::native == std::endian::big)), name_(name) {}
 
     double read(AttributeType type) {
         const std::size_t size = attribute_type_size(type);
@@ -146,14 +154,22 @@ public:
         if (swap_)
             for (std::size_t i = 0; i < size / 2; ++i) std::swap(bytes[i], bytes[size - 1 - i]);
         switch (type) {
-            case AttributeType::Int8: return as<std::int8_t>(bytes);
-            case AttributeType::UInt8: return as<std::uint8_t>(bytes);
-            case AttributeType::Int16: return as<std::int16_t>(bytes);
-            case AttributeType::UInt16: return as<std::uint16_t>(bytes);
-            case AttributeType::Int32: return as<std::int32_t>(bytes);
-            case AttributeType::UInt32: return as<std::uint32_t>(bytes);
-            case AttributeType::Float32: return as<float>(bytes);
-            default: return as<double>(bytes);
+            case AttributeType::Int8:
+                return as<std::int8_t>(bytes);
+            case AttributeType::UInt8:
+                return as<std::uint8_t>(bytes);
+            case AttributeType::Int16:
+                return as<std::int16_t>(bytes);
+            case AttributeType::UInt16:
+                return as<std::uint16_t>(bytes);
+            case AttributeType::Int32:
+                return as<std::int32_t>(bytes);
+            case AttributeType::UInt32:
+                return as<std::uint32_t>(bytes);
+            case AttributeType::Float32:
+                return as<float>(bytes);
+            default:
+                return as<double>(bytes);
         }
     }
     std::size_t remaining() const { return data_.size() - std::min(pos_, data_.size()); }
@@ -173,8 +189,7 @@ private:
 
 class AsciiCursor {
 public:
-    AsciiCursor(const std::string& data, std::size_t offset, const std::string& name)
-        : data_(data), pos_(offset), name_(name) {}
+    AsciiCursor(const std::string& data, std::size_t offset, const std::string& name) : data_(data), pos_(offset), name_(name) {}
 
     double read(AttributeType) {
         while (pos_ < data_.size() && std::isspace(static_cast<unsigned char>(data_[pos_]))) ++pos_;
@@ -186,10 +201,14 @@ public:
         const auto [ptr, ec] = std::from_chars(first, data_.data() + end, value);
         if (ec != std::errc() || ptr != data_.data() + end) {
             const std::string token(first, data_.data() + end);
-            if (token == "nan" || token == "-nan") value = std::nan("");
-            else if (token == "inf") value = HUGE_VAL;
-            else if (token == "-inf") value = -HUGE_VAL;
-            else throw Error::input(name_, "PLY body: '" + token + "' is not a number");
+            if (token == "nan" || token == "-nan")
+                value = std::nan("");
+            else if (token == "inf")
+                value = HUGE_VAL;
+            else if (token == "-inf")
+                value = -HUGE_VAL;
+            else
+                throw Error::input(name_, "PLY body: '" + token + "' is not a number");
         }
         pos_ = end;
         return value;
@@ -205,8 +224,7 @@ private:
 // Smallest number of bytes one item of the element can take: bounds the count a header may claim.
 std::size_t minimum_item_size(const Element& element, bool ascii) {
     std::size_t size = 0;
-    for (const auto& p : element.properties)
-        size += ascii ? 2 : attribute_type_size(p.is_list ? p.count_type : p.type);
+    for (const auto& p : element.properties) size += ascii ? 2 : attribute_type_size(p.is_list ? p.count_type : p.type);
     return size;
 }
 
@@ -224,13 +242,15 @@ void read_body(Cursor& cursor, File& file, bool ascii, const std::string& name) 
         const std::size_t item = minimum_item_size(element, ascii);
         if (item > 0 && element.count > cursor.remaining() / item + (ascii ? 1 : 0))
             throw Error::input(name, "PLY header declares " + std::to_string(element.count) + " " + element.name +
-                                         " items, more than the file can hold");
+                                             " items, more than the file can hold");
         if (item == 0 && element.count > 0) throw Error::input(name, "PLY element '" + element.name + "' has no properties");
         check_memory_estimate(element.count * held_item_size(element), name,
                               "the header's " + std::to_string(element.count) + " " + element.name + " items");
         for (auto& p : element.properties) {
-            if (p.is_list) p.lists.resize(element.count);
-            else p.values.resize(element.count);
+            if (p.is_list)
+                p.lists.resize(element.count);
+            else
+                p.values.resize(element.count);
         }
         for (std::size_t i = 0; i < element.count; ++i) {
             for (auto& p : element.properties) {
@@ -257,22 +277,40 @@ void put(std::ostream& out, double value) {
 
 void put_binary(std::ostream& out, AttributeType type, double value) {
     switch (type) {
-        case AttributeType::Int8: put<std::int8_t>(out, value); break;
-        case AttributeType::UInt8: put<std::uint8_t>(out, value); break;
-        case AttributeType::Int16: put<std::int16_t>(out, value); break;
-        case AttributeType::UInt16: put<std::uint16_t>(out, value); break;
-        case AttributeType::Int32: put<std::int32_t>(out, value); break;
-        case AttributeType::UInt32: put<std::uint32_t>(out, value); break;
-        case AttributeType::Float32: put<float>(out, value); break;
-        default: put<double>(out, value); break;
+        case AttributeType::Int8:
+            put<std::int8_t>(out, value);
+            break;
+        case AttributeType::UInt8:
+            put<std::uint8_t>(out, value);
+            break;
+        case AttributeType::Int16:
+            put<std::int16_t>(out, value);
+            break;
+        case AttributeType::UInt16:
+            put<std::uint16_t>(out, value);
+            break;
+        case AttributeType::Int32:
+            put<std::int32_t>(out, value);
+            break;
+        case AttributeType::UInt32:
+            put<std::uint32_t>(out, value);
+            break;
+        case AttributeType::Float32:
+            put<float>(out, value);
+            break;
+        default:
+            put<double>(out, value);
+            break;
     }
 }
 
 void put_ascii(std::ostream& out, AttributeType type, double value) {
     char buffer[40];
     std::to_chars_result r;
-    if (type == AttributeType::Float32) r = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(value));
-    else r = std::to_chars(buffer, buffer + sizeof buffer, value);
+    if (type == AttributeType::Float32)
+        r = std::to_chars(buffer, buffer + sizeof buffer, static_cast<float>(value));
+    else
+        r = std::to_chars(buffer, buffer + sizeof buffer, value);
     out.write(buffer, r.ptr - buffer);
 }
 
@@ -293,8 +331,7 @@ File read(const fs::path& path) {
 }
 
 void write(const File& file, const fs::path& path) {
-    if (file.format == "binary_big_endian")
-        throw Error(ExitCode::Internal, "PLY writer: big-endian output is not supported");
+    if (file.format == "binary_big_endian") throw Error(ExitCode::Internal, "PLY writer: big-endian output is not supported");
     const bool ascii = file.format == "ascii";
     write_atomically(path, [&](std::ostream& out) {
         out << "ply\nformat " << (ascii ? "ascii" : "binary_little_endian") << " 1.0\n";

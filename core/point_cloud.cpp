@@ -8,16 +8,26 @@ namespace treelobes {
 
 const char* attribute_type_name(AttributeType type) {
     switch (type) {
-        case AttributeType::UInt8: return "uint8";
-        case AttributeType::Int8: return "int8";
-        case AttributeType::UInt16: return "uint16";
-        case AttributeType::Int16: return "int16";
-        case AttributeType::UInt32: return "uint32";
-        case AttributeType::Int32: return "int32";
-        case AttributeType::UInt64: return "uint64";
-        case AttributeType::Int64: return "int64";
-        case AttributeType::Float32: return "float32";
-        case AttributeType::Float64: return "float64";
+        case AttributeType::UInt8:
+            return "uint8";
+        case AttributeType::Int8:
+            return "int8";
+        case AttributeType::UInt16:
+            return "uint16";
+        case AttributeType::Int16:
+            return "int16";
+        case AttributeType::UInt32:
+            return "uint32";
+        case AttributeType::Int32:
+            return "int32";
+        case AttributeType::UInt64:
+            return "uint64";
+        case AttributeType::Int64:
+            return "int64";
+        case AttributeType::Float32:
+            return "float32";
+        case AttributeType::Float64:
+            return "float64";
     }
     return "unknown";
 }
@@ -25,15 +35,19 @@ const char* attribute_type_name(AttributeType type) {
 std::size_t attribute_type_size(AttributeType type) {
     switch (type) {
         case AttributeType::UInt8:
-        case AttributeType::Int8: return 1;
+        case AttributeType::Int8:
+            return 1;
         case AttributeType::UInt16:
-        case AttributeType::Int16: return 2;
+        case AttributeType::Int16:
+            return 2;
         case AttributeType::UInt32:
         case AttributeType::Int32:
-        case AttributeType::Float32: return 4;
+        case AttributeType::Float32:
+            return 4;
         case AttributeType::UInt64:
         case AttributeType::Int64:
-        case AttributeType::Float64: return 8;
+        case AttributeType::Float64:
+            return 8;
     }
     return 0;
 }
@@ -127,8 +141,8 @@ void PointCloud::check_consistent(const std::string& context) const {
     const std::size_t n = size();
     auto check = [&](std::size_t count, const std::string& name) {
         if (count != 0 && count != n)
-            throw Error::input(context, "attribute '" + name + "' has " + std::to_string(count) +
-                                            " values for " + std::to_string(n) + " points");
+            throw Error::input(context,
+                               "attribute '" + name + "' has " + std::to_string(count) + " values for " + std::to_string(n) + " points");
     };
     check(intensity.size(), "intensity");
     check(return_number.size(), "return_number");
@@ -138,9 +152,8 @@ void PointCloud::check_consistent(const std::string& context) const {
     check(gps_time.size(), "gps_time");
     for (const auto& attribute : extras)  // extras are never optional per point
         if (attribute.values.size() != n)
-            throw Error::input(context, "attribute '" + attribute.name + "' has " +
-                                            std::to_string(attribute.values.size()) + " values for " +
-                                            std::to_string(n) + " points");
+            throw Error::input(context, "attribute '" + attribute.name + "' has " + std::to_string(attribute.values.size()) +
+                                                " values for " + std::to_string(n) + " points");
 }
 
 }  // namespace treelobes

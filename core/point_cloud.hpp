@@ -24,9 +24,9 @@ std::size_t attribute_type_size(AttributeType type);
 struct ExtraAttribute {
     std::string name;
     AttributeType type = AttributeType::Float64;
-    std::string description;             // LAS extra-bytes description (< 32 bytes)
-    std::optional<double> no_data;       // LAS extra-bytes no-data value, if declared
-    std::vector<double> values;          // one per point
+    std::string description;        // LAS extra-bytes description (< 32 bytes)
+    std::optional<double> no_data;  // LAS extra-bytes no-data value, if declared
+    std::vector<double> values;     // one per point
 };
 
 // One LAS variable-length record kept verbatim so it can be written back unchanged
@@ -49,31 +49,31 @@ struct Georeference {
 // What a reader learned about the file it read (for `treelobes info` and for writers
 // that want to keep the input's format choices).
 struct SourceFormat {
-    std::string format;                 // "las", "ply", "pcd", "xyz", ...
-    std::string version;                // "1.2" for LAS, "ascii"/"binary_little_endian" for PLY
-    int las_point_format = -1;          // 0..10 for LAS input
+    std::string format;         // "las", "ply", "pcd", "xyz", ...
+    std::string version;        // "1.2" for LAS, "ascii"/"binary_little_endian" for PLY
+    int las_point_format = -1;  // 0..10 for LAS input
     Eigen::Vector3d las_scale{0.001, 0.001, 0.001};
     Eigen::Vector3d las_offset{0, 0, 0};
-    std::size_t dropped_non_finite = 0; // points dropped because a coordinate was NaN/inf
+    std::size_t dropped_non_finite = 0;  // points dropped because a coordinate was NaN/inf
     // LAZ input (format stays "las": the points are LAS records once decoded).
     bool laz = false;
-    std::uint32_t laz_chunk_size = 0;   // points per chunk; 0xFFFFFFFF = variable-size chunks
+    std::uint32_t laz_chunk_size = 0;  // points per chunk; 0xFFFFFFFF = variable-size chunks
     std::size_t laz_chunks = 0;
     // COPC input: octree depth (levels) and nodes holding points; -1 when not COPC.
     int copc_levels = -1;
     std::size_t copc_nodes = 0;
-    std::size_t copc_nodes_read = 0;    // nodes decoded (fewer than copc_nodes under a bounds query)
+    std::size_t copc_nodes_read = 0;  // nodes decoded (fewer than copc_nodes under a bounds query)
 };
 
 struct PointCloud {
-    Eigen::Vector3d origin{0, 0, 0};             // add to a local position for the original coordinates
-    std::vector<Eigen::Vector3f> positions;      // local coordinates (metres)
+    Eigen::Vector3d origin{0, 0, 0};         // add to a local position for the original coordinates
+    std::vector<Eigen::Vector3f> positions;  // local coordinates (metres)
 
     // Optional standard attributes: empty vector = absent, otherwise one value per point.
     std::vector<std::uint16_t> intensity;
     std::vector<std::uint8_t> return_number;
     std::vector<std::uint8_t> number_of_returns;
-    std::vector<std::uint8_t> classification;    // ASPRS codes: 2 = ground
+    std::vector<std::uint8_t> classification;  // ASPRS codes: 2 = ground
     std::vector<std::array<std::uint16_t, 3>> rgb;
     std::vector<double> gps_time;
     std::vector<ExtraAttribute> extras;

@@ -19,8 +19,9 @@ namespace treelobes {
 
 namespace {
 
-constexpr std::array<const char*, 14> kCsvColumns = {"ID",     "parentID", "startX", "startY",      "startZ",    "endX",      "endY",
-                                                     "endZ",   "radius",   "length", "branchOrder", "branchID", "segmentID", "parentSegmentID"};
+constexpr std::array<const char*, 14> kCsvColumns = {"ID",          "parentID", "startX",    "startY",         "startZ",
+                                                     "endX",        "endY",     "endZ",      "radius",         "length",
+                                                     "branchOrder", "branchID", "segmentID", "parentSegmentID"};
 
 bool is_separator(char c) { return std::isspace(static_cast<unsigned char>(c)) || c == ',' || c == ';'; }
 
@@ -53,7 +54,8 @@ std::vector<std::string> split_header(const std::string& line) {
         if (is_separator(c) || c == '"') {
             if (!name.empty()) names.push_back(name);
             name.clear();
-        } else name += c;
+        } else
+            name += c;
     }
     if (!name.empty()) names.push_back(name);
     return names;
@@ -101,7 +103,7 @@ QsmModel read_treeqsm(std::istream& in, const std::string& name) {
         }
         if (values.size() != columns)
             throw Error::input(name, line_error(line_number, "expected " + std::to_string(columns) + " columns, found " +
-                                                                 std::to_string(values.size())));
+                                                                     std::to_string(values.size())));
         model.cylinders.push_back(cylinder_from_treeqsm_row(values, name, line_number));
     }
     return model;
@@ -132,7 +134,7 @@ QsmModel read_csv(std::istream& in, const std::string& name) {
         if (!parse_numbers(line, values)) throw Error::input(name, line_error(line_number, "expected numbers"));
         if (values.size() < column.size())
             throw Error::input(name, line_error(line_number, "expected " + std::to_string(column.size()) + " columns, found " +
-                                                                 std::to_string(values.size())));
+                                                                     std::to_string(values.size())));
         QsmCylinder cyl;
         cyl.start = {at(values, "startX"), at(values, "startY"), at(values, "startZ")};
         const Eigen::Vector3d end(at(values, "endX"), at(values, "endY"), at(values, "endZ"));
@@ -269,7 +271,8 @@ QsmModel read_qsm(const fs::path& path) {
     const std::string name = path.string();
     const QsmFileKind kind = detect_qsm_file(path);
     std::istringstream in(read_file(path));
-    if (kind == QsmFileKind::None) throw Error::input(name, "not a QSM: expected a TreeQSM cylinder table or a SimpleForest/rTwig CSV header");
+    if (kind == QsmFileKind::None)
+        throw Error::input(name, "not a QSM: expected a TreeQSM cylinder table or a SimpleForest/rTwig CSV header");
     QsmModel model = kind == QsmFileKind::Csv ? read_csv(in, name) : read_treeqsm(in, name);
     if (model.cylinders.empty()) throw Error::input(name, "QSM has no cylinders");
     model.validate(name);

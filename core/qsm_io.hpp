@@ -33,13 +33,13 @@ struct QsmCylinder {
     int extension = -1;             // 0-based index of the cylinder continuing this one, -1 for none
     bool added = false;             // TreeQSM: filled in, not fitted
     double unmodified_radius = 0;
-    int branch = 0;                 // 0-based branch (axis) index
-    int branch_order = 0;           // 0 on the trunk
-    int position_in_branch = 0;     // 0-based position along the branch
-    int segment = 0;                // 0-based segment (run between forks): CSV only, derived otherwise
+    int branch = 0;              // 0-based branch (axis) index
+    int branch_order = 0;        // 0 on the trunk
+    int position_in_branch = 0;  // 0-based position along the branch
+    int segment = 0;             // 0-based segment (run between forks): CSV only, derived otherwise
 
     Eigen::Vector3d end() const { return start + axis * length; }
-    double volume() const;          // pi r^2 l, cubic metres
+    double volume() const;  // pi r^2 l, cubic metres
 };
 
 struct QsmModel {

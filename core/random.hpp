@@ -19,7 +19,9 @@ inline std::uint64_t splitmix64(std::uint64_t x) {
 
 // Seed of an independent stream, e.g. stream_seed(tree_seed, pulse_index): parallel loops draw
 // from per-item streams so the result does not depend on the thread schedule.
-inline std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t key) { return splitmix64(seed ^ splitmix64(key + 0x632be59bd9b4e019ULL)); }
+inline std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t key) {
+    return splitmix64(seed ^ splitmix64(key + 0x632be59bd9b4e019ULL));
+}
 
 // xoshiro256** (Blackman & Vigna 2018).
 class Rng {

@@ -53,8 +53,8 @@ TreeGraph read_skeleton_ply(const fs::path& path, std::vector<std::string>* comm
     const ply::Element* edges = file.find("edge");
     const std::size_t n = vertex->count;
     if ((!edges ? 0 : edges->count) != n - 1)
-        throw Error::input(name, "a tree with " + std::to_string(n) + " vertices needs " + std::to_string(n - 1) +
-                                     " edges, found " + std::to_string(edges ? edges->count : 0));
+        throw Error::input(name, "a tree with " + std::to_string(n) + " vertices needs " + std::to_string(n - 1) + " edges, found " +
+                                         std::to_string(edges ? edges->count : 0));
     const auto adjacency = edges ? adjacency_from_edges(*edges, n, name) : std::vector<std::vector<int>>(n);
 
     // Breadth-first from vertex 0, renumbering nothing: node i of the graph is vertex i.
@@ -69,7 +69,8 @@ TreeGraph read_skeleton_ply(const fs::path& path, std::vector<std::string>* comm
         queue.pop_front();
         for (int v : adjacency[u]) {
             if (seen[v]) {
-                if (tree.nodes[u].parent != v) throw Error::input(name, "skeleton edges contain a cycle (at vertex " + std::to_string(v) + ")");
+                if (tree.nodes[u].parent != v)
+                    throw Error::input(name, "skeleton edges contain a cycle (at vertex " + std::to_string(v) + ")");
                 continue;
             }
             seen[v] = true;
@@ -79,9 +80,10 @@ TreeGraph read_skeleton_ply(const fs::path& path, std::vector<std::string>* comm
         }
     }
     for (std::size_t i = 0; i < n; ++i) {
-        if (!seen[i]) throw Error::input(name, "skeleton is not connected: vertex " + std::to_string(i) + " is not reachable from vertex 0");
-        tree.nodes[i].position = Eigen::Vector3f(static_cast<float>(x->values[i]), static_cast<float>(y->values[i]),
-                                                 static_cast<float>(z->values[i]));
+        if (!seen[i])
+            throw Error::input(name, "skeleton is not connected: vertex " + std::to_string(i) + " is not reachable from vertex 0");
+        tree.nodes[i].position =
+                Eigen::Vector3f(static_cast<float>(x->values[i]), static_cast<float>(y->values[i]), static_cast<float>(z->values[i]));
         tree.nodes[i].radius = radius ? static_cast<float>(radius->values[i]) : 0.0f;
     }
     tree.validate(name);

@@ -115,12 +115,18 @@ Layout layout_from_header(const Fields& header) {
         std::string name = lower(header[i]);
         while (!name.empty() && (name.front() == '/' || name.front() == '#')) name.erase(name.begin());
         Column column = Column::Extra;
-        if (i < 3) column = static_cast<Column>(i);  // x y z always first, whatever they are called
-        else if (name == "intensity" || name == "scalar_intensity") column = Column::Intensity;
-        else if (name == "classification" || name == "scalar_classification") column = Column::Classification;
-        else if (name == "r" || name == "red") column = Column::Red;
-        else if (name == "g" || name == "green") column = Column::Green;
-        else if (name == "b" || name == "blue") column = Column::Blue;
+        if (i < 3)
+            column = static_cast<Column>(i);  // x y z always first, whatever they are called
+        else if (name == "intensity" || name == "scalar_intensity")
+            column = Column::Intensity;
+        else if (name == "classification" || name == "scalar_classification")
+            column = Column::Classification;
+        else if (name == "r" || name == "red")
+            column = Column::Red;
+        else if (name == "g" || name == "green")
+            column = Column::Green;
+        else if (name == "b" || name == "blue")
+            column = Column::Blue;
         layout.columns.push_back(column);
         layout.names.push_back(std::string(header[i]));
     }
@@ -162,7 +168,8 @@ void store_attributes(const Layout& layout, Columns& c, PointCloud& cloud) {
     if (!c.intensity.empty()) cloud.intensity = to_u16(c.intensity);
     if (!c.classification.empty()) {
         cloud.classification.resize(c.classification.size());
-        for (std::size_t i = 0; i < c.classification.size(); ++i) cloud.classification[i] = attribute_value<std::uint8_t>(c.classification[i]);
+        for (std::size_t i = 0; i < c.classification.size(); ++i)
+            cloud.classification[i] = attribute_value<std::uint8_t>(c.classification[i]);
     }
     if (!c.red.empty() && c.red.size() == c.green.size() && c.red.size() == c.blue.size()) {
         const auto r = to_u16(c.red), g = to_u16(c.green), b = to_u16(c.blue);
@@ -216,11 +223,12 @@ PointCloud read_text_cloud(const fs::path& path) {
         split(line, separator, fields);
         if (fields.size() < 3)
             throw Error::input(name, "line " + std::to_string(lines.number()) + ": expected at least 3 numbers (x y z), found " +
-                                         std::to_string(fields.size()) + " field(s)");
+                                             std::to_string(fields.size()) + " field(s)");
         double values[3];
         for (int k = 0; k < 3; ++k) {
             const auto v = parse_number(fields[k]);
-            if (!v) throw Error::input(name, "line " + std::to_string(lines.number()) + ": '" + std::string(fields[k]) + "' is not a number");
+            if (!v)
+                throw Error::input(name, "line " + std::to_string(lines.number()) + ": '" + std::string(fields[k]) + "' is not a number");
             values[k] = *v;
         }
         if (!std::isfinite(values[0]) || !std::isfinite(values[1]) || !std::isfinite(values[2])) {
@@ -241,17 +249,29 @@ PointCloud read_text_cloud(const fs::path& path) {
             if (i < fields.size()) {
                 const auto parsed = parse_number(fields[i]);
                 if (!parsed)
-                    throw Error::input(name, "line " + std::to_string(lines.number()) + ", column " + std::to_string(i + 1) +
-                                                 ": '" + std::string(fields[i]) + "' is not a number");
+                    throw Error::input(name, "line " + std::to_string(lines.number()) + ", column " + std::to_string(i + 1) + ": '" +
+                                                     std::string(fields[i]) + "' is not a number");
                 v = *parsed;
             }
             switch (layout->columns[i]) {
-                case Column::Intensity: columns.intensity.push_back(v); break;
-                case Column::Classification: columns.classification.push_back(v); break;
-                case Column::Red: columns.red.push_back(v); break;
-                case Column::Green: columns.green.push_back(v); break;
-                case Column::Blue: columns.blue.push_back(v); break;
-                default: columns.extras[e++].push_back(v); break;
+                case Column::Intensity:
+                    columns.intensity.push_back(v);
+                    break;
+                case Column::Classification:
+                    columns.classification.push_back(v);
+                    break;
+                case Column::Red:
+                    columns.red.push_back(v);
+                    break;
+                case Column::Green:
+                    columns.green.push_back(v);
+                    break;
+                case Column::Blue:
+                    columns.blue.push_back(v);
+                    break;
+                default:
+                    columns.extras[e++].push_back(v);
+                    break;
             }
         }
     }

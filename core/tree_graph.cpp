@@ -11,8 +11,8 @@ namespace treelobes {
 int TreeGraph::add_node(const Eigen::Vector3f& position, float radius, int parent) {
     const int index = static_cast<int>(nodes.size());
     if (parent < -1 || parent >= index || (parent == -1) != (index == 0))
-        throw Error(ExitCode::Internal, "TreeGraph::add_node: node " + std::to_string(index) +
-                                            " given invalid parent " + std::to_string(parent));
+        throw Error(ExitCode::Internal,
+                    "TreeGraph::add_node: node " + std::to_string(index) + " given invalid parent " + std::to_string(parent));
     TreeNode node;
     node.position = position;
     node.radius = radius;
@@ -59,8 +59,7 @@ std::vector<int> TreeGraph::branch_orders() const {
     std::vector<int> order(nodes.size(), 0);
     for (int node : preorder()) {
         const auto& children = nodes[node].children;
-        for (std::size_t k = 0; k < children.size(); ++k)
-            order[children[k]] = order[node] + (k == 0 ? 0 : 1);
+        for (std::size_t k = 0; k < children.size(); ++k) order[children[k]] = order[node] + (k == 0 ? 0 : 1);
     }
     return order;
 }
@@ -72,8 +71,7 @@ float TreeGraph::total_length() const {
 }
 
 std::size_t TreeGraph::tip_count() const {
-    return static_cast<std::size_t>(
-        std::count_if(nodes.begin(), nodes.end(), [](const TreeNode& n) { return n.children.empty(); }));
+    return static_cast<std::size_t>(std::count_if(nodes.begin(), nodes.end(), [](const TreeNode& n) { return n.children.empty(); }));
 }
 
 void TreeGraph::order_children_by_subtree_length() {
@@ -82,8 +80,7 @@ void TreeGraph::order_children_by_subtree_length() {
         auto& node = nodes[i];
         if (node.children.size() < 2) continue;
         // Direction of the incoming edge; the root continues straight up.
-        Eigen::Vector3f incoming = node.parent >= 0 ? (node.position - nodes[node.parent].position)
-                                                    : Eigen::Vector3f(0, 0, 1);
+        Eigen::Vector3f incoming = node.parent >= 0 ? (node.position - nodes[node.parent].position) : Eigen::Vector3f(0, 0, 1);
         if (incoming.norm() > 0) incoming.normalize();
         auto turn = [&](int child) {
             Eigen::Vector3f d = nodes[child].position - node.position;
@@ -112,14 +109,13 @@ void TreeGraph::validate(const std::string& context) const {
         for (int child : node.children) {
             if (child <= 0 || child >= static_cast<int>(nodes.size()) || nodes[child].parent != static_cast<int>(i))
                 throw Error::input(context, "node " + std::to_string(i) + " lists child " + std::to_string(child) +
-                                                " whose parent is not " + std::to_string(i));
+                                                    " whose parent is not " + std::to_string(i));
             ++seen[child];
         }
     }
     for (std::size_t i = 1; i < nodes.size(); ++i)
         if (seen[i] != 1) throw Error::input(context, "node " + std::to_string(i) + " is not listed exactly once as a child");
-    if (preorder().size() != nodes.size())
-        throw Error::input(context, "the tree contains a cycle or nodes unreachable from the root");
+    if (preorder().size() != nodes.size()) throw Error::input(context, "the tree contains a cycle or nodes unreachable from the root");
 }
 
 TreeGraph keep_nodes(const TreeGraph& tree, const std::vector<bool>& keep, std::vector<int>& new_index) {
@@ -129,8 +125,10 @@ TreeGraph keep_nodes(const TreeGraph& tree, const std::vector<bool>& keep, std::
     new_index.assign(tree.size(), -1);
     for (int u : tree.preorder()) {
         const int parent = tree.nodes[u].parent;
-        if (keep[u]) new_index[u] = out.add_node(tree.nodes[u].position, tree.nodes[u].radius, parent < 0 ? -1 : new_index[parent]);
-        else new_index[u] = new_index[parent];
+        if (keep[u])
+            new_index[u] = out.add_node(tree.nodes[u].position, tree.nodes[u].radius, parent < 0 ? -1 : new_index[parent]);
+        else
+            new_index[u] = new_index[parent];
     }
     return out;
 }

@@ -15,8 +15,7 @@ void TriangleMesh::append(const TriangleMesh& other) {
 double TriangleMesh::signed_volume() const {
     double volume = 0.0;
     for (const auto& f : faces) {
-        const Eigen::Vector3d a = vertices[f[0]].cast<double>(), b = vertices[f[1]].cast<double>(),
-                              c = vertices[f[2]].cast<double>();
+        const Eigen::Vector3d a = vertices[f[0]].cast<double>(), b = vertices[f[1]].cast<double>(), c = vertices[f[2]].cast<double>();
         volume += a.dot(b.cross(c)) / 6.0;
     }
     return volume;
@@ -25,8 +24,7 @@ double TriangleMesh::signed_volume() const {
 double TriangleMesh::area() const {
     double sum = 0.0;
     for (const auto& f : faces) {
-        const Eigen::Vector3d a = vertices[f[0]].cast<double>(), b = vertices[f[1]].cast<double>(),
-                              c = vertices[f[2]].cast<double>();
+        const Eigen::Vector3d a = vertices[f[0]].cast<double>(), b = vertices[f[1]].cast<double>(), c = vertices[f[2]].cast<double>();
         sum += 0.5 * (b - a).cross(c - a).norm();
     }
     return sum;

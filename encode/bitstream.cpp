@@ -20,14 +20,13 @@ void BitWriter::write(std::uint64_t value, unsigned count) {
     }
 }
 
-BitReader::BitReader(std::span<const std::uint8_t> bytes, std::string context)
-    : bytes_(bytes), context_(std::move(context)) {}
+BitReader::BitReader(std::span<const std::uint8_t> bytes, std::string context) : bytes_(bytes), context_(std::move(context)) {}
 
 void BitReader::fail(const std::string& what) const { throw Error::input(context_, what); }
 
 std::uint64_t BitReader::read(unsigned count) {
-    if (count > bits_left()) fail("truncated stream (needs " + std::to_string(count) + " more bits at bit " +
-                                  std::to_string(position_) + ")");
+    if (count > bits_left())
+        fail("truncated stream (needs " + std::to_string(count) + " more bits at bit " + std::to_string(position_) + ")");
     std::uint64_t value = 0;
     while (count > 0) {
         const unsigned used = static_cast<unsigned>(position_ % 8);
@@ -89,9 +88,9 @@ namespace {
 constexpr std::uint64_t kMaxRange = std::uint64_t{1} << 62;
 
 struct MinimalBinaryShape {
-    unsigned long_bits;   // b = ceil(log2 n)
+    unsigned long_bits;         // b = ceil(log2 n)
     std::uint64_t short_count;  // 2^b - n values coded with b - 1 bits
-    std::uint64_t start;  // first value of the centred short block
+    std::uint64_t start;        // first value of the centred short block
 };
 
 MinimalBinaryShape shape_of(std::uint64_t n) {

@@ -10,8 +10,8 @@ namespace treelobes::encode {
 namespace {
 
 // One counting-sort pass: orders `items` stably by key[item] (keys < key_count).
-void counting_sort(const std::vector<std::uint32_t>& items, const std::vector<std::uint32_t>& key,
-                   std::size_t key_count, std::vector<std::uint32_t>& out) {
+void counting_sort(const std::vector<std::uint32_t>& items, const std::vector<std::uint32_t>& key, std::size_t key_count,
+                   std::vector<std::uint32_t>& out) {
     std::vector<std::uint32_t> start(key_count + 1, 0);
     for (std::uint32_t item : items) ++start[key[item] + 1];
     std::partial_sum(start.begin(), start.end(), start.begin());
@@ -69,11 +69,11 @@ BwtResult bwt_forward(std::span<const std::uint8_t> text, unsigned alphabet_size
 }
 
 // Walks the LF mapping from row 0 (the rotation "$text"), emitting the text backwards.
-std::vector<std::uint8_t> bwt_inverse(std::span<const std::uint8_t> last_column, std::size_t primary_index,
-                                      unsigned alphabet_size, const std::string& context) {
+std::vector<std::uint8_t> bwt_inverse(std::span<const std::uint8_t> last_column, std::size_t primary_index, unsigned alphabet_size,
+                                      const std::string& context) {
     const std::size_t n = last_column.size();
-    if (primary_index > n) throw Error::input(context, "BWT primary index " + std::to_string(primary_index) + " beyond the " +
-                                                           std::to_string(n) + " symbols");
+    if (primary_index > n)
+        throw Error::input(context, "BWT primary index " + std::to_string(primary_index) + " beyond the " + std::to_string(n) + " symbols");
     std::vector<std::size_t> first_row(alphabet_size + 1, 1);  // row 0 belongs to the sentinel
     std::vector<std::size_t> counts(alphabet_size, 0);
     for (std::uint8_t s : last_column) {

@@ -28,7 +28,7 @@ BwtResult bwt_forward(std::span<const std::uint8_t> text, unsigned alphabet_size
 
 // Inverts bwt_forward in O(n). Throws Error(InvalidInput) naming `context` when a symbol is not
 // below alphabet_size or the primary index does not give a single cycle through all n symbols.
-std::vector<std::uint8_t> bwt_inverse(std::span<const std::uint8_t> last_column, std::size_t primary_index,
-                                      unsigned alphabet_size, const std::string& context);
+std::vector<std::uint8_t> bwt_inverse(std::span<const std::uint8_t> last_column, std::size_t primary_index, unsigned alphabet_size,
+                                      const std::string& context);
 
 }  // namespace treelobes::encode

@@ -86,8 +86,7 @@ std::vector<int> parse_radius_list(const std::string& text, const std::string& c
         int radius = 0;
         const auto [end, error] = std::from_chars(value.data(), value.data() + value.size(), radius);
         if (value.empty() || error != std::errc() || end != value.data() + value.size() || radius < 0)
-            throw Error::input(context, "value " + std::to_string(radii.size() + 1) + " ('" + value +
-                                            "') is not a non-negative integer");
+            throw Error::input(context, "value " + std::to_string(radii.size() + 1) + " ('" + value + "') is not a non-negative integer");
         radii.push_back(radius);
     }
     if (!text.empty() && text.back() == ',') throw Error::input(context, "trailing comma after the last radius");
@@ -104,22 +103,21 @@ std::size_t check_symbols(const std::string& symbols, const std::string& context
         if (is_move(symbol)) continue;
         if (!is_terminator(symbol))
             throw Error::input(context, std::string("unknown chain code symbol '") + symbol + "' " + at_character(i) +
-                                            " (expected 0-5 for moves, 6 fork, 7 tip, 8 end of internode)");
+                                                " (expected 0-5 for moves, 6 fork, 7 tip, 8 end of internode)");
         ++internodes;
         if (symbol == kFork) ++queued_forks;
         if (symbol != kTip || i + 1 == symbols.size()) continue;
         // A 7 inside the code returns to the next queued lateral; there has to be one.
         if (queued_forks == 0)
-            throw Error::input(context, "tip symbol 7 " + at_character(i) +
-                                            " ends the last open branch but the code goes on (a fork 6 is missing)");
+            throw Error::input(context,
+                               "tip symbol 7 " + at_character(i) + " ends the last open branch but the code goes on (a fork 6 is missing)");
         --queued_forks;
     }
     const std::size_t last = symbols.size() - 1;
-    if (symbols[last] != kTip)
-        throw Error::input(context, "chain code ends " + at_character(last) + " without the final branch tip 7");
+    if (symbols[last] != kTip) throw Error::input(context, "chain code ends " + at_character(last) + " without the final branch tip 7");
     if (queued_forks > 0)
         throw Error::input(context, std::to_string(queued_forks) +
-                                        " fork(s) 6 without a lateral branch: the code ends before every queued lateral was coded");
+                                            " fork(s) 6 without a lateral branch: the code ends before every queued lateral was coded");
     return internodes;
 }
 
@@ -127,8 +125,8 @@ std::vector<Internode> read_internodes(const ChainCode& code, const std::string&
     const std::size_t count = check_symbols(code.symbols, context);
     if (code.radii.size() != count)
         throw Error::input(context, "radius list has " + std::to_string(code.radii.size()) + " values but the " +
-                                        code_kind_name(code.kind) + " code has " + std::to_string(count) +
-                                        " internodes (one radius per 6, 7 or 8)");
+                                            code_kind_name(code.kind) + " code has " + std::to_string(count) +
+                                            " internodes (one radius per 6, 7 or 8)");
     std::vector<Internode> internodes;
     internodes.reserve(count);
     Voxel delta = Voxel::Zero();
@@ -146,8 +144,8 @@ std::vector<Internode> read_internodes(const ChainCode& code, const std::string&
         internode.terminator = symbol;
         internode.radius = code.radii[internodes.size()];
         if (internode.radius < 0)
-            throw Error::input(context, "radius " + std::to_string(internodes.size() + 1) + " is negative (" +
-                                            std::to_string(internode.radius) + ")");
+            throw Error::input(
+                    context, "radius " + std::to_string(internodes.size() + 1) + " is negative (" + std::to_string(internode.radius) + ")");
         if (!within_range(internode.move))
             throw Error::input(context, "internode ending " + at_character(i) + " moves more than 2^40 voxels (corrupt code)");
         internodes.push_back(internode);

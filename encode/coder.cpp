@@ -21,14 +21,13 @@ void check_code_for_coding(const ChainCode& code, const std::string& context) {
     for (std::size_t i = 0; i < code.symbols.size(); ++i) {
         const char c = code.symbols[i];
         if (c < '0' || c > '8')
-            throw Error::input(context, std::string("chain code symbol '") + c + "' at character " + std::to_string(i + 1) +
-                                            " is not 0-8");
+            throw Error::input(context, std::string("chain code symbol '") + c + "' at character " + std::to_string(i + 1) + " is not 0-8");
         if (c >= '6') ++internodes;
     }
     if (code.symbols.size() > kMaxCodeSymbols) throw Error::input(context, "chain code too long to store");
     if (internodes != code.radii.size())
         throw Error::input(context, "the radius list has " + std::to_string(code.radii.size()) + " values for " +
-                                        std::to_string(internodes) + " internodes");
+                                            std::to_string(internodes) + " internodes");
 }
 
 CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::string& context, const BestPrior* prior) {
@@ -37,8 +36,8 @@ CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::strin
     return {best_encode_symbols(code.symbols, prior), best_encode_radii(code.symbols, code.radii, prior)};
 }
 
-ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
-                         CodeKind kind, const std::string& context, const BestPrior* prior) {
+ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder, CodeKind kind,
+                         const std::string& context, const BestPrior* prior) {
     ChainCode code;
     code.kind = kind;
     if (coder == Coder::Interpolative) {
@@ -53,11 +52,11 @@ ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const 
     return code;
 }
 
-InternodeVectors decode_stream_internodes(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii,
-                                          Coder coder, CodeKind kind, const std::string& context, const BestPrior* prior) {
+InternodeVectors decode_stream_internodes(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
+                                          CodeKind kind, const std::string& context, const BestPrior* prior) {
     InternodeVectors code = coder == Coder::Best
-                                ? best_decode_internodes(symbols, radii, context + " (symbols)", context + " (radii)", prior)
-                                : internode_vectors(decode_streams(symbols, radii, coder, kind, context, prior), context);
+                                    ? best_decode_internodes(symbols, radii, context + " (symbols)", context + " (radii)", prior)
+                                    : internode_vectors(decode_streams(symbols, radii, coder, kind, context, prior), context);
     code.kind = kind;
     return code;
 }

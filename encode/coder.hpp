@@ -42,12 +42,11 @@ CodedStreams encode_streams(const ChainCode& code, Coder coder, const std::strin
                             const BestPrior* prior = nullptr);
 // Inverse of encode_streams; `kind` is carried by the container. Throws Error(InvalidInput)
 // naming `context` for any corrupt or truncated stream.
-ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
-                         CodeKind kind, const std::string& context = "chain code", const BestPrior* prior = nullptr);
+ChainCode decode_streams(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder, CodeKind kind,
+                         const std::string& context = "chain code", const BestPrior* prior = nullptr);
 
 // decode_streams in internode form (chain_code.hpp), for decoders that build skeletons.
-InternodeVectors decode_stream_internodes(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii,
-                                          Coder coder, CodeKind kind, const std::string& context = "chain code",
-                                          const BestPrior* prior = nullptr);
+InternodeVectors decode_stream_internodes(std::span<const std::uint8_t> symbols, std::span<const std::uint8_t> radii, Coder coder,
+                                          CodeKind kind, const std::string& context = "chain code", const BestPrior* prior = nullptr);
 
 }  // namespace treelobes::encode

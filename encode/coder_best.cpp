@@ -117,13 +117,13 @@ struct SymbolModels {
 // decoder) and provides the contexts of the next internode.
 class ChainWalker {
 public:
-    bool start = true;                 // the next internode begins a branch: its vector is a full Δv
-    Voxel chain_direction = Voxel::Zero();  // Δv of the previous internode of the branch
-    Voxel parent_direction = Voxel::Zero(); // at a start: Δv of the internode that forked it off
+    bool start = true;                       // the next internode begins a branch: its vector is a full Δv
+    Voxel chain_direction = Voxel::Zero();   // Δv of the previous internode of the branch
+    Voxel parent_direction = Voxel::Zero();  // at a start: Δv of the internode that forked it off
     int since_start = 0;
-    int since_fork = 0;                // internodes since the branch's last fork (or its start)
-    int order = 0;                     // branch order (0 trunk)
-    unsigned recent_corrections = 0;   // were the last two corrections non-zero (2 bits)
+    int since_fork = 0;                     // internodes since the branch's last fork (or its start)
+    int order = 0;                          // branch order (0 trunk)
+    unsigned recent_corrections = 0;        // were the last two corrections non-zero (2 bits)
     std::array<int, 3> last_sign{0, 0, 0};  // sign of the last non-zero correction per axis
 
     // `vector` is what the symbols code: Δv at a start, else the correction.
@@ -181,8 +181,8 @@ template <class IO>
         for (int a = 0; a < 3; ++a) {
             const int parent = static_cast<int>(std::clamp<std::int64_t>(w.parent_direction[a], -3, 3)) + 3;
             const int norm = static_cast<int>(std::min<std::uint64_t>(used, kNormBuckets - 1));
-            const std::uint64_t magnitude =
-                code_uint(io, m.start_axis[(a * kParentBuckets + parent) * kNormBuckets + norm], static_cast<std::uint64_t>(std::abs(v[a])));
+            const std::uint64_t magnitude = code_uint(io, m.start_axis[(a * kParentBuckets + parent) * kNormBuckets + norm],
+                                                      static_cast<std::uint64_t>(std::abs(v[a])));
             spend(magnitude);
             const bool negative = magnitude != 0 && io.bit(m.start_sign[a * kParentBuckets + parent], v[a] < 0);
             v[a] = negative ? -static_cast<std::int64_t>(magnitude) : static_cast<std::int64_t>(magnitude);
@@ -192,15 +192,14 @@ template <class IO>
     const int since = std::min(w.since_start, 3), order = std::min(w.order, 3);
     // A branch bends where it forks: a correction right after a fork is more likely and larger.
     const int after_fork = w.since_fork == 0 ? 1 : 0;
-    if (!io.bit(m.correction_nonzero[((after_fork * 4 + w.recent_corrections) * 4 + since) * 4 + order], !v.isZero()))
-        return Voxel::Zero();
+    if (!io.bit(m.correction_nonzero[((after_fork * 4 + w.recent_corrections) * 4 + since) * 4 + order], !v.isZero())) return Voxel::Zero();
     int nonzero_axes = 0;
     for (int a = 0; a < 3; ++a) {
         const bool implied = a == 2 && nonzero_axes == 0;  // a non-zero correction needs one axis
         const int direction = static_cast<int>(std::min<std::int64_t>(std::abs(w.chain_direction[a]), 3));
-        const std::uint64_t magnitude =
-            code_uint(io, m.correction_axis[((after_fork * 3 + a) * 3 + nonzero_axes) * 4 + direction],
-                      static_cast<std::uint64_t>(std::abs(v[a])) - (IO::kEncoding && implied ? 1 : 0)) + (implied ? 1 : 0);
+        const std::uint64_t magnitude = code_uint(io, m.correction_axis[((after_fork * 3 + a) * 3 + nonzero_axes) * 4 + direction],
+                                                  static_cast<std::uint64_t>(std::abs(v[a])) - (IO::kEncoding && implied ? 1 : 0)) +
+                                        (implied ? 1 : 0);
         spend(magnitude);
         bool negative = false;
         if (magnitude != 0) {
@@ -216,8 +215,8 @@ template <class IO>
 template <class IO>
 [[gnu::always_inline]] inline char code_terminator(IO& io, SymbolModels& m, const ChainWalker& w, bool moved, char terminator) {
     // Forks come at fairly regular spacings along a branch: the distance to the last one matters.
-    const int ctx = (((int(w.start) * 4 + std::min(w.since_start, 3)) * 8 + std::min(w.since_fork, 7)) * 4 + std::min(w.order, 3)) * 2 +
-                    int(moved);
+    const int ctx =
+            (((int(w.start) * 4 + std::min(w.since_start, 3)) * 8 + std::min(w.since_fork, 7)) * 4 + std::min(w.order, 3)) * 2 + int(moved);
     if (io.bit(m.is_end_of_internode[ctx], terminator == kEndOfInternode)) return kEndOfInternode;
     return io.bit(m.is_fork[ctx], terminator == kFork) ? kFork : kTip;
 }
@@ -335,8 +334,8 @@ std::int64_t predict_radius(const Topology& t, std::span<const int> radii, std::
     const unsigned __int128 scaled = square * t.tips[i];
     // < 4 r^2 < 2^64; a 64-bit division when the product fits (always for real radii), as the
     // 128-bit one is a slow library call.
-    const auto x = (scaled >> 64) == 0 ? static_cast<std::uint64_t>(scaled) / t.tips[parent]
-                                       : static_cast<std::uint64_t>(scaled / t.tips[parent]);
+    const auto x =
+            (scaled >> 64) == 0 ? static_cast<std::uint64_t>(scaled) / t.tips[parent] : static_cast<std::uint64_t>(scaled / t.tips[parent]);
     return static_cast<std::int64_t>((isqrt(x) + 1) / 2);
 }
 
@@ -357,7 +356,8 @@ void code_radii(IO& io, const Topology& t, std::span<int> radii, RadiusPredictor
     std::vector<std::int64_t> residuals(radii.size(), 0);
     for (std::size_t i = 0; i < radii.size(); ++i) {
         const std::int64_t predicted = predict_radius(t, radii, i, predictor);
-        const int magnitude_bucket = static_cast<int>(std::min<unsigned>(bit_width64(static_cast<std::uint64_t>(std::abs(predicted))), kPredictedBuckets - 1));
+        const int magnitude_bucket =
+                static_cast<int>(std::min<unsigned>(bit_width64(static_cast<std::uint64_t>(std::abs(predicted))), kPredictedBuckets - 1));
         const std::int64_t parent_residual = t.parent[i] >= 0 ? residuals[t.parent[i]] : 0;
         const int ctx = ((int(t.start[i]) * 3 + terminator_index(t.terminator[i])) * kPredictedBuckets + magnitude_bucket) * 3 +
                         residual_bucket(parent_residual);
@@ -386,8 +386,7 @@ std::vector<std::uint8_t> encode_radii_with(const Topology& t, std::span<const i
 }
 
 // Codes the internodes of a canonical code with `models` (encoder side; also trains priors).
-void encode_canonical(Encoding& io, SymbolModels& models, const std::vector<std::pair<Voxel, char>>& internodes,
-                      std::size_t symbol_count) {
+void encode_canonical(Encoding& io, SymbolModels& models, const std::vector<std::pair<Voxel, char>>& internodes, std::size_t symbol_count) {
     ChainWalker walker;
     for (const auto& [vector, terminator] : internodes) {
         code_vector(io, models, walker, vector, symbol_count);
@@ -478,8 +477,9 @@ BestPrior BestPrior::deserialize(std::span<const std::uint8_t> bytes, const std:
     if (bytes.size() < 4) throw Error::input(context, "truncated model prior");
     std::uint32_t count = 0;
     for (int b = 0; b < 4; ++b) count |= static_cast<std::uint32_t>(bytes[static_cast<std::size_t>(b)]) << (8 * b);
-    if (count != kPriorModels) throw Error::input(context, "model prior of " + std::to_string(count) + " models (this build has " +
-                                                               std::to_string(kPriorModels) + ")");
+    if (count != kPriorModels)
+        throw Error::input(context,
+                           "model prior of " + std::to_string(count) + " models (this build has " + std::to_string(kPriorModels) + ")");
     std::vector<std::uint8_t> raw(2 * kPriorModels);
     uLongf size = static_cast<uLongf>(raw.size());
     if (uncompress(raw.data(), &size, bytes.data() + 4, static_cast<uLong>(bytes.size() - 4)) != Z_OK || size != raw.size())
@@ -650,8 +650,8 @@ namespace {
 
 // `symbols()` gives the code's symbol string, which only the `ic` fallback stream needs.
 template <class Symbols>
-std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, Symbols symbols, const Topology& topology,
-                              const std::string& context, const BestPrior* prior) {
+std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, Symbols symbols, const Topology& topology, const std::string& context,
+                              const BestPrior* prior) {
     std::vector<int> radii(topology.parent.size(), 0);
     if (radii.empty()) {
         if (!bytes.empty()) throw Error::input(context, "radii stream for a code without internodes");
@@ -671,9 +671,10 @@ std::vector<int> decode_radii(std::span<const std::uint8_t> bytes, Symbols symbo
 
 }  // namespace
 
-std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
-                                   const std::string& context, const BestPrior* prior) {
-    return decode_radii(bytes, [&]() -> const std::string& { return symbols; }, parse_topology(symbols), context, prior);
+std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols, const std::string& context,
+                                   const BestPrior* prior) {
+    return decode_radii(
+            bytes, [&]() -> const std::string& { return symbols; }, parse_topology(symbols), context, prior);
 }
 
 ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
@@ -681,14 +682,13 @@ ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span
     ChainCode code;
     std::vector<char> terminators;
     code.symbols = decode_symbols(symbol_bytes, symbols_context, prior, terminators);
-    code.radii = decode_radii(radii_bytes, [&]() -> const std::string& { return code.symbols; }, topology_of(terminators),
-                              radii_context, prior);
+    code.radii = decode_radii(
+            radii_bytes, [&]() -> const std::string& { return code.symbols; }, topology_of(terminators), radii_context, prior);
     return code;
 }
 
 InternodeVectors best_decode_internodes(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
-                                        const std::string& symbols_context, const std::string& radii_context,
-                                        const BestPrior* prior) {
+                                        const std::string& symbols_context, const std::string& radii_context, const BestPrior* prior) {
     const SymbolHeader header = read_symbol_header(symbol_bytes, symbols_context);
     if (header.mode != kCanonical)
         return internode_vectors(best_decode_code(symbol_bytes, radii_bytes, symbols_context, radii_context, prior), symbols_context);
@@ -704,8 +704,8 @@ InternodeVectors best_decode_internodes(std::span<const std::uint8_t> symbol_byt
     if (!io.rc.at_end()) throw Error::input(symbols_context, "trailing bytes after the symbol stream");
     std::string symbols;
     code.radii = decode_radii(
-        radii_bytes, [&]() -> const std::string& { return symbols = symbol_text(code); }, topology_of(code.terminators),
-        radii_context, prior);
+            radii_bytes, [&]() -> const std::string& { return symbols = symbol_text(code); }, topology_of(code.terminators), radii_context,
+            prior);
     return code;
 }
 

@@ -54,19 +54,16 @@ private:
 };
 
 std::vector<std::uint8_t> best_encode_symbols(const std::string& symbols, const BestPrior* prior = nullptr);
-std::string best_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context,
-                                const BestPrior* prior = nullptr);
+std::string best_decode_symbols(std::span<const std::uint8_t> bytes, const std::string& context, const BestPrior* prior = nullptr);
 
-std::vector<std::uint8_t> best_encode_radii(const std::string& symbols, std::span<const int> radii,
-                                            const BestPrior* prior = nullptr);
-std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
-                                   const std::string& context, const BestPrior* prior = nullptr);
+std::vector<std::uint8_t> best_encode_radii(const std::string& symbols, std::span<const int> radii, const BestPrior* prior = nullptr);
+std::vector<int> best_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols, const std::string& context,
+                                   const BestPrior* prior = nullptr);
 
 // Both streams at once, as best_decode_symbols then best_decode_radii but faster: the radii
 // decoder takes the topology from the symbol decoder instead of re-scanning the symbol string.
 ChainCode best_decode_code(std::span<const std::uint8_t> symbol_bytes, std::span<const std::uint8_t> radii_bytes,
-                           const std::string& symbols_context, const std::string& radii_context,
-                           const BestPrior* prior = nullptr);
+                           const std::string& symbols_context, const std::string& radii_context, const BestPrior* prior = nullptr);
 
 // best_decode_code in internode form (chain_code.hpp), for decoders that build skeletons: a
 // canonical symbol stream then never becomes text. Same checks and errors.

@@ -13,7 +13,7 @@ namespace treelobes::encode {
 
 namespace {
 
-constexpr unsigned kAlphabet = 9;                // symbols 0..8 (Table 1)
+constexpr unsigned kAlphabet = 9;  // symbols 0..8 (Table 1)
 constexpr std::uint64_t kMaxMtfPosition = kAlphabet - 1;
 // Radius d-gaps are differences of two ints, so shifted or zig-zagged gaps stay below 2^34.
 constexpr std::uint64_t kMaxShiftedGap = std::uint64_t{1} << 34;
@@ -148,8 +148,7 @@ std::vector<std::uint8_t> ic_encode_radii(const std::string& symbols, std::span<
     return zigzagged.size() < bytes.size() ? zigzagged : bytes;
 }
 
-std::vector<int> ic_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
-                                 const std::string& context) {
+std::vector<int> ic_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols, const std::string& context) {
     const std::size_t n = internode_count(symbols);
     std::vector<int> radii(n);
     if (n == 0) {

@@ -23,8 +23,7 @@ std::string ic_decode_symbols(std::span<const std::uint8_t> bytes, const std::st
 
 // The radii of the internodes of `symbols` (one per 6, 7 or 8).
 std::vector<std::uint8_t> ic_encode_radii(const std::string& symbols, std::span<const int> radii);
-std::vector<int> ic_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols,
-                                 const std::string& context);
+std::vector<int> ic_decode_radii(std::span<const std::uint8_t> bytes, const std::string& symbols, const std::string& context);
 
 enum class GapMap : std::uint8_t {
     Shift = 0,   // gap + shift, shift = -(most negative gap) (0 for monotone radii)
@@ -33,10 +32,10 @@ enum class GapMap : std::uint8_t {
 
 // The non-decreasing sequence Q the radii are coded as (exposed for tests and Fig. 9).
 struct RadiiSequence {
-    std::int64_t offset = 0;                 // the smallest radius, subtracted from all of them
+    std::int64_t offset = 0;  // the smallest radius, subtracted from all of them
     GapMap map = GapMap::Shift;
-    std::uint64_t shift = 0;                 // for GapMap::Shift
-    std::vector<std::uint64_t> cumulative;   // Q
+    std::uint64_t shift = 0;                // for GapMap::Shift
+    std::vector<std::uint64_t> cumulative;  // Q
 };
 RadiiSequence radii_to_sequence(const std::string& symbols, std::span<const int> radii, GapMap map);
 // The signed d-gaps of the zero-aligned, inverted branch sublists, concatenated (step 1-3).

@@ -20,8 +20,7 @@ constexpr std::size_t kMaxNameBytes = 4096;
 
 }  // namespace
 
-std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& trees, const TreeFileOptions& options,
-                                             ForestStats* stats) {
+std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& trees, const TreeFileOptions& options, ForestStats* stats) {
     if (trees.size() > kMaxForestTrees) throw Error::usage("too many trees for one .forest file");
     std::vector<StoredTree> stored(trees.size());
     std::vector<std::exception_ptr> errors(trees.size());
@@ -110,8 +109,8 @@ std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& tree
     return out;
 }
 
-void write_forest_file(const std::vector<ForestTree>& trees, const TreeFileOptions& options,
-                       const std::filesystem::path& path, ForestStats* stats) {
+void write_forest_file(const std::vector<ForestTree>& trees, const TreeFileOptions& options, const std::filesystem::path& path,
+                       ForestStats* stats) {
     const std::vector<std::uint8_t> bytes = write_forest_bytes(trees, options, stats);
     write_file_atomically(path, std::string(bytes.begin(), bytes.end()));
 }
@@ -149,7 +148,7 @@ ForestReader::ForestReader(const std::filesystem::path& path) : context_(path.st
 }
 
 ForestReader::ForestReader(std::vector<std::uint8_t> bytes, std::string context)
-    : context_(std::move(context)), memory_(std::move(bytes)), in_memory_(true) {
+        : context_(std::move(context)), memory_(std::move(bytes)), in_memory_(true) {
     parse_index(memory_, memory_.size());
 }
 
@@ -159,7 +158,7 @@ void ForestReader::parse_index(std::span<const std::uint8_t> head, std::uint64_t
     const std::uint8_t version = in.u8();
     if (version != kForestFileVersion)
         throw Error::input(context_, "unsupported .forest version " + std::to_string(version) + " (this build reads " +
-                                         std::to_string(kForestFileVersion) + ")");
+                                             std::to_string(kForestFileVersion) + ")");
     const std::uint32_t count = in.u32();
     const std::uint32_t index_size = in.u32();
     if (static_cast<std::uint64_t>(kHeaderBytes) + index_size + 4 > head.size())

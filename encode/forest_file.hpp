@@ -55,8 +55,8 @@ struct ForestStats {
 // Encodes every tree with `options` (trees are independent: coded in parallel, output identical).
 std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& trees, const TreeFileOptions& options,
                                              ForestStats* stats = nullptr);
-void write_forest_file(const std::vector<ForestTree>& trees, const TreeFileOptions& options,
-                       const std::filesystem::path& path, ForestStats* stats = nullptr);
+void write_forest_file(const std::vector<ForestTree>& trees, const TreeFileOptions& options, const std::filesystem::path& path,
+                       ForestStats* stats = nullptr);
 
 // The skeleton of a stored forest tree in world coordinates: origin = the tree's position, local
 // positions rotated by its azimuth.

@@ -14,15 +14,12 @@ struct Segment {
     Eigen::Vector3d a, b;
 };
 
-Eigen::Vector3d world(const TreeGraph& tree, int node) {
-    return tree.nodes[node].position.cast<double>() + tree.origin;
-}
+Eigen::Vector3d world(const TreeGraph& tree, int node) { return tree.nodes[node].position.cast<double>() + tree.origin; }
 
 // Every edge as a segment; a tree without edges is its root point.
 std::vector<Segment> segments_of(const TreeGraph& tree) {
     std::vector<Segment> segments;
-    for (std::size_t i = 1; i < tree.size(); ++i)
-        segments.push_back({world(tree, tree.nodes[i].parent), world(tree, static_cast<int>(i))});
+    for (std::size_t i = 1; i < tree.size(); ++i) segments.push_back({world(tree, tree.nodes[i].parent), world(tree, static_cast<int>(i))});
     if (segments.empty() && !tree.empty()) segments.push_back({world(tree, 0), world(tree, 0)});
     return segments;
 }
@@ -109,8 +106,10 @@ private:
                     for (long y = clamp_axis(lo[1], 1); y <= clamp_axis(hi[1], 1); ++y)
                         for (long x = clamp_axis(lo[0], 0); x <= clamp_axis(hi[0], 0); ++x) {
                             const long cell = cell_index(x, y, z);
-                            if (pass == 0) ++offsets_[cell + 1];
-                            else entries_[cursor[cell]++] = static_cast<int>(s);
+                            if (pass == 0)
+                                ++offsets_[cell + 1];
+                            else
+                                entries_[cursor[cell]++] = static_cast<int>(s);
                         }
             }
         }
@@ -208,8 +207,8 @@ HausdorffResult skeleton_hausdorff(const TreeGraph& original, const TreeGraph& o
     return result;
 }
 
-VertexErrorCheck check_vertex_error(const TreeGraph& original, const TreeGraph& decoded,
-                                    const std::vector<int>& decoded_to_source, double voxel_size) {
+VertexErrorCheck check_vertex_error(const TreeGraph& original, const TreeGraph& decoded, const std::vector<int>& decoded_to_source,
+                                    double voxel_size) {
     if (decoded_to_source.size() != decoded.size())
         throw Error(ExitCode::Internal, "check_vertex_error: the node map does not match the decoded tree");
     VertexErrorCheck check;

@@ -21,8 +21,7 @@ std::uint64_t sub_steps(std::uint64_t a, std::uint64_t steps, std::uint64_t gap)
 }
 
 // Possible values of element m given the values at a and b (a < m < b).
-Range middle_range(std::size_t a, std::uint64_t left, std::size_t m, std::size_t b, std::uint64_t right,
-                   std::uint64_t max_gap) {
+Range middle_range(std::size_t a, std::uint64_t left, std::size_t m, std::size_t b, std::uint64_t right, std::uint64_t max_gap) {
     Range r{left, right};
     if (max_gap != kNoGapBound) {
         r.low = std::max(r.low, sub_steps(right, b - m, max_gap));
@@ -47,8 +46,8 @@ std::uint64_t read_value(BitReader& in, std::uint64_t n, MiddleCode code) {
     return x;
 }
 
-void write_recursive(BitWriter& out, std::span<const std::uint64_t> v, std::size_t a, std::size_t b,
-                     const InterpolativeOptions& o, std::vector<InterpolativeStep>* trace) {
+void write_recursive(BitWriter& out, std::span<const std::uint64_t> v, std::size_t a, std::size_t b, const InterpolativeOptions& o,
+                     std::vector<InterpolativeStep>* trace) {
     if (b - a < 2) return;
     const std::size_t m = a + (b - a) / 2;
     const Range r = middle_range(a, v[a], m, b, v[b], o.max_gap);
@@ -62,8 +61,7 @@ void write_recursive(BitWriter& out, std::span<const std::uint64_t> v, std::size
     write_recursive(out, v, m, b, o, trace);
 }
 
-void read_recursive(BitReader& in, std::span<std::uint64_t> v, std::size_t a, std::size_t b,
-                    const InterpolativeOptions& o) {
+void read_recursive(BitReader& in, std::span<std::uint64_t> v, std::size_t a, std::size_t b, const InterpolativeOptions& o) {
     if (b - a < 2) return;
     const std::size_t m = a + (b - a) / 2;
     const Range r = middle_range(a, v[a], m, b, v[b], o.max_gap);
@@ -81,9 +79,8 @@ void read_recursive(BitReader& in, std::span<std::uint64_t> v, std::size_t a, st
 
 }  // namespace
 
-void write_interpolative_between(BitWriter& out, std::span<const std::uint64_t> values, std::size_t first,
-                                 std::size_t last, const InterpolativeOptions& options,
-                                 std::vector<InterpolativeStep>* trace) {
+void write_interpolative_between(BitWriter& out, std::span<const std::uint64_t> values, std::size_t first, std::size_t last,
+                                 const InterpolativeOptions& options, std::vector<InterpolativeStep>* trace) {
     if (first > last || last >= values.size()) throw Error(ExitCode::Internal, "interpolative coding: bad positions");
     write_recursive(out, values, first, last, options, trace);
 }

@@ -38,9 +38,8 @@ struct InterpolativeStep {
 // Codes the elements strictly between positions `first` and `last` of a non-decreasing
 // sequence whose values at `first` and `last` the decoder already knows. Appends a step per
 // coded element to `trace` when given (in coding order).
-void write_interpolative_between(BitWriter& out, std::span<const std::uint64_t> values, std::size_t first,
-                                 std::size_t last, const InterpolativeOptions& options,
-                                 std::vector<InterpolativeStep>* trace = nullptr);
+void write_interpolative_between(BitWriter& out, std::span<const std::uint64_t> values, std::size_t first, std::size_t last,
+                                 const InterpolativeOptions& options, std::vector<InterpolativeStep>* trace = nullptr);
 // Fills values[first+1 .. last-1] given values[first] and values[last].
 void read_interpolative_between(BitReader& in, std::span<std::uint64_t> values, std::size_t first, std::size_t last,
                                 const InterpolativeOptions& options);

@@ -29,7 +29,6 @@ std::vector<double> lod_thresholds(const std::vector<int>& radii, int levels);
 
 // LOD 0..thresholds.size(): the full code, then successive reductions (each from the previous
 // one, which equals reducing the full code by the larger threshold).
-std::vector<ChainCode> lod_chain(const ChainCode& code, const std::vector<double>& thresholds,
-                                 const std::string& context = "chain code");
+std::vector<ChainCode> lod_chain(const ChainCode& code, const std::vector<double>& thresholds, const std::string& context = "chain code");
 
 }  // namespace treelobes::encode

@@ -31,8 +31,7 @@ struct BitModel {
             return r;
         }();
         const std::int32_t target = bit ? 0 : 65535;
-        const std::int32_t delta = static_cast<std::int32_t>(
-            (static_cast<std::int64_t>(target - p0) * rates[seen]) >> 16);
+        const std::int32_t delta = static_cast<std::int32_t>((static_cast<std::int64_t>(target - p0) * rates[seen]) >> 16);
         int p = p0 + delta;
         p = p < 64 ? 64 : (p > 65535 - 64 ? 65535 - 64 : p);
         p0 = static_cast<std::uint16_t>(p);
@@ -109,7 +108,7 @@ class RangeDecoder {
 public:
     // `context` names the stream in errors and must outlive the decoder.
     RangeDecoder(std::span<const std::uint8_t> bytes, const std::string& context)
-        : next_(bytes.data()), end_(bytes.data() + bytes.size()), context_(&context) {
+            : next_(bytes.data()), end_(bytes.data() + bytes.size()), context_(&context) {
         for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next_byte();
     }
     RangeDecoder(std::span<const std::uint8_t>, std::string&&) = delete;  // would dangle
@@ -149,7 +148,8 @@ private:
         }
     }
     [[gnu::always_inline]] std::uint32_t next_byte() {
-        if (next_ == end_) [[unlikely]] fail_decoding(context_, "truncated arithmetic-coded stream");
+        if (next_ == end_) [[unlikely]]
+            fail_decoding(context_, "truncated arithmetic-coded stream");
         return *next_++;
     }
 

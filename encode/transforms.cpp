@@ -41,8 +41,8 @@ std::vector<std::uint8_t> mtf_encode(std::span<const std::uint8_t> symbols, unsi
     return out;
 }
 
-std::vector<std::uint8_t> mtf_decode(std::span<const std::uint8_t> positions, unsigned alphabet_size,
-                                     const std::string& context, MtfRule rule) {
+std::vector<std::uint8_t> mtf_decode(std::span<const std::uint8_t> positions, unsigned alphabet_size, const std::string& context,
+                                     MtfRule rule) {
     std::vector<std::uint8_t> table = natural_table(alphabet_size);
     std::vector<std::uint8_t> out;
     out.reserve(positions.size());
@@ -62,8 +62,7 @@ std::vector<std::uint64_t> cumulative_sum(std::span<const std::uint64_t> values)
     return sums;
 }
 
-std::vector<std::uint64_t> differences(std::span<const std::uint64_t> sums, std::uint64_t max_difference,
-                                       const std::string& context) {
+std::vector<std::uint64_t> differences(std::span<const std::uint64_t> sums, std::uint64_t max_difference, const std::string& context) {
     std::vector<std::uint64_t> values(sums.size());
     std::uint64_t previous = 0;
     for (std::size_t i = 0; i < sums.size(); ++i) {

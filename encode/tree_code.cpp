@@ -30,7 +30,7 @@ std::vector<Voxel> voxelize_tree(const TreeGraph& tree, double voxel_size, const
         const Eigen::Vector3d scaled = (tree.nodes[i].position.cast<double>() - root) / voxel_size;
         if (scaled.cwiseAbs().maxCoeff() > kMaxVoxelsFromRoot)
             throw Error::input(context, "node " + std::to_string(i) + " lies too far from the root for voxel size " +
-                                            std::to_string(voxel_size) + " m");
+                                                std::to_string(voxel_size) + " m");
         for (int axis = 0; axis < 3; ++axis) voxels[i][axis] = voxelize(scaled[axis]);
     }
     return voxels;
@@ -42,8 +42,8 @@ std::vector<int> quantize_radii(const TreeGraph& tree, double radius_unit, const
         const float radius = tree.nodes[i].radius;
         if (radius < 0.0f) throw Error::input(context, "node " + std::to_string(i) + " has a negative radius");
         if (radius / radius_unit > std::numeric_limits<int>::max() / 2)
-            throw Error::input(context, "node " + std::to_string(i) + " has a radius too large for radius unit " +
-                                            std::to_string(radius_unit) + " m");
+            throw Error::input(
+                    context, "node " + std::to_string(i) + " has a radius too large for radius unit " + std::to_string(radius_unit) + " m");
         radii[i] = quantize_radius(radius, radius_unit);
     }
     return radii;
@@ -60,8 +60,7 @@ double turn(const Voxel& incoming, const Voxel& move) {
 // Children of every vertex in coding order: main child first, then laterals. Uses only what the
 // code stores (quantized radii, voxel moves) plus the node index, so a decoded tree, whose
 // indices follow the code order, sorts the same way.
-std::vector<std::vector<int>> coding_order(const TreeGraph& tree, const std::vector<Voxel>& voxels,
-                                           const std::vector<int>& radii) {
+std::vector<std::vector<int>> coding_order(const TreeGraph& tree, const std::vector<Voxel>& voxels, const std::vector<int>& radii) {
     // Incoming direction of each vertex: the last non-zero move on the path from the root, so that
     // zero-length internodes (contracted by the decoder) do not change it; +z above the root.
     std::vector<Voxel> incoming(tree.size(), Voxel(0, 0, 1));
@@ -85,8 +84,7 @@ std::vector<std::vector<int>> coding_order(const TreeGraph& tree, const std::vec
 // Nodes whose internode the decoder would read as a multi-way fork code (contracted_internodes):
 // the first vertex of a branch (a child of the root, or a lateral in coding order) that lies
 // in its parent's voxel and is not a tip.
-std::vector<bool> nodes_read_as_forks(const TreeGraph& tree, const std::vector<Voxel>& voxels,
-                                      const std::vector<std::vector<int>>& order) {
+std::vector<bool> nodes_read_as_forks(const TreeGraph& tree, const std::vector<Voxel>& voxels, const std::vector<std::vector<int>>& order) {
     std::vector<bool> read_as_fork(tree.size(), false);
     for (std::size_t node = 0; node < tree.size(); ++node)
         for (int child : order[node]) {
@@ -129,7 +127,7 @@ class StreamBuilder {
 public:
     StreamBuilder(const TreeGraph& tree, const std::vector<Voxel>& voxels, const std::vector<int>& radii,
                   std::vector<std::vector<int>> order)
-        : tree_(tree), voxels_(voxels), radii_(radii), order_(std::move(order)) {}
+            : tree_(tree), voxels_(voxels), radii_(radii), order_(std::move(order)) {}
 
     // Returns the stream; `sources` receives the tree node behind each internode (-1 for the
     // zero-length internodes of forks).
@@ -211,7 +209,7 @@ std::vector<int> decoded_sources(const std::vector<Internode>& stream, const std
 class TreeBuilder {
 public:
     TreeBuilder(const CodeGeometry& geometry, CodeKind kind, std::size_t internodes, const std::string& context)
-        : geometry_(geometry), root_(geometry.root_position.cast<double>()), kind_(kind), context_(context) {
+            : geometry_(geometry), root_(geometry.root_position.cast<double>()), kind_(kind), context_(context) {
         check_positive(geometry.voxel_size, "voxel size");
         check_positive(geometry.radius_unit, "radius unit");
         if (geometry.root_radius < 0) throw Error::input(context, "root radius is negative");
@@ -236,8 +234,8 @@ public:
         if (!contracted) {
             const Voxel voxel = voxels_[static_cast<std::size_t>(attach_)] + move;
             if (voxel.cwiseAbs().maxCoeff() > kMaxVoxelCoordinate)
-                throw Error::input(context_, "internode " + std::to_string(index + 1) +
-                                                 " ends more than 2^40 voxels from the root (corrupt code)");
+                throw Error::input(context_,
+                                   "internode " + std::to_string(index + 1) + " ends more than 2^40 voxels from the root (corrupt code)");
             const Eigen::Vector3d position = root_ + voxel.cast<double>() * geometry_.voxel_size;
             attach_ = add_child(position.cast<float>(), static_cast<float>(radius * geometry_.radius_unit));
             voxels_.push_back(voxel);
@@ -272,10 +270,10 @@ private:
     const CodeKind kind_;
     const std::string& context_;
     TreeGraph tree_;
-    std::vector<Voxel> voxels_;     // voxel of every vertex added so far
+    std::vector<Voxel> voxels_;      // voxel of every vertex added so far
     std::vector<int> queued_forks_;  // FIFO: vertices whose next lateral is still to come
     std::size_t next_fork_ = 0;
-    int attach_ = 0;                 // vertex the next internode starts from
+    int attach_ = 0;  // vertex the next internode starts from
     Voxel previous_ = Voxel::Zero();
     bool differential_base_ = false;  // DBF6: the internode codes a correction of `previous_`
     bool branch_start_ = true;        // no vertex of the current branch decoded yet
@@ -289,9 +287,7 @@ std::int64_t voxelize(double coordinate_in_voxels) {
     return static_cast<std::int64_t>(std::trunc(x + 0.5 * sign));
 }
 
-int quantize_radius(float radius, double radius_unit) {
-    return static_cast<int>(std::round(static_cast<double>(radius) / radius_unit));
-}
+int quantize_radius(float radius, double radius_unit) { return static_cast<int>(std::round(static_cast<double>(radius) / radius_unit)); }
 
 namespace {
 
@@ -321,7 +317,7 @@ std::optional<CodeParameters> find_code_parameters(const std::vector<std::string
             l != "internode_length" || u != "radius_unit" || !(std::isfinite(p.resolution) && p.resolution > 0) ||
             !(std::isfinite(p.internode_length) && p.internode_length > 0) || !(std::isfinite(p.radius_unit) && p.radius_unit > 0))
             throw Error::input(context, "malformed header comment '" + comment +
-                                            "', expected 'treelobes_code resolution R internode_length L radius_unit U'");
+                                                "', expected 'treelobes_code resolution R internode_length L radius_unit U'");
         return p;
     }
     return std::nullopt;
@@ -346,8 +342,7 @@ EncodedTree encode_tree(const TreeGraph& tree, const EncodeOptions& options, con
 
     EncodedTree encoded;
     encoded.resolution = options.resolution;
-    encoded.internode_length =
-        options.internode_length > 0.0 ? options.internode_length : median_internode_length(tree, context);
+    encoded.internode_length = options.internode_length > 0.0 ? options.internode_length : median_internode_length(tree, context);
     encoded.geometry.voxel_size = encoded.internode_length / options.resolution;  // Eq. 2
     encoded.geometry.radius_unit = options.radius_unit;
     encoded.geometry.root_position = tree.nodes[0].position;
@@ -391,8 +386,8 @@ TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const
     const std::size_t count = check_symbols(code.symbols, context);
     if (code.radii.size() != count)  // read_internodes's checks and messages, inlined below
         throw Error::input(context, "radius list has " + std::to_string(code.radii.size()) + " values but the " +
-                                        code_kind_name(code.kind) + " code has " + std::to_string(count) +
-                                        " internodes (one radius per 6, 7 or 8)");
+                                            code_kind_name(code.kind) + " code has " + std::to_string(count) +
+                                            " internodes (one radius per 6, 7 or 8)");
     // One pass over the symbols, without an intermediate internode stream (read_internodes and
     // contracted_internodes do the same in two more passes).
     TreeBuilder builder(geometry, code.kind, count, context);
@@ -404,8 +399,7 @@ TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const
             delta[(symbol - '0') % 3] += symbol < '3' ? 1 : -1;
             continue;
         }
-        builder.add(index, delta, symbol, code.radii[index],
-                    [&] { return "internode ending at character " + std::to_string(s + 1); });
+        builder.add(index, delta, symbol, code.radii[index], [&] { return "internode ending at character " + std::to_string(s + 1); });
         delta.setZero();
         ++index;
     }
@@ -416,10 +410,9 @@ TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& ge
     const std::size_t count = code.terminators.size();
     if (code.vectors.size() != count || code.radii.size() != count)
         throw Error::input(context, "radius list has " + std::to_string(code.radii.size()) + " values but the " +
-                                        code_kind_name(code.kind) + " code has " + std::to_string(count) +
-                                        " internodes (one radius per 6, 7 or 8)");
-    if (count == 0 || code.terminators.back() != kTip)
-        throw Error::input(context, "chain code ends without the final branch tip 7");
+                                            code_kind_name(code.kind) + " code has " + std::to_string(count) +
+                                            " internodes (one radius per 6, 7 or 8)");
+    if (count == 0 || code.terminators.back() != kTip) throw Error::input(context, "chain code ends without the final branch tip 7");
     TreeBuilder builder(geometry, code.kind, count, context);
     for (std::size_t i = 0; i < count; ++i) {
         const char terminator = code.terminators[i];
@@ -429,10 +422,10 @@ TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& ge
         // one leaves none.
         if (terminator == kTip && i + 1 < count && builder.open_forks() == 0)
             throw Error::input(context, "tip 7 of internode " + std::to_string(i + 1) +
-                                            " ends the last open branch but the code goes on (a fork 6 is missing)");
+                                                " ends the last open branch but the code goes on (a fork 6 is missing)");
         if (i + 1 == count && builder.open_forks() > 0)
             throw Error::input(context, std::to_string(builder.open_forks()) +
-                                            " fork(s) 6 without a lateral branch: the code ends before every queued lateral was coded");
+                                                " fork(s) 6 without a lateral branch: the code ends before every queued lateral was coded");
         builder.add(i, code.vectors[i], terminator, code.radii[i], [&] { return "internode " + std::to_string(i + 1); });
     }
     return builder.take();

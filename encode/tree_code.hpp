@@ -36,11 +36,11 @@ struct EncodeOptions {
 
 // What a decoder needs besides C and R.
 struct CodeGeometry {
-    double voxel_size = 0.0;                     // d = l / r in metres
-    double radius_unit = 0.001;                  // metres per radius step
-    int root_radius = 0;                         // root vertex radius in radius units
-    Eigen::Vector3f root_position{0, 0, 0};      // local coordinates of the root vertex
-    Eigen::Vector3d origin{0, 0, 0};             // TreeGraph::origin of the tree
+    double voxel_size = 0.0;                 // d = l / r in metres
+    double radius_unit = 0.001;              // metres per radius step
+    int root_radius = 0;                     // root vertex radius in radius units
+    Eigen::Vector3f root_position{0, 0, 0};  // local coordinates of the root vertex
+    Eigen::Vector3d origin{0, 0, 0};         // TreeGraph::origin of the tree
 };
 
 struct EncodedTree {
@@ -67,8 +67,7 @@ TreeGraph decode_tree(const ChainCode& code, const CodeGeometry& geometry, const
 
 // decode_tree for a code in internode form (same tree, same checks of the structure and of
 // every value; errors name internodes instead of characters).
-TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& geometry,
-                            const std::string& context = "chain code");
+TreeGraph decode_internodes(const InternodeVectors& code, const CodeGeometry& geometry, const std::string& context = "chain code");
 
 // The parameters a decoded skeleton records in its PLY header (comment "treelobes_code
 // resolution R internode_length L radius_unit U", shortest decimals that read back exactly), so

@@ -77,8 +77,8 @@ std::uint8_t ByteReader::u8() { return take(1)[0]; }
 
 std::uint32_t ByteReader::u32() {
     const auto b = take(4);
-    return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 |
-           static_cast<std::uint32_t>(b[2]) << 16 | static_cast<std::uint32_t>(b[3]) << 24;
+    return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 | static_cast<std::uint32_t>(b[2]) << 16 |
+           static_cast<std::uint32_t>(b[3]) << 24;
 }
 
 float ByteReader::f32() { return std::bit_cast<float>(u32()); }
@@ -178,8 +178,8 @@ StoredTree parse_tree_record(std::span<const std::uint8_t> bytes, std::size_t& p
     const std::uint64_t lods = in.varint();
     if (lods < 1 || lods > kMaxLods) in.fail("invalid LOD count " + std::to_string(lods));
     if (lod >= static_cast<int>(lods))
-        throw Error::usage(context + " stores " + std::to_string(lods) + " LODs (0.." + std::to_string(lods - 1) +
-                           "), not LOD " + std::to_string(lod));
+        throw Error::usage(context + " stores " + std::to_string(lods) + " LODs (0.." + std::to_string(lods - 1) + "), not LOD " +
+                           std::to_string(lod));
     for (std::uint64_t k = 1; k < lods; ++k) {
         const std::uint64_t t = in.varint();
         if (t > INT32_MAX) in.fail("LOD threshold out of range");
@@ -200,8 +200,7 @@ StoredTree parse_tree_record(std::span<const std::uint8_t> bytes, std::size_t& p
         } else if (lod < 0 || static_cast<int>(k) == lod) {
             tree.lods[k] = decode_streams(symbols, radii, tree.coder, tree.kind, context + ": LOD " + std::to_string(k),
                                           (flags & kUsesPrior) ? prior : nullptr);
-            if (sizes)
-                sizes->push_back({symbol_bytes, radii_bytes, tree.lods[k].symbols.size(), tree.lods[k].radii.size()});
+            if (sizes) sizes->push_back({symbol_bytes, radii_bytes, tree.lods[k].symbols.size(), tree.lods[k].radii.size()});
         } else if (sizes) {
             sizes->push_back({symbol_bytes, radii_bytes, 0, 0});
         }
@@ -212,8 +211,8 @@ StoredTree parse_tree_record(std::span<const std::uint8_t> bytes, std::size_t& p
 
 }  // namespace
 
-StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod,
-                            const std::string& context, std::vector<StreamSizes>* sizes, const BestPrior* prior) {
+StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod, const std::string& context,
+                            std::vector<StreamSizes>* sizes, const BestPrior* prior) {
     return parse_tree_record(bytes, position, lod, context, sizes, prior, nullptr);
 }
 
@@ -234,19 +233,17 @@ std::vector<std::uint8_t> write_tree_file_bytes(const StoredTree& tree, std::vec
     return out;
 }
 
-StoredTree read_tree_file_bytes(std::span<const std::uint8_t> bytes, int lod, const std::string& context,
-                                std::vector<StreamSizes>* sizes) {
+StoredTree read_tree_file_bytes(std::span<const std::uint8_t> bytes, int lod, const std::string& context, std::vector<StreamSizes>* sizes) {
     if (bytes.size() < 4 || std::memcmp(bytes.data(), kMagic, 4) != 0) throw Error::input(context, "not a .dbf6 file (no DBF6 magic)");
     if (bytes.size() < 4 + 1 + 4) throw Error::input(context, "truncated .dbf6 file");
     if (bytes[4] != kTreeFileVersion)
         throw Error::input(context, "unsupported .dbf6 version " + std::to_string(bytes[4]) + " (this build reads " +
-                                        std::to_string(kTreeFileVersion) + ")");
+                                            std::to_string(kTreeFileVersion) + ")");
     // The checksum comes first: a corrupt or truncated file is reported as such, not as whatever
     // the damaged bytes would decode to.
     const auto body = bytes.first(bytes.size() - 4);
     ByteReader trailer(bytes, bytes.size() - 4, context);
-    if (trailer.u32() != crc32_of(body))
-        throw Error::input(context, "checksum mismatch: the .dbf6 file is corrupt or truncated");
+    if (trailer.u32() != crc32_of(body)) throw Error::input(context, "checksum mismatch: the .dbf6 file is corrupt or truncated");
     std::size_t position = 5;
     StoredTree tree = read_tree_record(body, position, lod, context, sizes);
     if (position != body.size()) throw Error::input(context, "unexpected bytes after the tree record");

@@ -38,17 +38,17 @@ struct StoredTree {
     double radius_unit = 0.001;
     Eigen::Vector3d root_position{0, 0, 0};  // world coordinates of the root vertex
     int root_radius = 0;
-    std::vector<int> thresholds;             // lods - 1 values, radius units
-    std::vector<ChainCode> lods;             // LOD 0 first
+    std::vector<int> thresholds;  // lods - 1 values, radius units
+    std::vector<ChainCode> lods;  // LOD 0 first
 
-    CodeGeometry geometry() const;           // voxel size l / r, radius unit, root
+    CodeGeometry geometry() const;  // voxel size l / r, radius unit, root
 };
 
 // Sizes of one LOD's streams in bytes (for --stats).
 struct StreamSizes {
     std::size_t symbols = 0;
     std::size_t radii = 0;
-    std::size_t code_length = 0;   // symbols of the chain code
+    std::size_t code_length = 0;  // symbols of the chain code
     std::size_t internodes = 0;
 };
 
@@ -62,9 +62,8 @@ std::vector<std::uint8_t> write_tree_record(const StoredTree& tree, std::vector<
 // Parses a tree record; decodes only LOD `lod` (-1: all) into `lods` (others stay empty codes).
 // `position` advances past the record. Throws Error(InvalidInput) naming `context`, also for a
 // record coded with a prior when `prior` is null.
-StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod,
-                            const std::string& context, std::vector<StreamSizes>* sizes = nullptr,
-                            const BestPrior* prior = nullptr);
+StoredTree read_tree_record(std::span<const std::uint8_t> bytes, std::size_t& position, int lod, const std::string& context,
+                            std::vector<StreamSizes>* sizes = nullptr, const BestPrior* prior = nullptr);
 
 // LOD `lod` of a tree record straight to its skeleton: read_tree_record then decode_stored_tree,
 // without the chain code's symbol text. Same checks and errors.
@@ -95,7 +94,7 @@ void put_varint(std::vector<std::uint8_t>& out, std::uint64_t v);
 class ByteReader {
 public:
     ByteReader(std::span<const std::uint8_t> bytes, std::size_t position, std::string context)
-        : bytes_(bytes), position_(position), context_(std::move(context)) {}
+            : bytes_(bytes), position_(position), context_(std::move(context)) {}
     std::uint8_t u8();
     std::uint32_t u32();
     float f32();

@@ -102,7 +102,8 @@ json geometry_templates(const std::vector<ExportTree>& trees, const std::vector<
     json templates = json::array();
     VertexGrid grid(Eigen::Vector3d::Zero());
     for (auto& [species, members] : trees_of_species) {
-        std::stable_sort(members.begin(), members.end(), [&](std::size_t a, std::size_t b) { return measures[a].height < measures[b].height; });
+        std::stable_sort(members.begin(), members.end(),
+                         [&](std::size_t a, std::size_t b) { return measures[a].height < measures[b].height; });
         const std::size_t chosen = members[(members.size() - 1) / 2];
         TriangleMesh mesh = lod2_mesh(trees[chosen], options);
         mesh.origin -= measures[chosen].base;  // relative to the stem base
@@ -160,7 +161,8 @@ json extent(const json& vertices, const Eigen::Vector3d& translate) {
 }
 
 void collect_indices(const json& boundaries, std::vector<long long>& out) {
-    if (boundaries.is_number_integer()) out.push_back(boundaries.get<long long>());
+    if (boundaries.is_number_integer())
+        out.push_back(boundaries.get<long long>());
     else if (boundaries.is_array())
         for (const auto& b : boundaries) collect_indices(b, out);
 }
@@ -239,7 +241,8 @@ std::string cityjson_text(const std::vector<ExportTree>& trees, const std::strin
     if (options.instances) geometry_template_block = geometry_templates(trees, measures, options, templates);
     json objects = json::object();
     for (std::size_t i = 0; i < trees.size(); ++i)
-        objects[trees[i].name] = tree_object(trees[i], measures[i], grid, options, options.instances ? &templates.at(trees[i].species) : nullptr);
+        objects[trees[i].name] =
+                tree_object(trees[i], measures[i], grid, options, options.instances ? &templates.at(trees[i].species) : nullptr);
     json vertices = grid.vertices();
     json metadata = {{"title", "trees exported by treelobes " + std::string(kVersion)}};
     if (!vertices.empty()) metadata["geographicalExtent"] = extent(vertices, translate);
@@ -271,8 +274,10 @@ std::vector<std::string> check_cityjson(const std::string& text) {
     for (const auto& [id, object] : objects.items()) {
         const json geometries = object.value("geometry", json::array());
         for (const auto& geometry : geometries) {
-            if (geometry.value("type", "") == "GeometryInstance") check_instance(geometry, id, vertex_count, template_count, problems);
-            else check_geometry(geometry, id, vertex_count, problems);
+            if (geometry.value("type", "") == "GeometryInstance")
+                check_instance(geometry, id, vertex_count, template_count, problems);
+            else
+                check_geometry(geometry, id, vertex_count, problems);
         }
     }
     for (long long t = 0; t < template_count; ++t)

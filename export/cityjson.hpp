@@ -26,7 +26,7 @@
 namespace treelobes::exporting {
 
 struct CityJsonOptions {
-    int branch_sides = 6;  // tube sides of the LoD 2 branches
+    int branch_sides = 6;    // tube sides of the LoD 2 branches
     bool instances = false;  // LoD 2 as per-species GeometryInstances of templates
 };
 

@@ -119,7 +119,8 @@ json materials(bool leaves) {
         if (two_sided) m["doubleSided"] = true;
         return m;
     };
-    json list = json::array({material("bark", {0.36, 0.25, 0.16, 1.0}, 0.9, false), material("foliage", {0.22, 0.45, 0.14, 1.0}, 0.8, true)});
+    json list =
+            json::array({material("bark", {0.36, 0.25, 0.16, 1.0}, 0.9, false), material("foliage", {0.22, 0.45, 0.14, 1.0}, 0.8, true)});
     if (leaves) {
         json leaf = material("leaves", {1.0, 1.0, 1.0, 1.0}, 0.8, true);
         leaf["pbrMetallicRoughness"]["baseColorTexture"] = {{"index", 0}};
@@ -223,7 +224,8 @@ std::string glb_bytes(const std::vector<GltfTree>& trees, const Eigen::Vector3d&
                      {"buffers", json::array({{{"byteLength", builder.bin.size()}}})}};
     if (leaves) {
         document["images"] = builder.images;
-        document["samplers"] = json::array({{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kClampToEdge}, {"wrapT", kClampToEdge}}});
+        document["samplers"] = json::array(
+                {{{"magFilter", kLinear}, {"minFilter", kLinearMipmapLinear}, {"wrapS", kClampToEdge}, {"wrapT", kClampToEdge}}});
         document["textures"] = json::array({{{"sampler", 0}, {"source", 0}, {"name", "leaf"}}});
     }
     if (nodes.size() > scene_nodes.size()) document["extensionsUsed"] = {"MSFT_lod"};

@@ -23,9 +23,9 @@ namespace treelobes::exporting {
 
 struct GltfTree {
     std::string name;
-    Eigen::Vector3d origin{0, 0, 0};                      // world position of the tree's frame
-    std::vector<TreeLod> lods;                            // LOD 0 first; mesh origins are ignored (tree frame)
-    std::vector<std::pair<std::string, double>> extras;   // measures stored in the node's extras
+    Eigen::Vector3d origin{0, 0, 0};                     // world position of the tree's frame
+    std::vector<TreeLod> lods;                           // LOD 0 first; mesh origins are ignored (tree frame)
+    std::vector<std::pair<std::string, double>> extras;  // measures stored in the node's extras
     std::string species;
 };
 

@@ -67,8 +67,10 @@ QsmModel qsm_from_tree(const TreeGraph& tree, const std::string& context) {
             const Eigen::Vector3d end = tree.origin + n.position.cast<double>();
             c.length = (end - c.start).norm();
             const bool continuation = k > 0 || (n.parent == 0 && b == 0);
-            if (c.length > 0) c.axis = (end - c.start) / c.length;
-            else if (n.parent != 0) c.axis = model.cylinders[cylinder_of[n.parent]].axis;  // a zero-length internode keeps its parent's direction
+            if (c.length > 0)
+                c.axis = (end - c.start) / c.length;
+            else if (n.parent != 0)
+                c.axis = model.cylinders[cylinder_of[n.parent]].axis;  // a zero-length internode keeps its parent's direction
             c.radius = continuation ? 0.5 * (static_cast<double>(p.radius) + n.radius) : static_cast<double>(n.radius);
             c.unmodified_radius = c.radius;
             c.parent = n.parent == 0 ? -1 : cylinder_of[n.parent];

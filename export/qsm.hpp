@@ -21,26 +21,26 @@ QsmModel qsm_from_tree(const TreeGraph& tree, const std::string& context = "skel
 // TreeQSM's treedata quantities (volumes in cubic metres here; the table file shows litres).
 struct QsmTreeMeasures {
     double total_volume = 0, trunk_volume = 0, branch_volume = 0;  // m^3
-    double height = 0;                 // highest cylinder end minus the lowest trunk start (m)
+    double height = 0;                                             // highest cylinder end minus the lowest trunk start (m)
     double trunk_length = 0, branch_length = 0, total_length = 0;  // m
-    std::size_t branches = 0;          // branches of order >= 1
+    std::size_t branches = 0;                                      // branches of order >= 1
     int max_branch_order = 0;
-    double dbh = 0;                    // diameter of the trunk cylinder at 1.3 m above the base (m); 0 if the trunk is lower
-    Eigen::Vector3d base{0, 0, 0};     // start of the lowest trunk cylinder
+    double dbh = 0;                 // diameter of the trunk cylinder at 1.3 m above the base (m); 0 if the trunk is lower
+    Eigen::Vector3d base{0, 0, 0};  // start of the lowest trunk cylinder
 };
 QsmTreeMeasures measure_qsm(const QsmModel& model);
 
 // One row of TreeQSM's branch table.
 struct QsmBranch {
-    int id = 0;            // branch id of the cylinders (0-based)
+    int id = 0;  // branch id of the cylinders (0-based)
     int order = 0;
-    int parent = -1;       // branch id of the parent branch, -1 for the trunk
-    double volume = 0;     // m^3
-    double length = 0;     // m
-    double angle = 0;      // degrees between the branch's first cylinder and its parent cylinder
-    double height = 0;     // m above the base, at the branch's first cylinder start
-    double azimuth = 0;    // degrees, atan2(y, x) of the first cylinder's axis
-    double diameter = 0;   // m, of the first cylinder
+    int parent = -1;      // branch id of the parent branch, -1 for the trunk
+    double volume = 0;    // m^3
+    double length = 0;    // m
+    double angle = 0;     // degrees between the branch's first cylinder and its parent cylinder
+    double height = 0;    // m above the base, at the branch's first cylinder start
+    double azimuth = 0;   // degrees, atan2(y, x) of the first cylinder's axis
+    double diameter = 0;  // m, of the first cylinder
 };
 std::vector<QsmBranch> qsm_branches(const QsmModel& model);
 

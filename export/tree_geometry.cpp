@@ -83,7 +83,8 @@ std::vector<TreeLod> tree_lods(const ExportTree& tree, const TreeGeometryOptions
         TreeLod lod;
         const int sides = std::max(3, options.sides - 2 * k);
         lod.wood = branch_tubes(tree, sides, k == 0 ? 2 : 1, lod_threshold(tree.skeleton, k, options.lods));
-        if (!tree.lobes.empty()) lod.foliage = lobes_mesh(tree);
+        if (!tree.lobes.empty())
+            lod.foliage = lobes_mesh(tree);
         else if (options.leaves) {
             const int stride = 1 << k;
             lod.foliage = leaf_cards(tree.skeleton, stride, static_cast<float>(options.leaf_size * std::sqrt(stride)), lod.foliage_uvs);

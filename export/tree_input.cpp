@@ -56,14 +56,16 @@ void read_file_into(const fs::path& path, int lod, ExportInput& input) {
         }
     } else {
         ExportTree tree;
-        if (ext == "tlobe") tree = tree_from_tlobe(path);
+        if (ext == "tlobe")
+            tree = tree_from_tlobe(path);
         else if (ext == "dbf6") {
             tree.name = path.stem().string();
             tree.skeleton = encode::decode_stored_tree(encode::read_tree_file(path, lod), lod, path.string());
         } else if (ext == "ply") {
             tree.name = path.stem().string();
             tree.skeleton = read_skeleton_ply(path);
-        } else throw Error::input(path.string(), "not a tree file: expected a skeleton PLY, .tlobe, .dbf6, .forest or a folder of them");
+        } else
+            throw Error::input(path.string(), "not a tree file: expected a skeleton PLY, .tlobe, .dbf6, .forest or a folder of them");
         tree.skeleton.validate(path.string());
         input.trees.push_back(std::move(tree));
     }
@@ -97,8 +99,10 @@ std::optional<double> tree_confidence(const fs::path& tlobe, std::size_t lobe_po
             throw Error::input(record.string(), std::string("not JSON: ") + e.what());
         }
         const nlohmann::json points = json.value("points", nlohmann::json());
-        if (points.is_number()) tree_points = points.get<double>();  // tile record: all points of the tree
-        else if (points.is_object() && points.value("main", nlohmann::json()).is_number() && points.value("lobes", nlohmann::json()).is_number())
+        if (points.is_number())
+            tree_points = points.get<double>();  // tile record: all points of the tree
+        else if (points.is_object() && points.value("main", nlohmann::json()).is_number() &&
+                 points.value("lobes", nlohmann::json()).is_number())
             tree_points = points["main"].get<double>() + points["lobes"].get<double>();  // lobes summary
         if (tree_points > 0) break;
     }

@@ -30,8 +30,8 @@ struct ExportTree {
 
 struct ExportInput {
     std::vector<ExportTree> trees;
-    std::string crs;                  // from the inputs' georef sidecars ("" when unknown)
-    std::vector<std::string> files;   // files the trees came from
+    std::string crs;                 // from the inputs' georef sidecars ("" when unknown)
+    std::vector<std::string> files;  // files the trees came from
 };
 
 // `lod` selects the LOD of .dbf6 and .forest inputs (0 = full detail). Throws Error(InvalidInput)

@@ -17,8 +17,7 @@ float crown_base_z(const TreeGraph& tree, float min_length) {
     for (int node = 0; node >= 0 && !tree.nodes[node].children.empty(); node = tree.nodes[node].children.front()) {
         const auto& children = tree.nodes[node].children;
         for (std::size_t k = 1; k < children.size(); ++k)
-            if (below[children[k]] + tree.edge_length(children[k]) >= min_length)
-                lowest = std::min(lowest, tree.nodes[node].position.z());
+            if (below[children[k]] + tree.edge_length(children[k]) >= min_length) lowest = std::min(lowest, tree.nodes[node].position.z());
     }
     return lowest;
 }

@@ -23,8 +23,8 @@ struct TreeMeasures {
     double total_length = 0;       // m of skeleton
     std::size_t branches = 0;      // branches of order >= 1
     std::size_t lobes = 0;
-    Eigen::Vector3d base{0, 0, 0}; // world coordinates
-    TriangleMesh crown_hull;       // closed, origin = the tree's origin; empty if the crown spans no volume
+    Eigen::Vector3d base{0, 0, 0};  // world coordinates
+    TriangleMesh crown_hull;        // closed, origin = the tree's origin; empty if the crown spans no volume
 };
 
 TreeMeasures measure_tree(const ExportTree& tree, double crown_branch_fraction = 0.05);

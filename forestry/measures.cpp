@@ -19,9 +19,12 @@ namespace treelobes::forestry {
 
 const char* dbh_quality_name(DbhQuality quality) {
     switch (quality) {
-        case DbhQuality::Ok: return "ok";
-        case DbhQuality::PartialArc: return "partial_arc";
-        case DbhQuality::NotVisible: return "not_visible";
+        case DbhQuality::Ok:
+            return "ok";
+        case DbhQuality::PartialArc:
+            return "partial_arc";
+        case DbhQuality::NotVisible:
+            return "not_visible";
     }
     throw Error(ExitCode::Internal, "unknown DBH quality");
 }
@@ -29,13 +32,10 @@ const char* dbh_quality_name(DbhQuality quality) {
 namespace {
 
 void check_sizes(std::span<const Eigen::Vector3f> points, std::span<const float> hag, const char* what) {
-    if (points.size() != hag.size())
-        throw Error(ExitCode::Internal, std::string(what) + ": one height above ground per point expected");
+    if (points.size() != hag.size()) throw Error(ExitCode::Internal, std::string(what) + ": one height above ground per point expected");
 }
 
-double horizontal_distance(const Eigen::Vector3f& p, const Eigen::Vector3d& base) {
-    return std::hypot(p.x() - base.x(), p.y() - base.y());
-}
+double horizontal_distance(const Eigen::Vector3f& p, const Eigen::Vector3d& base) { return std::hypot(p.x() - base.x(), p.y() - base.y()); }
 
 // Value at quantile q (0..1) of `values` (nearest rank); values must not be empty.
 double quantile(std::vector<double> values, double q) {
@@ -53,8 +53,8 @@ DbhMeasure not_visible(DbhMeasure m, std::string reason) {
 
 }  // namespace
 
-DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
-                       const Eigen::Vector3d& base, const DbhOptions& options) {
+DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
+                       const DbhOptions& options) {
     check_sizes(points, height_above_ground, "measure_dbh");
     std::vector<Eigen::Vector2f> slice;
     for (std::size_t i = 0; i < points.size(); ++i)
@@ -63,7 +63,8 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
             slice.emplace_back(points[i].x(), points[i].y());
     DbhMeasure m;
     m.slice_points = slice.size();
-    if (slice.size() < options.min_inliers) return not_visible(m, "fewer than " + std::to_string(options.min_inliers) + " points at breast height");
+    if (slice.size() < options.min_inliers)
+        return not_visible(m, "fewer than " + std::to_string(options.min_inliers) + " points at breast height");
     const CircleFit fit = fit_circle(slice, static_cast<float>(options.fit_tolerance), static_cast<float>(options.min_radius),
                                      static_cast<float>(options.max_radius));
     if (!fit.ok) return not_visible(m, "no circle fits the breast-height points");
@@ -96,8 +97,8 @@ double projected_hull_area(std::span<const Eigen::Vector3f> points) {
     return std::abs(bg::area(hull));
 }
 
-CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
-                           const Eigen::Vector3d& base, const CrownOptions& options) {
+CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
+                           const CrownOptions& options) {
     check_sizes(points, height_above_ground, "measure_crown");
     CrownMeasure m;
     if (points.size() < options.min_points) {
@@ -110,8 +111,7 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
     std::vector<double> crown_heights;
     for (std::size_t i = 0; i < points.size(); ++i)
         if (horizontal_distance(points[i], base) >= offset) crown_heights.push_back(height_above_ground[i]);
-    if (crown_heights.size() >= options.min_points)
-        m.base_height = std::max(0.0, quantile(crown_heights, options.base_quantile));
+    if (crown_heights.size() >= options.min_points) m.base_height = std::max(0.0, quantile(crown_heights, options.base_quantile));
 
     const double area = projected_hull_area(points);
     if (area > 0) {
@@ -137,8 +137,10 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
         return m;
     }
     const lobes::AlphaShapeResult shape = lobes::alpha_shape(thinned, {.alpha_factor = options.alpha_factor});
-    if (!shape.failure.empty()) m.volume_failure = shape.failure;
-    else m.volume = std::abs(shape.mesh.signed_volume());
+    if (!shape.failure.empty())
+        m.volume_failure = shape.failure;
+    else
+        m.volume = std::abs(shape.mesh.signed_volume());
     return m;
 }
 

@@ -21,40 +21,40 @@ enum class DbhQuality { Ok, PartialArc, NotVisible };
 const char* dbh_quality_name(DbhQuality quality);
 
 struct DbhOptions {
-    double breast_height = 1.3;     // metres above the terrain
-    double slice_half_width = 0.1;  // metres: points with |HAG - breast_height| below this
-    double search_radius = 1.5;     // metres around the stem base (horizontal)
-    double fit_tolerance = 0.02;    // metres: RANSAC inlier band of the circle
+    double breast_height = 1.3;                   // metres above the terrain
+    double slice_half_width = 0.1;                // metres: points with |HAG - breast_height| below this
+    double search_radius = 1.5;                   // metres around the stem base (horizontal)
+    double fit_tolerance = 0.02;                  // metres: RANSAC inlier band of the circle
     double min_radius = 0.015, max_radius = 1.0;  // metres
     std::size_t min_inliers = 8;
-    double ok_coverage = 0.6;       // fraction of 10-degree sectors around the centre holding inliers
-    double min_coverage = 0.25;     // below: not_visible
-    double max_relative_rms = 0.25; // rms / radius above this: not a stem (branch clutter, leaves)
-    double hollow_fraction = 0.6;   // points closer to the centre than this many radii are inside the stem...
-    double max_interior_share = 0.25; // ...and more of them than this share of the inliers: not a stem
+    double ok_coverage = 0.6;          // fraction of 10-degree sectors around the centre holding inliers
+    double min_coverage = 0.25;        // below: not_visible
+    double max_relative_rms = 0.25;    // rms / radius above this: not a stem (branch clutter, leaves)
+    double hollow_fraction = 0.6;      // points closer to the centre than this many radii are inside the stem...
+    double max_interior_share = 0.25;  // ...and more of them than this share of the inliers: not a stem
 };
 
 struct DbhMeasure {
     DbhQuality quality = DbhQuality::NotVisible;
-    std::optional<double> diameter;     // metres; set for Ok and PartialArc
-    Eigen::Vector2d centre{0, 0};       // local frame, when a circle was fitted
-    double coverage = 0.0;              // of the fitted circle (0 when none)
-    double rms = 0.0;                   // metres
-    std::size_t slice_points = 0;       // points in the breast-height slice near the base
-    std::string reason;                 // why not_visible, or empty
+    std::optional<double> diameter;  // metres; set for Ok and PartialArc
+    Eigen::Vector2d centre{0, 0};    // local frame, when a circle was fitted
+    double coverage = 0.0;           // of the fitted circle (0 when none)
+    double rms = 0.0;                // metres
+    std::size_t slice_points = 0;    // points in the breast-height slice near the base
+    std::string reason;              // why not_visible, or empty
 };
 
 // `base` is the stem base in the local frame (its x, y limit the search).
-DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
-                       const Eigen::Vector3d& base, const DbhOptions& options = {});
+DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
+                       const DbhOptions& options = {});
 
 struct CrownOptions {
-    double min_offset = 0.5;           // metres: crown points lie at least this far from the stem axis...
-    double offset_fraction = 0.1;      // ...and this fraction of the tree's horizontal extent
-    double base_quantile = 0.05;       // crown base = this quantile of the crown points' HAG
+    double min_offset = 0.5;       // metres: crown points lie at least this far from the stem axis...
+    double offset_fraction = 0.1;  // ...and this fraction of the tree's horizontal extent
+    double base_quantile = 0.05;   // crown base = this quantile of the crown points' HAG
     std::size_t min_points = 10;
-    double alpha_factor = 2.0;         // crown volume: alpha shape at alpha = factor * alpha_min
-    double volume_cell = 0.25;         // metres: crown points thinned on this grid for the alpha shape
+    double alpha_factor = 2.0;  // crown volume: alpha shape at alpha = factor * alpha_min
+    double volume_cell = 0.25;  // metres: crown points thinned on this grid for the alpha shape
     std::size_t max_volume_points = 3000;
 };
 
@@ -66,8 +66,8 @@ struct CrownMeasure {
     std::string volume_failure;            // why there is no volume, or empty
 };
 
-CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
-                           const Eigen::Vector3d& base, const CrownOptions& options = {});
+CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
+                           const CrownOptions& options = {});
 
 // Area of the convex hull of points seen from above (square metres; 0 for fewer than 3 points
 // or collinear ones).

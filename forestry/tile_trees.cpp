@@ -118,24 +118,23 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
     }
     for (TreeInput& tree : trees) {
         const auto known = bases.find(tree.id);
-        tree.base = known != bases.end() ? known->second
-                                         : estimate_stem_base(tree.points.positions, tree.height_above_ground);
+        tree.base = known != bases.end() ? known->second : estimate_stem_base(tree.points.positions, tree.height_above_ground);
     }
     return trees;
 }
 
 std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin) {
     std::string csv =
-        "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
-        "woody_volume_m3,species,species_confidence,points,lobes\n";
+            "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
+            "woody_volume_m3,species,species_confidence,points,lobes\n";
     for (const TreeRow& row : rows) {
         const TreeMeasures& m = row.measures;
         const Eigen::Vector3d p = origin + m.position;
-        csv += row.global_id + "," + std::to_string(m.id) + "," + fixed(p.x(), 3) + "," + fixed(p.y(), 3) + "," + fixed(p.z(), 3) + "," + fixed(m.height, 2) +
-               "," + cell(m.dbh.diameter, 3) + "," + dbh_quality_name(m.dbh.quality) + "," + cell(m.crown.base_height, 2) + "," +
-               cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," + cell(m.crown.volume, 2) + "," +
-               fixed(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," + std::to_string(m.points) +
-               "," + std::to_string(row.lobes) + "\n";
+        csv += row.global_id + "," + std::to_string(m.id) + "," + fixed(p.x(), 3) + "," + fixed(p.y(), 3) + "," + fixed(p.z(), 3) + "," +
+               fixed(m.height, 2) + "," + cell(m.dbh.diameter, 3) + "," + dbh_quality_name(m.dbh.quality) + "," +
+               cell(m.crown.base_height, 2) + "," + cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," +
+               cell(m.crown.volume, 2) + "," + fixed(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," +
+               std::to_string(m.points) + "," + std::to_string(row.lobes) + "\n";
     }
     return csv;
 }
@@ -161,12 +160,20 @@ std::string tree_record(const TreeRow& row, const Eigen::Vector3d& origin, const
     record["position"] = {p.x(), p.y(), p.z()};
     record["exact"] = {{"position_local", {m.position.x(), m.position.y(), m.position.z()}},
                        {"height", m.height},
-                       {"dbh", {{"quality", dbh_quality_name(m.dbh.quality)}, {"diameter", optional_json(m.dbh.diameter)},
-                                {"centre", {m.dbh.centre.x(), m.dbh.centre.y()}}, {"coverage", m.dbh.coverage}, {"rms", m.dbh.rms},
-                                {"slice_points", m.dbh.slice_points}, {"reason", m.dbh.reason}}},
-                       {"crown", {{"base_height", optional_json(m.crown.base_height)}, {"diameter", optional_json(m.crown.diameter)},
-                                  {"projected_area", optional_json(m.crown.projected_area)}, {"volume", optional_json(m.crown.volume)},
-                                  {"volume_failure", m.crown.volume_failure}}},
+                       {"dbh",
+                        {{"quality", dbh_quality_name(m.dbh.quality)},
+                         {"diameter", optional_json(m.dbh.diameter)},
+                         {"centre", {m.dbh.centre.x(), m.dbh.centre.y()}},
+                         {"coverage", m.dbh.coverage},
+                         {"rms", m.dbh.rms},
+                         {"slice_points", m.dbh.slice_points},
+                         {"reason", m.dbh.reason}}},
+                       {"crown",
+                        {{"base_height", optional_json(m.crown.base_height)},
+                         {"diameter", optional_json(m.crown.diameter)},
+                         {"projected_area", optional_json(m.crown.projected_area)},
+                         {"volume", optional_json(m.crown.volume)},
+                         {"volume_failure", m.crown.volume_failure}}},
                        {"woody_volume", m.woody_volume},
                        {"species_probabilities", m.species_probabilities}};
     record["options_key"] = options_key;

@@ -32,10 +32,10 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
 // A finished tree as the tables show it.
 struct TreeRow {
     TreeMeasures measures;
-    std::string species;                      // voted species; empty without a model
-    std::optional<double> species_confidence; // the tree's own probability of that species
+    std::string species;                       // voted species; empty without a model
+    std::optional<double> species_confidence;  // the tree's own probability of that species
     std::size_t lobes = 0;
-    std::string global_id;                    // the tree's id across a survey (from its stem base; set by the caller)
+    std::string global_id;  // the tree's id across a survey (from its stem base; set by the caller)
 };
 
 // trees.csv: header then one row per tree (global_id first, then the tile's tree_id); global coordinates (origin added) to the millimetre;

@@ -49,7 +49,7 @@ TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& optio
         throw Error(ExitCode::Internal, name + ": one height above ground per point expected");
     if (tree.points.size() < options.min_points)
         throw Error::input(name, std::to_string(tree.points.size()) + " points, fewer than the " + std::to_string(options.min_points) +
-                                     " a tree model needs (--min-tree-points)");
+                                         " a tree model needs (--min-tree-points)");
     TreeOutcome outcome;
     outcome.id = tree.id;
     auto mark = Clock::now();
@@ -94,7 +94,8 @@ std::vector<TreeOutcome> process_trees(std::span<const TreeInput> trees, const T
     // Large trees first: the slowest work starts early, so the last thread does not wait alone.
     std::vector<std::size_t> order(trees.size());
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return trees[a].points.size() > trees[b].points.size(); });
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return trees[a].points.size() > trees[b].points.size(); });
     tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t k) {
         const std::size_t i = order[k];
         TreeProducts products;

@@ -35,10 +35,10 @@ struct JointBoostModel;
 namespace treelobes::forestry {
 
 struct TreeInput {
-    int id = 0;                               // the tree's id in the tile (> 0)
-    PointCloud points;                        // its points: positions in the tile's local frame, the tile's origin
-    std::vector<float> height_above_ground;   // per point, metres
-    Eigen::Vector3d base{0, 0, 0};            // stem base from the segmentation, local frame
+    int id = 0;                              // the tree's id in the tile (> 0)
+    PointCloud points;                       // its points: positions in the tile's local frame, the tile's origin
+    std::vector<float> height_above_ground;  // per point, metres
+    Eigen::Vector3d base{0, 0, 0};           // stem base from the segmentation, local frame
 };
 
 struct TreePipelineOptions {
@@ -49,38 +49,38 @@ struct TreePipelineOptions {
     BranchMeshOptions mesh;
     DbhOptions dbh;
     CrownOptions crown;
-    std::size_t min_points = 50;                      // smaller trees fail ("too few points")
-    const classify::JointBoostModel* model = nullptr; // species probabilities when set
+    std::size_t min_points = 50;                       // smaller trees fail ("too few points")
+    const classify::JointBoostModel* model = nullptr;  // species probabilities when set
     classify::FeatureOptions features;
 };
 
 struct TreeMeasures {
     int id = 0;
-    Eigen::Vector3d position{0, 0, 0};   // stem base, local frame (x, y of the DBH circle when fitted)
-    double height = 0;                   // metres: highest point above the terrain
+    Eigen::Vector3d position{0, 0, 0};  // stem base, local frame (x, y of the DBH circle when fitted)
+    double height = 0;                  // metres: highest point above the terrain
     DbhMeasure dbh;
     CrownMeasure crown;
-    double woody_volume = 0;             // cubic metres, from the skeleton's cylinders
+    double woody_volume = 0;  // cubic metres, from the skeleton's cylinders
     std::size_t points = 0;
     std::vector<double> species_probabilities;  // per model class; empty without a model
 };
 
 // The per-tree files' contents, handed to the caller once and then dropped.
 struct TreeProducts {
-    TreeGraph skeleton;                  // tile origin, radii from the allometry
+    TreeGraph skeleton;  // tile origin, radii from the allometry
     TriangleMesh branches;
-    std::string tlobe;                   // .tlobe bytes
-    std::vector<std::uint8_t> dbf6;      // .dbf6 bytes
+    std::string tlobe;               // .tlobe bytes
+    std::vector<std::uint8_t> dbf6;  // .dbf6 bytes
     std::size_t lobes = 0;
 };
 
 struct TreeOutcome {
     int id = 0;
     bool ok = false;
-    std::string failure;                 // the reason when !ok
+    std::string failure;  // the reason when !ok
     ExitCode failure_code = ExitCode::Ok;
-    TreeMeasures measures;               // valid when ok
-    TreeGraph skeleton;                  // kept for the tile's .forest
+    TreeMeasures measures;                                // valid when ok
+    TreeGraph skeleton;                                   // kept for the tile's .forest
     std::vector<std::pair<std::string, double>> seconds;  // per stage
 };
 

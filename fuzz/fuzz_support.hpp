@@ -18,17 +18,14 @@
 
 namespace treelobes::fuzz {
 
-inline std::string_view as_text(const std::uint8_t* data, std::size_t size) {
-    return {reinterpret_cast<const char*>(data), size};
-}
+inline std::string_view as_text(const std::uint8_t* data, std::size_t size) { return {reinterpret_cast<const char*>(data), size}; }
 
 // Runs `read` and swallows the one exception type that reports bad input.
 template <typename Read>
 void expect_only_input_errors(Read&& read) {
     try {
         read();
-    } catch (const Error&) {
-    }
+    } catch (const Error&) {}
 }
 
 // Readers that take a path get the input as a file with the extension that selects the
@@ -36,7 +33,7 @@ void expect_only_input_errors(Read&& read) {
 // /dev/shm exists; the same path is reused for every input.
 inline std::filesystem::path input_file(std::string_view bytes, const std::string& extension) {
     static const std::filesystem::path folder =
-        std::filesystem::is_directory("/dev/shm") ? std::filesystem::path("/dev/shm") : std::filesystem::temp_directory_path();
+            std::filesystem::is_directory("/dev/shm") ? std::filesystem::path("/dev/shm") : std::filesystem::temp_directory_path();
     const std::filesystem::path path = folder / ("treelobes-fuzz-" + std::to_string(::getpid()) + "." + extension);
     std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
     return path;

@@ -34,9 +34,7 @@ void write_bytes(const fs::path& path, std::string_view bytes) {
     std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
 }
 
-std::string_view as_text(const std::vector<std::uint8_t>& bytes) {
-    return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
-}
+std::string_view as_text(const std::vector<std::uint8_t>& bytes) { return {reinterpret_cast<const char*>(bytes.data()), bytes.size()}; }
 
 // Every `step`-th point, attributes and extra bytes kept.
 PointCloud thinned(const PointCloud& cloud, std::size_t keep) {
@@ -157,8 +155,8 @@ void code_seeds(const fs::path& source, const fs::path& out) {
 // A closed octahedron around `c` with half-size `r`, outward.
 TriangleMesh octahedron(const Eigen::Vector3f& c, float r) {
     TriangleMesh m;
-    m.vertices = {c + Eigen::Vector3f(r, 0, 0), c + Eigen::Vector3f(-r, 0, 0), c + Eigen::Vector3f(0, r, 0),
-                  c + Eigen::Vector3f(0, -r, 0), c + Eigen::Vector3f(0, 0, r), c + Eigen::Vector3f(0, 0, -r)};
+    m.vertices = {c + Eigen::Vector3f(r, 0, 0),  c + Eigen::Vector3f(-r, 0, 0), c + Eigen::Vector3f(0, r, 0),
+                  c + Eigen::Vector3f(0, -r, 0), c + Eigen::Vector3f(0, 0, r),  c + Eigen::Vector3f(0, 0, -r)};
     m.faces = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
     return m;
 }
@@ -202,12 +200,10 @@ void jointboost_seeds(const fs::path& out) {
     options.max_rounds = 6;
     options.route_min_trees = 10;
     options.folds = 2;
-    classify::save_jointboost(classify::train_jointboost(table, labels, {"pine", "birch"}, options),
-                              out / "jointboost/routed.json");
+    classify::save_jointboost(classify::train_jointboost(table, labels, {"pine", "birch"}, options), out / "jointboost/routed.json");
     options.route_by_scan = false;
     options.fold_ensemble = false;
-    classify::save_jointboost(classify::train_jointboost(table, labels, {"pine", "birch"}, options),
-                              out / "jointboost/single.json");
+    classify::save_jointboost(classify::train_jointboost(table, labels, {"pine", "birch"}, options), out / "jointboost/single.json");
 }
 
 // A file with the format-selecting first byte of qsm_fuzz.cpp / export_info_fuzz.cpp.
@@ -251,8 +247,8 @@ int main(int argc, char** argv) {
         return 1;
     }
     const fs::path source = argv[1], out = argv[2];
-    for (const char* target : {"las", "ply_cloud", "skeleton_ply", "text_cloud", "pcd", "mesh", "dbf6", "dbf6_record",
-                               "chain_code", "forest", "forest_record", "tlobe", "tlobe_payload", "jointboost", "qsm", "export_info"})
+    for (const char* target : {"las", "ply_cloud", "skeleton_ply", "text_cloud", "pcd", "mesh", "dbf6", "dbf6_record", "chain_code",
+                               "forest", "forest_record", "tlobe", "tlobe_payload", "jointboost", "qsm", "export_info"})
         fs::create_directories(out / target);
     cloud_seeds(source, out);
     skeleton_and_mesh_seeds(source, out);

@@ -146,7 +146,7 @@ std::vector<Vec3> sample_tangents(const std::vector<Sample>& s) {
 Vec3 any_perpendicular(const Vec3& t) {
     const Vec3 axis = std::abs(t.x()) <= std::abs(t.y()) && std::abs(t.x()) <= std::abs(t.z()) ? Vec3::UnitX()
                       : std::abs(t.y()) <= std::abs(t.z())                                     ? Vec3::UnitY()
-                                                                                                : Vec3::UnitZ();
+                                                                                               : Vec3::UnitZ();
     return t.cross(axis).normalized();
 }
 
@@ -180,8 +180,8 @@ std::vector<Vec3> transport_normals(const std::vector<Sample>& s, const std::vec
 }
 
 // Appends the rings, side quads and caps of one tube.
-void emit_tube(const std::vector<Sample>& s, const std::vector<Vec3>& t, const std::vector<Vec3>& n,
-               const BranchMeshOptions& o, TriangleMesh& mesh) {
+void emit_tube(const std::vector<Sample>& s, const std::vector<Vec3>& t, const std::vector<Vec3>& n, const BranchMeshOptions& o,
+               TriangleMesh& mesh) {
     const int sides = o.sides;
     const int first = static_cast<int>(mesh.vertices.size());
     for (std::size_t i = 0; i < s.size(); ++i) {
@@ -205,7 +205,7 @@ void emit_tube(const std::vector<Sample>& s, const std::vector<Vec3>& t, const s
     mesh.vertices.push_back(s.back().position);
     const std::size_t last = s.size() - 1;
     for (int j = 0; j < sides; ++j) {
-        mesh.faces.push_back({base, v(0, j + 1), v(0, j)});        // faces -T
+        mesh.faces.push_back({base, v(0, j + 1), v(0, j)});       // faces -T
         mesh.faces.push_back({tip, v(last, j), v(last, j + 1)});  // faces +T
     }
 }

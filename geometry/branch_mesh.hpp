@@ -16,12 +16,12 @@
 namespace treelobes {
 
 struct BranchMeshOptions {
-    int sides = 8;              // vertices per ring (3..64)
-    int subdivisions = 2;       // rings per internode along the smooth curve (1 = a ring at each node only)
-    float min_radius = 0.002f;  // metres; smaller radii (twig tips, allometric zeros) are raised to this
-    float radius_scale = 1.0f;  // multiplies every node radius
+    int sides = 8;                 // vertices per ring (3..64)
+    int subdivisions = 2;          // rings per internode along the smooth curve (1 = a ring at each node only)
+    float min_radius = 0.002f;     // metres; smaller radii (twig tips, allometric zeros) are raised to this
+    float radius_scale = 1.0f;     // multiplies every node radius
     float min_axis_radius = 0.0f;  // metres; axes whose base radius is below this are left out (0 = keep all)
-    bool cap_ends = true;       // close each tube at its base and tip
+    bool cap_ends = true;          // close each tube at its base and tip
 };
 
 // Builds the tubes of every axis of `tree` (validated first; Error(InvalidInput) if it is not a

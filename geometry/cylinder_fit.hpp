@@ -11,11 +11,11 @@ namespace treelobes {
 
 struct CylinderFit {
     bool converged = false;
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();      // on the axis, level with the points' centroid
-    Eigen::Vector3d direction = Eigen::Vector3d::UnitZ(); // unit
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();       // on the axis, level with the points' centroid
+    Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();  // unit
     double radius = 0;
-    double rms = 0;       // RMS of |distance to the axis - radius| (metres)
-    double arc = 0;       // degrees around the axis covered by points (360 minus the widest empty gap)
+    double rms = 0;  // RMS of |distance to the axis - radius| (metres)
+    double arc = 0;  // degrees around the axis covered by points (360 minus the widest empty gap)
 };
 
 // Least-squares cylinder (Levenberg-Marquardt over axis position, direction and radius) through

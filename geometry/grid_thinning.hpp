@@ -18,9 +18,7 @@ namespace treelobes {
 template <typename Scalar>
 std::vector<std::size_t> first_point_per_cell(const std::vector<Eigen::Matrix<Scalar, 3, 1>>& points, Scalar cell,
                                               const Eigen::Matrix<Scalar, 3, 1>& anchor = Eigen::Matrix<Scalar, 3, 1>::Zero()) {
-    const auto index = [cell](Scalar v) {
-        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / cell)) & 0x1FFFFF);
-    };
+    const auto index = [cell](Scalar v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v / cell)) & 0x1FFFFF); };
     std::unordered_set<std::uint64_t> seen;
     std::vector<std::size_t> kept;
     for (std::size_t i = 0; i < points.size(); ++i) {

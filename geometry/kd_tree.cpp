@@ -48,8 +48,8 @@ void KdTree::knn(const Eigen::Vector3f& query, int k, std::vector<int>& indices,
     indices.assign(found.begin(), found.end());
 }
 
-void KdTree::radius_search(const Eigen::Vector3f& query, float radius, std::vector<int>& indices,
-                           std::vector<float>& squared_distances, std::size_t max_results) const {
+void KdTree::radius_search(const Eigen::Vector3f& query, float radius, std::vector<int>& indices, std::vector<float>& squared_distances,
+                           std::size_t max_results) const {
     indices.clear();
     squared_distances.clear();
     if (!impl_->index || !(radius > 0.0f)) return;

@@ -29,8 +29,8 @@ public:
     void knn(const Eigen::Vector3f& query, int k, std::vector<int>& indices, std::vector<float>& squared_distances) const;
     // Every point strictly closer than `radius`, nearest first; at most `max_results` of the
     // nearest when max_results > 0.
-    void radius_search(const Eigen::Vector3f& query, float radius, std::vector<int>& indices,
-                       std::vector<float>& squared_distances, std::size_t max_results = 0) const;
+    void radius_search(const Eigen::Vector3f& query, float radius, std::vector<int>& indices, std::vector<float>& squared_distances,
+                       std::size_t max_results = 0) const;
     // Index of the nearest point (-1 for an empty index).
     int nearest(const Eigen::Vector3f& query, float* squared_distance = nullptr) const;
 

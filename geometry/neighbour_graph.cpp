@@ -150,8 +150,8 @@ void large_component_bridges(std::span<const Eigen::Vector3f> points, const std:
         std::vector<int> foreign;
         std::vector<Eigen::Vector3f> foreign_points;
         for (std::size_t q = 0; q < points.size(); ++q)
-            if (label[q] != static_cast<int>(c) && label[q] != static_cast<int>(largest) &&
-                (points[q].array() >= low.array()).all() && (points[q].array() <= high.array()).all()) {
+            if (label[q] != static_cast<int>(c) && label[q] != static_cast<int>(largest) && (points[q].array() >= low.array()).all() &&
+                (points[q].array() <= high.array()).all()) {
                 foreign.push_back(static_cast<int>(q));
                 foreign_points.push_back(points[q]);
             }
@@ -225,10 +225,9 @@ float bridge_cost(const Eigen::Vector3f& from, const Eigen::Vector3f& to, std::s
 // of its ends when that is cheaper. Candidates lie within the shortest bridge's cost of an end
 // (no farther point can be cheaper).
 void directed_bridges(std::span<const Eigen::Vector3f> points, const KdTree& tree, const std::vector<int>& label,
-                      const std::vector<std::vector<int>>& members, std::size_t largest, float weight,
-                      std::vector<Candidate>& best) {
-    constexpr std::size_t kMinPoints = 5;      // a few samples of a sparse twig already show its direction
-    constexpr double kMinElongation = 9.0;     // length at least 3 times the width
+                      const std::vector<std::vector<int>>& members, std::size_t largest, float weight, std::vector<Candidate>& best) {
+    constexpr std::size_t kMinPoints = 5;   // a few samples of a sparse twig already show its direction
+    constexpr double kMinElongation = 9.0;  // length at least 3 times the width
     constexpr std::size_t kMaxCandidates = 4096;
     std::vector<int> found;
     std::vector<float> d2;
@@ -326,8 +325,8 @@ NeighbourGraph to_compressed_rows(std::span<const Eigen::Vector3f> points, const
 
 }  // namespace
 
-NeighbourGraph build_neighbour_graph(std::span<const Eigen::Vector3f> points, const NeighbourGraphOptions& options,
-                                     const KdTree* tree, const KnnTable* given) {
+NeighbourGraph build_neighbour_graph(std::span<const Eigen::Vector3f> points, const NeighbourGraphOptions& options, const KdTree* tree,
+                                     const KnnTable* given) {
     if (options.neighbours < 2 || options.neighbours > 64)
         throw Error::usage("neighbour graph: neighbours must be in 2..64, got " + std::to_string(options.neighbours));
     if (!(options.beta > 0.0) || !std::isfinite(options.beta)) throw Error::usage("neighbour graph: beta must be > 0");
@@ -370,8 +369,8 @@ NeighbourGraph build_neighbour_graph(std::span<const Eigen::Vector3f> points, co
     graph.longest_bridge = longest;
     const auto t3 = std::chrono::steady_clock::now();
     auto seconds = [](auto a, auto b) { return std::to_string(std::chrono::duration<double>(b - a).count()); };
-    log_debug("neighbour graph: kNN edges " + seconds(t0, t1) + " s, bridging " + seconds(t1, t2) + " s (" +
-              std::to_string(components) + " pieces), rows " + seconds(t2, t3) + " s");
+    log_debug("neighbour graph: kNN edges " + seconds(t0, t1) + " s, bridging " + seconds(t1, t2) + " s (" + std::to_string(components) +
+              " pieces), rows " + seconds(t2, t3) + " s");
     return graph;
 }
 

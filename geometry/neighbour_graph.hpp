@@ -15,12 +15,12 @@ namespace treelobes {
 class KdTree;
 
 struct NeighbourGraphOptions {
-    int neighbours = 10;          // k of the kNN graph (2..64)
-    double beta = 1.0;            // edge weight exponent (species parameter, Livny et al. 2011, Table 1)
-    float max_edge_length = 0.0f; // metres; longer kNN edges are dropped before bridging (0 = gap_factor x spacing)
-    bool join_components = true;  // add bridging edges until the graph is connected
-    float gap_factor = 10.0f;     // automatic max_edge_length in median nearest-neighbour distances: a clump
-                                  // of fewer than k points must not reach across a gap with kNN edges
+    int neighbours = 10;            // k of the kNN graph (2..64)
+    double beta = 1.0;              // edge weight exponent (species parameter, Livny et al. 2011, Table 1)
+    float max_edge_length = 0.0f;   // metres; longer kNN edges are dropped before bridging (0 = gap_factor x spacing)
+    bool join_components = true;    // add bridging edges until the graph is connected
+    float gap_factor = 10.0f;       // automatic max_edge_length in median nearest-neighbour distances: a clump
+                                    // of fewer than k points must not reach across a gap with kNN edges
     float direction_weight = 0.0f;  // > 0: an elongated piece joins where its own axis leads (see bridge_cost), 0 = shortest bridges
 };
 
@@ -29,11 +29,11 @@ struct NeighbourGraphOptions {
 struct NeighbourGraph {
     std::vector<std::uint32_t> offsets;
     std::vector<int> targets;
-    std::vector<float> lengths;  // Euclidean edge length (metres)
-    std::vector<float> weights;  // length^beta
-    std::size_t components = 0;  // connected pieces before bridging
-    std::size_t bridges = 0;     // bridging edges added
-    float longest_bridge = 0.0f; // metres
+    std::vector<float> lengths;   // Euclidean edge length (metres)
+    std::vector<float> weights;   // length^beta
+    std::size_t components = 0;   // connected pieces before bridging
+    std::size_t bridges = 0;      // bridging edges added
+    float longest_bridge = 0.0f;  // metres
 
     std::size_t vertex_count() const { return offsets.empty() ? 0 : offsets.size() - 1; }
     std::size_t edge_count() const { return targets.size() / 2; }

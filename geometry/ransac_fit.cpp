@@ -98,8 +98,7 @@ PlaneFit fit_plane(std::span<const Eigen::Vector3f> points, float threshold, int
     return fit;
 }
 
-CircleFit fit_circle(std::span<const Eigen::Vector2f> points, float threshold, float min_radius, float max_radius,
-                     int max_iterations) {
+CircleFit fit_circle(std::span<const Eigen::Vector2f> points, float threshold, float min_radius, float max_radius, int max_iterations) {
     CircleFit fit;
     if (points.size() < 5) return fit;
     silence_pcl_console();

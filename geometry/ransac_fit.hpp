@@ -23,16 +23,15 @@ struct PlaneFit {
 // RANSAC plane with inlier band `threshold` (metres). ok = false with fewer than 3 points or no model.
 // max_tilt_degrees > 0 only accepts planes whose normal is within that angle of the z axis
 // (ground: a dense stem face must not win).
-PlaneFit fit_plane(std::span<const Eigen::Vector3f> points, float threshold, int max_iterations = 1000,
-                   float max_tilt_degrees = 0.0f);
+PlaneFit fit_plane(std::span<const Eigen::Vector3f> points, float threshold, int max_iterations = 1000, float max_tilt_degrees = 0.0f);
 
 struct CircleFit {
     bool ok = false;
     Eigen::Vector2f centre{0, 0};
     float radius = 0.0f;
-    float rms = 0.0f;            // RMS of |distance to centre - radius| over the inliers (metres)
+    float rms = 0.0f;  // RMS of |distance to centre - radius| over the inliers (metres)
     std::size_t inliers = 0;
-    float coverage = 0.0f;       // fraction of 10-degree sectors around the centre holding inliers
+    float coverage = 0.0f;  // fraction of 10-degree sectors around the centre holding inliers
 };
 
 // RANSAC circle (radius limited to [min_radius, max_radius]) refined by geometric least

@@ -23,10 +23,10 @@ struct AlphaShapeOptions {
 };
 
 struct AlphaShapeResult {
-    TriangleMesh mesh;               // closed 2-manifold, outward; empty when `failure` is set
-    double alpha_min_radius = 0.0;   // ball radius of CGAL's optimal alpha (metres)
-    double alpha_radius = 0.0;       // alpha_factor * alpha_min_radius
-    std::string failure;             // why there is no shape ("all points on one plane", ...)
+    TriangleMesh mesh;              // closed 2-manifold, outward; empty when `failure` is set
+    double alpha_min_radius = 0.0;  // ball radius of CGAL's optimal alpha (metres)
+    double alpha_radius = 0.0;      // alpha_factor * alpha_min_radius
+    std::string failure;            // why there is no shape ("all points on one plane", ...)
 };
 
 // Regularized alpha shape of `points` (local coordinates; the mesh gets origin 0, i.e. the same
@@ -34,9 +34,9 @@ struct AlphaShapeResult {
 AlphaShapeResult alpha_shape(std::span<const Eigen::Vector3f> points, const AlphaShapeOptions& options = {});
 
 struct SimplifyOptions {
-    double tolerance = 0.03;       // metres: collapses whose quadric error exceeds tolerance^2 stop...
-    std::size_t max_faces = 400;   // ... unless the mesh still has more faces than this
-    std::size_t min_faces = 8;     // never below (a tetrahedron has 4)
+    double tolerance = 0.03;      // metres: collapses whose quadric error exceeds tolerance^2 stop...
+    std::size_t max_faces = 400;  // ... unless the mesh still has more faces than this
+    std::size_t min_faces = 8;    // never below (a tetrahedron has 4)
 };
 
 // Garland-Heckbert edge collapse of a closed 2-manifold; the result is checked to be closed

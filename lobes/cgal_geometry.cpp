@@ -47,9 +47,7 @@ using AlphaTds = CGAL::Triangulation_data_structure_3<AlphaVertex, AlphaCell>;
 using Delaunay = CGAL::Delaunay_triangulation_3<K, AlphaTds, CGAL::Fast_location>;
 using AlphaShape3 = CGAL::Alpha_shape_3<Delaunay>;
 
-Eigen::Vector3f to_eigen(const Point& p) {
-    return {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
-}
+Eigen::Vector3f to_eigen(const Point& p) { return {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())}; }
 
 // The regular facets (between a solid and an empty cell) as triangles seen from the solid
 // cell's outside: the opposite vertex of the solid cell lies behind each triangle. The

@@ -58,9 +58,8 @@ bool pair_fan(const TriangleMesh& mesh, int a, int b, const EdgeFan& fan, std::v
     };
     for (int h : fan.forward) add(h, false);
     for (int h : fan.backward) add(h, true);
-    std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
-        return x.angle != y.angle ? x.angle < y.angle : x.half_edge < y.half_edge;
-    });
+    std::sort(entries.begin(), entries.end(),
+              [](const Entry& x, const Entry& y) { return x.angle != y.angle ? x.angle < y.angle : x.half_edge < y.half_edge; });
     const std::size_t n = entries.size();
     for (std::size_t i = 0; i < n; ++i)
         if (entries[i].backward == entries[(i + 1) % n].backward) return false;
@@ -103,7 +102,7 @@ void split_vertex_fans(TriangleMesh& mesh, const std::vector<int>& opposite) {
             visited[h] = 1;
             faces[h / 3][h % 3] = copy;
             const int previous = (h / 3) * 3 + (h % 3 + 2) % 3;  // ends at `vertex`
-            h = opposite[previous];                               // starts at `vertex`
+            h = opposite[previous];                              // starts at `vertex`
         } while (h != start && h >= 0 && !visited[h]);
     }
     mesh.faces = std::move(faces);

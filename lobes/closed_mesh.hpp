@@ -18,9 +18,9 @@
 namespace treelobes::lobes {
 
 struct ClosedMeshReport {
-    std::size_t unpaired_half_edges = 0;   // half-edges without an opposite (holes, flipped faces)
-    std::size_t repeated_half_edges = 0;   // directed edges used by more than one face (non-manifold)
-    std::size_t degenerate_faces = 0;      // faces repeating a vertex index
+    std::size_t unpaired_half_edges = 0;  // half-edges without an opposite (holes, flipped faces)
+    std::size_t repeated_half_edges = 0;  // directed edges used by more than one face (non-manifold)
+    std::size_t degenerate_faces = 0;     // faces repeating a vertex index
     bool closed() const { return unpaired_half_edges == 0 && repeated_half_edges == 0 && degenerate_faces == 0; }
 };
 

@@ -19,14 +19,11 @@ float segment_distance(const Eigen::Vector3f& p, const Eigen::Vector3f& a, const
 
 }  // namespace
 
-std::size_t EdgeConfidence::low_count() const {
-    return static_cast<std::size_t>(std::count(low.begin(), low.end(), 1));
-}
+std::size_t EdgeConfidence::low_count() const { return static_cast<std::size_t>(std::count(low.begin(), low.end(), 1)); }
 
-EdgeConfidence edge_confidence(const TreeGraph& tree, std::span<const Eigen::Vector3f> points,
-                               std::span<const int> point_internode, std::span<const float> lobe_diameter) {
-    if (point_internode.size() != points.size())
-        throw Error::usage("edge confidence: one internode per point expected");
+EdgeConfidence edge_confidence(const TreeGraph& tree, std::span<const Eigen::Vector3f> points, std::span<const int> point_internode,
+                               std::span<const float> lobe_diameter) {
+    if (point_internode.size() != points.size()) throw Error::usage("edge confidence: one internode per point expected");
     if (lobe_diameter.size() != tree.size()) throw Error::usage("edge confidence: one d' per skeleton node expected");
     const std::size_t n = tree.size();
     EdgeConfidence c;
@@ -55,8 +52,7 @@ EdgeConfidence edge_confidence(const TreeGraph& tree, std::span<const Eigen::Vec
     return c;
 }
 
-MainSplit split_at_low_confidence(const TreeGraph& tree, const EdgeConfidence& confidence,
-                                  std::span<const int> point_internode) {
+MainSplit split_at_low_confidence(const TreeGraph& tree, const EdgeConfidence& confidence, std::span<const int> point_internode) {
     MainSplit split;
     split.main.assign(tree.size(), 0);
     if (tree.empty()) return split;

@@ -33,14 +33,14 @@ struct EdgeConfidence {
 
 // `point_internode[i]` is the node at the upper end of point i's internode, -1 for points the
 // skeleton left out; `lobe_diameter` is d'(u) per node. Throws Error(Usage) on size mismatches.
-EdgeConfidence edge_confidence(const TreeGraph& tree, std::span<const Eigen::Vector3f> points,
-                               std::span<const int> point_internode, std::span<const float> lobe_diameter);
+EdgeConfidence edge_confidence(const TreeGraph& tree, std::span<const Eigen::Vector3f> points, std::span<const int> point_internode,
+                               std::span<const float> lobe_diameter);
 
 struct LobeCluster {
-    int seed_node = -1;        // p_i: lower end of the low-confidence edge (on the main structure)
-    int first_node = -1;       // upper end of the low-confidence edge: the cluster's subtree root
-    std::vector<int> nodes;    // the subtree of first_node, pre-order
-    std::vector<int> points;   // indices of the points assigned to those nodes, ascending
+    int seed_node = -1;       // p_i: lower end of the low-confidence edge (on the main structure)
+    int first_node = -1;      // upper end of the low-confidence edge: the cluster's subtree root
+    std::vector<int> nodes;   // the subtree of first_node, pre-order
+    std::vector<int> points;  // indices of the points assigned to those nodes, ascending
 };
 
 struct MainSplit {
@@ -48,7 +48,6 @@ struct MainSplit {
     std::vector<LobeCluster> clusters;  // in pre-order of first_node
 };
 
-MainSplit split_at_low_confidence(const TreeGraph& tree, const EdgeConfidence& confidence,
-                                  std::span<const int> point_internode);
+MainSplit split_at_low_confidence(const TreeGraph& tree, const EdgeConfidence& confidence, std::span<const int> point_internode);
 
 }  // namespace treelobes::lobes

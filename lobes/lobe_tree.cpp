@@ -106,10 +106,9 @@ std::size_t attach_dropped_points(const PointCloud& cloud, const std::vector<int
 
 }  // namespace
 
-LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, const ReconstructOptions& ro,
-                         const std::string& species, const LobeOptions& o, LobeReport* report_out) {
-    if (o.min_lobe_faces < 4 || o.max_lobe_faces < o.min_lobe_faces)
-        throw Error::usage("lobes: face limits must satisfy 4 <= min <= max");
+LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, const ReconstructOptions& ro, const std::string& species,
+                         const LobeOptions& o, LobeReport* report_out) {
+    if (o.min_lobe_faces < 4 || o.max_lobe_faces < o.min_lobe_faces) throw Error::usage("lobes: face limits must satisfy 4 <= min <= max");
     if (r.point_internode.size() != cloud.size()) throw Error::usage("lobes: the reconstruction belongs to another cloud");
     LobeReport report;
     StageClock clock(report.seconds);

@@ -21,24 +21,24 @@
 namespace treelobes::lobes {
 
 struct Lobe {
-    TriangleMesh mesh;                  // closed 2-manifold, outward, in the tree's frame (origin 0)
-    int seed_node = -1;                 // p_i as a node of LobeTree::skeleton
-    Eigen::Vector3f seed_direction{0, 0, 1};  // unit vector from p_i toward the cluster's centroid
-    std::size_t points = 0;             // points of cluster C_i
+    TriangleMesh mesh;                            // closed 2-manifold, outward, in the tree's frame (origin 0)
+    int seed_node = -1;                           // p_i as a node of LobeTree::skeleton
+    Eigen::Vector3f seed_direction{0, 0, 1};      // unit vector from p_i toward the cluster's centroid
+    std::size_t points = 0;                       // points of cluster C_i
     std::vector<Eigen::Vector3f> cluster_points;  // C_i in the tree's frame, plus the nearby points the
                                                   // reconstruction dropped as outliers; not stored: the .tlobe
                                                   // keeps their occupancy, on a grid sized to the file budget
-    Occupancy occupancy;                // read from a .tlobe (empty when the file had no room for it)
+    Occupancy occupancy;                          // read from a .tlobe (empty when the file had no room for it)
     double volume() const { return mesh.signed_volume(); }
     double area() const { return mesh.area(); }
 };
 
 struct LobeTree {
-    TreeGraph skeleton;                 // main branching structure; radius = d(u)/2 (Livny et al. 2011, Eq. 1)
-    std::string species;                // may be empty (no species given)
+    TreeGraph skeleton;                        // main branching structure; radius = d(u)/2 (Livny et al. 2011, Eq. 1)
+    std::string species;                       // may be empty (no species given)
     double beta = 1.5, gamma = 1.5, fs = 1.0;  // Livny et al. 2011, Table 1 parameters used
     double alpha_factor = 5.0;
-    double root_diameter = 0.0;         // d_root (metres)
+    double root_diameter = 0.0;  // d_root (metres)
     std::vector<Lobe> lobes;
 
     // Seed point p_i of a lobe: position, thickness (d at p_i) and direction.
@@ -47,24 +47,24 @@ struct LobeTree {
 };
 
 struct LobeOptions {
-    AlphaShapeOptions alpha;            // alpha = alpha_factor * alpha_min (default 5)
+    AlphaShapeOptions alpha;              // alpha = alpha_factor * alpha_min (default 5)
     std::size_t min_cluster_points = 30;  // smaller clusters stay on the skeleton as branches
     std::size_t max_shape_points = 6000;  // larger clusters are thinned on a grid before the alpha shape
-    std::size_t face_budget = 12000;    // faces over all lobes after simplification, shared by area
-    std::size_t max_lobe_faces = 600;   // per lobe, at most
-    std::size_t min_lobe_faces = 12;    // per lobe, at least (when the alpha shape has more)
-    double simplify_tolerance = 0.02;   // metres: collapses below this error always happen
-    double dropped_point_reach = 0.0;   // metres: outliers this close to a cluster join its occupancy (0 = off:
-                                        // the larger occupancy takes coarser cells, docs/lobes.md)
+    std::size_t face_budget = 12000;      // faces over all lobes after simplification, shared by area
+    std::size_t max_lobe_faces = 600;     // per lobe, at most
+    std::size_t min_lobe_faces = 12;      // per lobe, at least (when the alpha shape has more)
+    double simplify_tolerance = 0.02;     // metres: collapses below this error always happen
+    double dropped_point_reach = 0.0;     // metres: outliers this close to a cluster join its occupancy (0 = off:
+                                          // the larger occupancy takes coarser cells, docs/lobes.md)
 };
 
 struct LobeReport {
     std::size_t low_confidence_edges = 0;
-    std::size_t clusters = 0;           // before the fallbacks below
-    std::size_t kept_small = 0;         // clusters under min_cluster_points kept as branches
-    std::size_t kept_no_shape = 0;      // clusters without a 3D alpha shape (flat, collinear) kept as branches
-    std::size_t lobe_points = 0;        // points inside lobes
-    std::size_t main_points = 0;        // points on the main structure
+    std::size_t clusters = 0;                 // before the fallbacks below
+    std::size_t kept_small = 0;               // clusters under min_cluster_points kept as branches
+    std::size_t kept_no_shape = 0;            // clusters without a 3D alpha shape (flat, collinear) kept as branches
+    std::size_t lobe_points = 0;              // points inside lobes
+    std::size_t main_points = 0;              // points on the main structure
     std::size_t dropped_points_attached = 0;  // outliers added to lobes' occupancy points
     std::size_t faces_before_simplification = 0;
     std::vector<std::pair<std::string, double>> seconds;
@@ -73,7 +73,7 @@ struct LobeReport {
 // `cloud` is the cloud `reconstruction` was made from (its point_internode indexes it).
 // `species` and the parameters in `reconstruction_options` are recorded in the result.
 LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& reconstruction,
-                         const ReconstructOptions& reconstruction_options, const std::string& species,
-                         const LobeOptions& options = {}, LobeReport* report = nullptr);
+                         const ReconstructOptions& reconstruction_options, const std::string& species, const LobeOptions& options = {},
+                         LobeReport* report = nullptr);
 
 }  // namespace treelobes::lobes

@@ -10,7 +10,9 @@ DistanceSummary summarise_distances(std::vector<float> distances) {
     s.count = distances.size();
     if (distances.empty()) return s;
     std::sort(distances.begin(), distances.end());
-    const auto at = [&](double q) { return static_cast<double>(distances[static_cast<std::size_t>(q * static_cast<double>(distances.size() - 1) + 0.5)]); };
+    const auto at = [&](double q) {
+        return static_cast<double>(distances[static_cast<std::size_t>(q * static_cast<double>(distances.size() - 1) + 0.5)]);
+    };
     s.mean = std::accumulate(distances.begin(), distances.end(), 0.0) / static_cast<double>(distances.size());
     s.median = at(0.5);
     s.p95 = at(0.95);

@@ -20,10 +20,10 @@ class ByteWriter;
 class ByteReader;
 
 struct Occupancy {
-    float cell = 0;                            // metres; 0 = no occupancy recorded
+    float cell = 0;                              // metres; 0 = no occupancy recorded
     std::array<std::int64_t, 3> first{0, 0, 0};  // index of the grid's first cell
     std::array<std::int64_t, 3> size{0, 0, 0};   // cells along x, y, z
-    std::vector<std::uint8_t> bits;            // 1 = the cell held a point; size[0]*size[1]*size[2] entries
+    std::vector<std::uint8_t> bits;              // 1 = the cell held a point; size[0]*size[1]*size[2] entries
 
     bool empty() const { return cell <= 0 || bits.empty(); }
     bool occupied(const Eigen::Vector3f& p) const;

@@ -16,15 +16,16 @@ namespace treelobes::lobes {
 
 namespace {
 
-constexpr int kMaxChainsPerBranchlet = 60;   // thick chains first (breadth-first); bounds the library
-constexpr float kLeafyThickness = 0.02f;     // leaves grow on twigs thinner than this (metres)
-constexpr float kChildThicknessRatio = 0.6f; // t' = ratio * #InitThickness * t at the fork
+constexpr int kMaxChainsPerBranchlet = 60;    // thick chains first (breadth-first); bounds the library
+constexpr float kLeafyThickness = 0.02f;      // leaves grow on twigs thinner than this (metres)
+constexpr float kChildThicknessRatio = 0.6f;  // t' = ratio * #InitThickness * t at the fork
 
 float radians(double degrees) { return static_cast<float>(degrees * std::numbers::pi / 180.0); }
 
 // A unit vector perpendicular to v, turned by `spin` around v (the spiral angle).
 Eigen::Vector3f perpendicular(const Eigen::Vector3f& v, float spin) {
-    Eigen::Vector3f side = std::abs(v.z()) < 0.95f ? Eigen::Vector3f(v.cross(Eigen::Vector3f::UnitZ())) : Eigen::Vector3f(v.cross(Eigen::Vector3f::UnitX()));
+    Eigen::Vector3f side = std::abs(v.z()) < 0.95f ? Eigen::Vector3f(v.cross(Eigen::Vector3f::UnitZ()))
+                                                   : Eigen::Vector3f(v.cross(Eigen::Vector3f::UnitX()));
     side.normalize();
     return Eigen::AngleAxisf(spin, v) * side;
 }
@@ -91,8 +92,7 @@ std::vector<PatchSegment> simplify_axis(const std::vector<PatchSegment>& segment
 }
 
 // Seed(t, v): one chain of #ChainPts segments with its leaves and new seeds (docking points).
-Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLibraryOptions& o, Rng& rng,
-                 std::vector<Seed>& new_seeds) {
+Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLibraryOptions& o, Rng& rng, std::vector<Seed>& new_seeds) {
     const PatchProfile& pp = profile.patch;
     const LeafProfile& leaf = profile.growth.leaves;
     const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
@@ -124,8 +124,8 @@ Patch grow_chain(const Seed& seed, const SpeciesProfile& profile, const PatchLib
                 if (normal.norm() < 1e-4f) normal = perpendicular(d, 0);
                 const float size = static_cast<float>(1.0 + rng.uniform(-leaf.size_v, leaf.size_v));
                 for (int c = 0; c < std::max(1, leaf.cluster); ++c)
-                    patch.leaves.push_back({b, d, normal.normalized(), static_cast<float>(leaf.length_m) * size,
-                                            static_cast<float>(leaf.width_m) * size});
+                    patch.leaves.push_back(
+                            {b, d, normal.normalized(), static_cast<float>(leaf.length_m) * size, static_cast<float>(leaf.width_m) * size});
             }
         }
         // Transf(v, #Phototropism, #Gravitropism), with a little random bending.
@@ -174,8 +174,8 @@ float Patch::length() const {
 
 PatchLibrary build_patch_library(const SpeciesProfile& profile, const PatchLibraryOptions& o) {
     if (o.branchlets < 1 || o.branchlets > 1000) throw Error::usage("patch library: branchlets must be 1..1000");
-    if (!(o.min_root_thickness > 0 && o.max_root_thickness >= o.min_root_thickness && o.min_twig_thickness > 0 &&
-          o.segment_length > 0 && o.simplify_tolerance >= 0))
+    if (!(o.min_root_thickness > 0 && o.max_root_thickness >= o.min_root_thickness && o.min_twig_thickness > 0 && o.segment_length > 0 &&
+          o.simplify_tolerance >= 0))
         throw Error::usage("patch library: thicknesses and segment length must be positive (min <= max), the simplify tolerance >= 0");
     PatchLibrary library;
     library.species = profile.entry.name;

@@ -46,19 +46,19 @@ struct Patch {
     float root_thickness = 0;                 // diameter at the root (metres)
     Eigen::Vector3f root_direction{0, 0, 1};  // unit
     std::vector<PatchSegment> segments;
-    std::vector<PatchLeaf> leaves;            // shuffled: any prefix is a uniform subsample (LOD)
+    std::vector<PatchLeaf> leaves;  // shuffled: any prefix is a uniform subsample (LOD)
     std::vector<DockingPoint> docks;
-    int branchlet = 0;                        // the complete branchlet it was cut from
-    float step = 0;                           // segment length it was grown with (before simplifying)
-    float length() const;                     // along its segments
+    int branchlet = 0;     // the complete branchlet it was cut from
+    float step = 0;        // segment length it was grown with (before simplifying)
+    float length() const;  // along its segments
 };
 
 struct PatchLibraryOptions {
-    int branchlets = 24;               // Livny et al. 2011: 20-30 per species
-    double min_root_thickness = 0.004; // metres
+    int branchlets = 24;                // Livny et al. 2011: 20-30 per species
+    double min_root_thickness = 0.004;  // metres
     double max_root_thickness = 0.08;
-    double min_twig_thickness = 0.002; // no seeds (docking points) thinner than this
-    double segment_length = 4.0;       // segment length per unit root thickness of its chain
+    double min_twig_thickness = 0.002;  // no seeds (docking points) thinner than this
+    double segment_length = 4.0;        // segment length per unit root thickness of its chain
     // Douglas-Peucker tolerance of a chain's axis, per unit root thickness of the chain: nearly
     // collinear segments are merged once, so a patch draws fewer twig prisms (0 = off). Leaves and
     // docking points keep their grown positions, within this distance of the simplified axis.

@@ -81,7 +81,8 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
         const Lobe& lobe = tree.lobes[i];
         fill_volume[i] = std::max(lobe.volume(), 0.0);
         if (!lobe.occupancy.empty())
-            fill_volume[i] = std::min(fill_volume[i], static_cast<double>(lobe.occupancy.occupied_count()) * std::pow(static_cast<double>(lobe.occupancy.cell), 3));
+            fill_volume[i] = std::min(fill_volume[i], static_cast<double>(lobe.occupancy.occupied_count()) *
+                                                              std::pow(static_cast<double>(lobe.occupancy.cell), 3));
         total_volume += fill_volume[i];
     }
     // Triangles per patch, on average over the library. Leafy species (compound leaves,
@@ -125,7 +126,8 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
         // half-way; with about kCellsPerPatch cells per patch, docking points in filled parts
         // are dropped and the patches spread over the whole lobe (measured: 1 cell per patch
         // leaves budget unspent, 4 leaves small lobes sparse).
-        const double patches = std::min(static_cast<double>(o.texturing.max_patches_per_lobe), static_cast<double>(triangles) / mean_triangles);
+        const double patches =
+                std::min(static_cast<double>(o.texturing.max_patches_per_lobe), static_cast<double>(triangles) / mean_triangles);
         lobe_options.max_fill_cells = std::min(o.texturing.max_fill_cells, std::max(1.0, kCellsPerPatch * patches));
         out.lobes[i] = texture_lobe(lobe.mesh, seed, out.library, lobe_options, i, &lobe.occupancy);
     };
@@ -165,7 +167,8 @@ SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textu
     if (n >= 2) {
         std::vector<int> nodes(n - 1);
         std::iota(nodes.begin(), nodes.end(), 1);
-        std::stable_sort(nodes.begin(), nodes.end(), [&](int a, int b) { return tree.skeleton.nodes[a].radius > tree.skeleton.nodes[b].radius; });
+        std::stable_sort(nodes.begin(), nodes.end(),
+                         [&](int a, int b) { return tree.skeleton.nodes[a].radius > tree.skeleton.nodes[b].radius; });
         std::vector<bool> keep(n, false);
         keep[0] = true;
         out.skeleton_edges = std::max<std::size_t>(1, prefix(fraction, nodes.size()));

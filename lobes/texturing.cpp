@@ -188,7 +188,8 @@ void check_texturing(const PatchLibrary& library, const TexturingOptions& o) {
 double fill_cell_size(const TriangleMesh& lobe, const TexturingOptions& o, const Occupancy* occupancy) {
     double fill_volume = std::max(lobe.signed_volume(), 0.0);
     if (occupancy != nullptr)
-        fill_volume = std::min(fill_volume, static_cast<double>(occupancy->occupied_count()) * std::pow(static_cast<double>(occupancy->cell), 3));
+        fill_volume =
+                std::min(fill_volume, static_cast<double>(occupancy->occupied_count()) * std::pow(static_cast<double>(occupancy->cell), 3));
     return std::max(o.fill_cell, std::cbrt(fill_volume / o.max_fill_cells));
 }
 
@@ -243,11 +244,15 @@ class LobeTexturer {
 public:
     LobeTexturer(const TriangleMesh& lobe, const PatchLibrary& library, const TexturingOptions& o, std::uint64_t stream,
                  const Occupancy* occupancy)
-        : library_(library), o_(o), volume_(lobe, 40), cell_(fill_cell_size(lobe, o, occupied_or_null(occupancy))),
-          fill_grid_(LobeVolume::with_cell_size(lobe, static_cast<float>(cell_))),
-          target_(fill_targets(fill_grid_, occupied_or_null(occupancy))), filled_(fill_grid_.cell_count(), 0),
-          fill_total_(std::max(1, static_cast<int>(std::count(target_.begin(), target_.end(), 1)))),
-          rng_(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17) {
+            : library_(library),
+              o_(o),
+              volume_(lobe, 40),
+              cell_(fill_cell_size(lobe, o, occupied_or_null(occupancy))),
+              fill_grid_(LobeVolume::with_cell_size(lobe, static_cast<float>(cell_))),
+              target_(fill_targets(fill_grid_, occupied_or_null(occupancy))),
+              filled_(fill_grid_.cell_count(), 0),
+              fill_total_(std::max(1, static_cast<int>(std::count(target_.begin(), target_.end(), 1)))),
+              rng_(o.seed * 0x2545f4914f6cdd1dULL + stream * 0x9e3779b97f4a7c15ULL + 17) {
         texture_.target_cells = static_cast<std::size_t>(fill_total_);
         samples_.resize(library.patches.size());
         fit_samples_.resize(library.patches.size());
@@ -411,8 +416,8 @@ private:
 
 }  // namespace
 
-LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library,
-                         const TexturingOptions& o, std::uint64_t stream, const Occupancy* occupancy) {
+LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library, const TexturingOptions& o,
+                         std::uint64_t stream, const Occupancy* occupancy) {
     check_texturing(library, o);
     return LobeTexturer(lobe, library, o, stream, occupancy).run(seed);
 }

@@ -68,11 +68,11 @@ private:
 
 struct TexturingOptions {
     std::uint64_t seed = 1;
-    int candidates = 8;                 // patches fitted per docking point
+    int candidates = 8;                         // patches fitted per docking point
     std::size_t max_patches_per_lobe = 100000;  // a safety bound; the triangle budget governs
-    std::size_t max_triangles = SIZE_MAX;  // a hard bound: patches are placed only while their triangles
-                                           // (patch_triangles with the two values below) fit
-    int twig_sides = 3;                    // as the synthesized mesh draws the patches
+    std::size_t max_triangles = SIZE_MAX;       // a hard bound: patches are placed only while their triangles
+                                                // (patch_triangles with the two values below) fit
+    int twig_sides = 3;                         // as the synthesized mesh draws the patches
     double leaf_share = 1;
     double fill_cell = 0.04;            // metres: edge of the fill cells at least ...
     double max_fill_cells = 60000;      // ... enlarged so that a lobe has at most about this many
@@ -92,18 +92,18 @@ struct PatchInstance {
 struct LobeTexture {
     std::vector<PatchInstance> instances;
     std::size_t docks_used = 0;
-    std::size_t docks_outside = 0;     // docking points outside the lobe, not used
-    std::size_t docks_redundant = 0;   // docking points whose best patch reaches no cell short of patches
+    std::size_t docks_outside = 0;    // docking points outside the lobe, not used
+    std::size_t docks_redundant = 0;  // docking points whose best patch reaches no cell short of patches
     std::size_t reseeds = 0;
-    double filled = 0;                 // fraction of lobe cells (occupied ones, with an occupancy) reached
-    std::size_t triangles = 0;         // of the placed patches (patch_triangles), <= max_triangles
-    bool budget_spent = false;         // stopped by max_triangles or max_patches_per_lobe, not by the fill
-    std::size_t target_cells = 0;      // fill cells to be reached
+    double filled = 0;             // fraction of lobe cells (occupied ones, with an occupancy) reached
+    std::size_t triangles = 0;     // of the placed patches (patch_triangles), <= max_triangles
+    bool budget_spent = false;     // stopped by max_triangles or max_patches_per_lobe, not by the fill
+    std::size_t target_cells = 0;  // fill cells to be reached
 };
 
 // Textures one lobe (closed mesh) from its seed. `stream` selects the random stream (the lobe
 // index). `occupancy` may be null or empty (then the whole lobe is filled).
-LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library,
-                         const TexturingOptions& options, std::uint64_t stream, const Occupancy* occupancy = nullptr);
+LobeTexture texture_lobe(const TriangleMesh& lobe, const DockingPoint& seed, const PatchLibrary& library, const TexturingOptions& options,
+                         std::uint64_t stream, const Occupancy* occupancy = nullptr);
 
 }  // namespace treelobes::lobes

@@ -21,13 +21,13 @@ inline constexpr std::uint8_t kTlobeMajorVersion = 3;
 inline constexpr std::uint8_t kTlobeMinorVersion = 0;
 
 struct TlobeOptions {
-    double quantum = 0.005;           // metres: grid of skeleton positions and lobe vertices
-    double diameter_quantum = 0.0005; // metres: grid of branch diameters
-    int compression_level = 9;        // deflate level 1..9
-    std::size_t max_bytes = 39000;    // the occupancy grid is coarsened until the file fits (target < 40 kB)
+    double quantum = 0.005;            // metres: grid of skeleton positions and lobe vertices
+    double diameter_quantum = 0.0005;  // metres: grid of branch diameters
+    int compression_level = 9;         // deflate level 1..9
+    std::size_t max_bytes = 39000;     // the occupancy grid is coarsened until the file fits (target < 40 kB)
     // Metres, finest first, steps of about 1.2 (each one costs an encoding pass).
     std::vector<double> occupancy_cells{0.03, 0.035, 0.04, 0.05, 0.06, 0.07, 0.085, 0.1, 0.12, 0.14,
-                                        0.17, 0.2, 0.24, 0.3, 0.35, 0.4, 0.5, 0.6, 0.8};
+                                        0.17, 0.2,   0.24, 0.3,  0.35, 0.4,  0.5,   0.6, 0.8};
 };
 
 // Bytes of the file. Lobes with cluster_points get their occupancy on the finest grid of

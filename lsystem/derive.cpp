@@ -30,12 +30,14 @@ public:
         context_.random = &random;
         for (std::size_t i = 0; i < in.size(); ++i) {
             const int rule = select(in, i, random);
-            if (rule < 0) out.push_back(in.symbol(i), in.params(i));
-            else produce(rules_[static_cast<std::size_t>(rule)], in, i, out);
+            if (rule < 0)
+                out.push_back(in.symbol(i), in.params(i));
+            else
+                produce(rules_[static_cast<std::size_t>(rule)], in, i, out);
             if (out.size() > max_modules)
                 throw Error::input(system_.source, "derivation step " + std::to_string(step) + " produces more than " +
-                                                       std::to_string(max_modules) +
-                                                       " modules; lower the derivation length (--steps) or raise --max-modules");
+                                                           std::to_string(max_modules) +
+                                                           " modules; lower the derivation length (--steps) or raise --max-modules");
         }
     }
 
@@ -58,8 +60,7 @@ private:
     }
 
     // All stochastic rules from position `first` on that match compete, weighted by probability.
-    int draw_stochastic(const ModuleString& in, std::size_t i, const std::vector<int>& candidates, std::size_t first,
-                        Rng& random) {
+    int draw_stochastic(const ModuleString& in, std::size_t i, const std::vector<int>& candidates, std::size_t first, Rng& random) {
         group_.clear();
         double total = 0.0;
         for (std::size_t k = first; k < candidates.size(); ++k) {
@@ -160,7 +161,8 @@ private:
         brackets_.assign(in.size(), -1);
         open_.clear();
         for (std::size_t i = 0; i < in.size(); ++i) {
-            if (in.symbol(i) == Alphabet::kPush) open_.push_back(i);
+            if (in.symbol(i) == Alphabet::kPush)
+                open_.push_back(i);
             else if (in.symbol(i) == Alphabet::kPop && !open_.empty()) {
                 brackets_[i] = static_cast<std::ptrdiff_t>(open_.back());
                 brackets_[open_.back()] = static_cast<std::ptrdiff_t>(i);
@@ -184,10 +186,9 @@ private:
                 const double v = e.evaluate(context_);
                 if (!std::isfinite(v))
                     throw Error::input(system_.source, "line " + std::to_string(rule.line) + ": the rule gives module '" +
-                                                           system_.alphabet->name(module.symbol) +
-                                                           "' a non-finite parameter at step " +
-                                                           std::to_string(static_cast<int>(context_.step)) +
-                                                           " (division by zero or overflow?)");
+                                                               system_.alphabet->name(module.symbol) + "' a non-finite parameter at step " +
+                                                               std::to_string(static_cast<int>(context_.step)) +
+                                                               " (division by zero or overflow?)");
                 values_.push_back(v);
             }
             out.push_back(module.symbol, values_);
@@ -220,8 +221,10 @@ void apply_cuts(ModuleString& string) {
         int depth = 0;
         for (++i; i < string.size(); ++i) {
             const int s = string.symbol(i);
-            if (s == Alphabet::kPush) ++depth;
-            else if (s == Alphabet::kPop && depth-- == 0) break;
+            if (s == Alphabet::kPush)
+                ++depth;
+            else if (s == Alphabet::kPop && depth-- == 0)
+                break;
         }
         if (i < string.size()) out.push_back(string.symbol(i), string.params(i));  // the branch's ']'
     }
@@ -234,8 +237,7 @@ ModuleString derive(const LSystem& system, const DeriveOptions& options) {
     const std::optional<int> steps = options.steps ? options.steps : system.derivation_length;
     if (!steps) throw Error::input(system.source, "no 'derivation length:' line (or give the number of steps)");
     if (*steps < 0 || *steps > kMaxDerivationLength)
-        throw Error::usage("derivation length " + std::to_string(*steps) + " is outside 0.." +
-                           std::to_string(kMaxDerivationLength));
+        throw Error::usage("derivation length " + std::to_string(*steps) + " is outside 0.." + std::to_string(kMaxDerivationLength));
     if (system.axiom.size() > options.max_modules)
         throw Error::input(system.source, "the axiom has more than " + std::to_string(options.max_modules) + " modules");
     Rng random(options.seed.value_or(system.seed));
@@ -249,9 +251,9 @@ ModuleString derive(const LSystem& system, const DeriveOptions& options) {
         std::swap(current, next);
         work += current.size();
         if (work > max_work && step < *steps)
-            throw Error::input(system.source, "derivation stopped at step " + std::to_string(step) + " of " +
-                                                  std::to_string(*steps) + ": more than " + std::to_string(max_work) +
-                                                  " modules rewritten in total; lower the derivation length (--steps)");
+            throw Error::input(system.source, "derivation stopped at step " + std::to_string(step) + " of " + std::to_string(*steps) +
+                                                      ": more than " + std::to_string(max_work) +
+                                                      " modules rewritten in total; lower the derivation length (--steps)");
     }
     return current;
 }

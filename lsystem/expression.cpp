@@ -17,13 +17,13 @@ struct FunctionInfo {
 
 const std::unordered_map<std::string, FunctionInfo>& functions() {
     static const std::unordered_map<std::string, FunctionInfo> table = {
-        {"sin", {Op::Sin, 1, false}},     {"cos", {Op::Cos, 1, false}},     {"tan", {Op::Tan, 1, false}},
-        {"asin", {Op::Asin, 1, false}},   {"acos", {Op::Acos, 1, false}},   {"atan", {Op::Atan, 1, false}},
-        {"sqrt", {Op::Sqrt, 1, false}},   {"exp", {Op::Exp, 1, false}},     {"log", {Op::Log, 1, false}},
-        {"abs", {Op::Abs, 1, false}},     {"floor", {Op::Floor, 1, false}}, {"ceil", {Op::Ceil, 1, false}},
-        {"round", {Op::Round, 1, false}}, {"sign", {Op::Sign, 1, false}},   {"atan2", {Op::Atan2, 2, false}},
-        {"min", {Op::Min, 2, false}},     {"max", {Op::Max, 2, false}},     {"pow", {Op::PowFn, 2, false}},
-        {"ran", {Op::Ran, 1, true}},      {"uniform", {Op::Uniform, 2, true}}, {"normal", {Op::Normal, 2, true}},
+            {"sin", {Op::Sin, 1, false}},     {"cos", {Op::Cos, 1, false}},        {"tan", {Op::Tan, 1, false}},
+            {"asin", {Op::Asin, 1, false}},   {"acos", {Op::Acos, 1, false}},      {"atan", {Op::Atan, 1, false}},
+            {"sqrt", {Op::Sqrt, 1, false}},   {"exp", {Op::Exp, 1, false}},        {"log", {Op::Log, 1, false}},
+            {"abs", {Op::Abs, 1, false}},     {"floor", {Op::Floor, 1, false}},    {"ceil", {Op::Ceil, 1, false}},
+            {"round", {Op::Round, 1, false}}, {"sign", {Op::Sign, 1, false}},      {"atan2", {Op::Atan2, 2, false}},
+            {"min", {Op::Min, 2, false}},     {"max", {Op::Max, 2, false}},        {"pow", {Op::PowFn, 2, false}},
+            {"ran", {Op::Ran, 1, true}},      {"uniform", {Op::Uniform, 2, true}}, {"normal", {Op::Normal, 2, true}},
     };
     return table;
 }
@@ -31,11 +31,31 @@ const std::unordered_map<std::string, FunctionInfo>& functions() {
 // Stack effect of one instruction: how many values it pops and pushes.
 int pops(Op op) {
     switch (op) {
-    case Op::Const: case Op::Param: case Op::Step: case Op::Steps: return 0;
-    case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
-    case Op::Atan: case Op::Sqrt: case Op::Exp: case Op::Log: case Op::Abs: case Op::Floor: case Op::Ceil:
-    case Op::Round: case Op::Sign: case Op::Ran: return 1;
-    default: return 2;
+        case Op::Const:
+        case Op::Param:
+        case Op::Step:
+        case Op::Steps:
+            return 0;
+        case Op::Neg:
+        case Op::Not:
+        case Op::Sin:
+        case Op::Cos:
+        case Op::Tan:
+        case Op::Asin:
+        case Op::Acos:
+        case Op::Atan:
+        case Op::Sqrt:
+        case Op::Exp:
+        case Op::Log:
+        case Op::Abs:
+        case Op::Floor:
+        case Op::Ceil:
+        case Op::Round:
+        case Op::Sign:
+        case Op::Ran:
+            return 1;
+        default:
+            return 2;
     }
 }
 
@@ -86,23 +106,38 @@ private:
     void parse_equality() {
         parse_relational();
         for (;;) {
-            if (consume_op("==")) { parse_relational(); emit(Op::Eq); }
-            else if (consume_op("!=")) { parse_relational(); emit(Op::Ne); }
-            else if (c_.peek() == '=' ) { c_.get(); parse_relational(); emit(Op::Eq); }
-            else return;
+            if (consume_op("==")) {
+                parse_relational();
+                emit(Op::Eq);
+            } else if (consume_op("!=")) {
+                parse_relational();
+                emit(Op::Ne);
+            } else if (c_.peek() == '=') {
+                c_.get();
+                parse_relational();
+                emit(Op::Eq);
+            } else
+                return;
         }
     }
     void parse_relational() {
         parse_additive();
         for (;;) {
-            if (consume_op("<=")) { parse_additive(); emit(Op::Le); }
-            else if (consume_op(">=")) { parse_additive(); emit(Op::Ge); }
-            else if (consume_op("<")) { parse_additive(); emit(Op::Lt); }
-            else if (consume_op(">")) {
+            if (consume_op("<=")) {
+                parse_additive();
+                emit(Op::Le);
+            } else if (consume_op(">=")) {
+                parse_additive();
+                emit(Op::Ge);
+            } else if (consume_op("<")) {
+                parse_additive();
+                emit(Op::Lt);
+            } else if (consume_op(">")) {
                 // "->" never follows an operand inside an expression; leave it for the rule parser.
                 parse_additive();
                 emit(Op::Gt);
-            } else return;
+            } else
+                return;
         }
     }
     void parse_additive() {
@@ -112,28 +147,57 @@ private:
             // A '-' followed by '>' is the rule arrow, not a subtraction.
             if (c_.peek() == '-' && c_.peek(1) == '>') return;
             if (c_.peek() == '-' && c_.peek(1) == '-' && c_.peek(2) == '>') return;
-            if (c_.consume('+')) { parse_multiplicative(); emit(Op::Add); }
-            else if (c_.consume('-')) { parse_multiplicative(); emit(Op::Sub); }
-            else return;
+            if (c_.consume('+')) {
+                parse_multiplicative();
+                emit(Op::Add);
+            } else if (c_.consume('-')) {
+                parse_multiplicative();
+                emit(Op::Sub);
+            } else
+                return;
         }
     }
     void parse_multiplicative() {
         parse_unary();
         for (;;) {
             c_.skip_space();
-            if (c_.consume('*')) { parse_unary(); emit(Op::Mul); }
-            else if (c_.consume('/')) { parse_unary(); emit(Op::Div); }
-            else if (c_.consume('%')) { parse_unary(); emit(Op::Mod); }
-            else return;
+            if (c_.consume('*')) {
+                parse_unary();
+                emit(Op::Mul);
+            } else if (c_.consume('/')) {
+                parse_unary();
+                emit(Op::Div);
+            } else if (c_.consume('%')) {
+                parse_unary();
+                emit(Op::Mod);
+            } else
+                return;
         }
     }
     void parse_unary() {
         Nesting guard(*this);
         c_.skip_space();
-        if (c_.peek() == '-' && c_.peek(1) != '>') { c_.get(); parse_unary(); emit(Op::Neg); return; }
-        if (c_.consume('+')) { parse_unary(); return; }
-        if (c_.peek() == '!' && c_.peek(1) != '=') { c_.get(); parse_unary(); emit(Op::Not); return; }
-        if (consume_word("not")) { parse_unary(); emit(Op::Not); return; }
+        if (c_.peek() == '-' && c_.peek(1) != '>') {
+            c_.get();
+            parse_unary();
+            emit(Op::Neg);
+            return;
+        }
+        if (c_.consume('+')) {
+            parse_unary();
+            return;
+        }
+        if (c_.peek() == '!' && c_.peek(1) != '=') {
+            c_.get();
+            parse_unary();
+            emit(Op::Not);
+            return;
+        }
+        if (consume_word("not")) {
+            parse_unary();
+            emit(Op::Not);
+            return;
+        }
         parse_power();
     }
     void parse_power() {
@@ -195,18 +259,26 @@ private:
                 return;
             }
         }
-        if (name == "pi") { emit(Op::Const, 0, 3.14159265358979323846); return; }
-        if (scope_.allow_step && name == "step") { emit(Op::Step); return; }
-        if (scope_.allow_step && name == "steps") { emit(Op::Steps); return; }
+        if (name == "pi") {
+            emit(Op::Const, 0, 3.14159265358979323846);
+            return;
+        }
+        if (scope_.allow_step && name == "step") {
+            emit(Op::Step);
+            return;
+        }
+        if (scope_.allow_step && name == "steps") {
+            emit(Op::Steps);
+            return;
+        }
         c_.fail_at(start, "unknown name '" + name + "' (not a parameter of the predecessor, a #define constant" +
-                              std::string(scope_.allow_step ? ", step, steps" : "") + " or pi)");
+                                  std::string(scope_.allow_step ? ", step, steps" : "") + " or pi)");
     }
     void parse_call(const std::string& name, std::size_t start) {
         const auto it = functions().find(name);
         if (it == functions().end()) c_.fail_at(start, "unknown function '" + name + "'");
         const FunctionInfo info = it->second;
-        if (info.random && !scope_.allow_random)
-            c_.fail_at(start, "random function '" + name + "' is not allowed here (only in rules)");
+        if (info.random && !scope_.allow_random) c_.fail_at(start, "random function '" + name + "' is not allowed here (only in rules)");
         c_.consume('(');
         int args = 0;
         c_.skip_space();
@@ -220,8 +292,8 @@ private:
             }
         }
         if (args != info.arity)
-            c_.fail_at(start, name + "() takes " + std::to_string(info.arity) + " argument" +
-                                  (info.arity == 1 ? "" : "s") + ", got " + std::to_string(args));
+            c_.fail_at(start, name + "() takes " + std::to_string(info.arity) + " argument" + (info.arity == 1 ? "" : "s") + ", got " +
+                                      std::to_string(args));
         if (info.random) expr_.uses_random_ = true;
         emit(info.op);
     }
@@ -288,53 +360,135 @@ double Expression::evaluate(const EvalContext& context) const {
     };
     for (const Instruction& ins : code_) {
         switch (ins.op) {
-        case Op::Const: stack[++top] = ins.value; break;
-        case Op::Param: stack[++top] = context.params[static_cast<std::size_t>(ins.slot)]; break;
-        case Op::Step: stack[++top] = context.step; break;
-        case Op::Steps: stack[++top] = context.steps; break;
-        case Op::Neg: stack[top] = -stack[top]; break;
-        case Op::Not: stack[top] = stack[top] == 0.0 ? 1.0 : 0.0; break;
-        case Op::Sin: stack[top] = std::sin(stack[top]); break;
-        case Op::Cos: stack[top] = std::cos(stack[top]); break;
-        case Op::Tan: stack[top] = std::tan(stack[top]); break;
-        case Op::Asin: stack[top] = std::asin(stack[top]); break;
-        case Op::Acos: stack[top] = std::acos(stack[top]); break;
-        case Op::Atan: stack[top] = std::atan(stack[top]); break;
-        case Op::Sqrt: stack[top] = std::sqrt(stack[top]); break;
-        case Op::Exp: stack[top] = std::exp(stack[top]); break;
-        case Op::Log: stack[top] = std::log(stack[top]); break;
-        case Op::Abs: stack[top] = std::fabs(stack[top]); break;
-        case Op::Floor: stack[top] = std::floor(stack[top]); break;
-        case Op::Ceil: stack[top] = std::ceil(stack[top]); break;
-        case Op::Round: stack[top] = std::round(stack[top]); break;
-        case Op::Sign: stack[top] = static_cast<double>((stack[top] > 0) - (stack[top] < 0)); break;
-        case Op::Ran: stack[top] = stack[top] * random().uniform(); break;
-        default: {
-            const double b = stack[top--];
-            double& a = stack[top];
-            switch (ins.op) {
-            case Op::Add: a += b; break;
-            case Op::Sub: a -= b; break;
-            case Op::Mul: a *= b; break;
-            case Op::Div: a /= b; break;
-            case Op::Mod: a = std::fmod(a, b); break;
-            case Op::Pow: case Op::PowFn: a = std::pow(a, b); break;
-            case Op::Lt: a = a < b; break;
-            case Op::Le: a = a <= b; break;
-            case Op::Gt: a = a > b; break;
-            case Op::Ge: a = a >= b; break;
-            case Op::Eq: a = a == b; break;
-            case Op::Ne: a = a != b; break;
-            case Op::And: a = (a != 0.0 && b != 0.0); break;
-            case Op::Or: a = (a != 0.0 || b != 0.0); break;
-            case Op::Atan2: a = std::atan2(a, b); break;
-            case Op::Min: a = std::min(a, b); break;
-            case Op::Max: a = std::max(a, b); break;
-            case Op::Uniform: a = random().uniform(a, b); break;
-            case Op::Normal: a = random().normal(a, b); break;
-            default: break;
+            case Op::Const:
+                stack[++top] = ins.value;
+                break;
+            case Op::Param:
+                stack[++top] = context.params[static_cast<std::size_t>(ins.slot)];
+                break;
+            case Op::Step:
+                stack[++top] = context.step;
+                break;
+            case Op::Steps:
+                stack[++top] = context.steps;
+                break;
+            case Op::Neg:
+                stack[top] = -stack[top];
+                break;
+            case Op::Not:
+                stack[top] = stack[top] == 0.0 ? 1.0 : 0.0;
+                break;
+            case Op::Sin:
+                stack[top] = std::sin(stack[top]);
+                break;
+            case Op::Cos:
+                stack[top] = std::cos(stack[top]);
+                break;
+            case Op::Tan:
+                stack[top] = std::tan(stack[top]);
+                break;
+            case Op::Asin:
+                stack[top] = std::asin(stack[top]);
+                break;
+            case Op::Acos:
+                stack[top] = std::acos(stack[top]);
+                break;
+            case Op::Atan:
+                stack[top] = std::atan(stack[top]);
+                break;
+            case Op::Sqrt:
+                stack[top] = std::sqrt(stack[top]);
+                break;
+            case Op::Exp:
+                stack[top] = std::exp(stack[top]);
+                break;
+            case Op::Log:
+                stack[top] = std::log(stack[top]);
+                break;
+            case Op::Abs:
+                stack[top] = std::fabs(stack[top]);
+                break;
+            case Op::Floor:
+                stack[top] = std::floor(stack[top]);
+                break;
+            case Op::Ceil:
+                stack[top] = std::ceil(stack[top]);
+                break;
+            case Op::Round:
+                stack[top] = std::round(stack[top]);
+                break;
+            case Op::Sign:
+                stack[top] = static_cast<double>((stack[top] > 0) - (stack[top] < 0));
+                break;
+            case Op::Ran:
+                stack[top] = stack[top] * random().uniform();
+                break;
+            default: {
+                const double b = stack[top--];
+                double& a = stack[top];
+                switch (ins.op) {
+                    case Op::Add:
+                        a += b;
+                        break;
+                    case Op::Sub:
+                        a -= b;
+                        break;
+                    case Op::Mul:
+                        a *= b;
+                        break;
+                    case Op::Div:
+                        a /= b;
+                        break;
+                    case Op::Mod:
+                        a = std::fmod(a, b);
+                        break;
+                    case Op::Pow:
+                    case Op::PowFn:
+                        a = std::pow(a, b);
+                        break;
+                    case Op::Lt:
+                        a = a < b;
+                        break;
+                    case Op::Le:
+                        a = a <= b;
+                        break;
+                    case Op::Gt:
+                        a = a > b;
+                        break;
+                    case Op::Ge:
+                        a = a >= b;
+                        break;
+                    case Op::Eq:
+                        a = a == b;
+                        break;
+                    case Op::Ne:
+                        a = a != b;
+                        break;
+                    case Op::And:
+                        a = (a != 0.0 && b != 0.0);
+                        break;
+                    case Op::Or:
+                        a = (a != 0.0 || b != 0.0);
+                        break;
+                    case Op::Atan2:
+                        a = std::atan2(a, b);
+                        break;
+                    case Op::Min:
+                        a = std::min(a, b);
+                        break;
+                    case Op::Max:
+                        a = std::max(a, b);
+                        break;
+                    case Op::Uniform:
+                        a = random().uniform(a, b);
+                        break;
+                    case Op::Normal:
+                        a = random().normal(a, b);
+                        break;
+                    default:
+                        break;
+                }
             }
-        }
         }
     }
     return stack[0];

@@ -22,12 +22,47 @@
 namespace treelobes::lsystem::detail {
 
 enum class Op : unsigned char {
-    Const, Param, Step, Steps,
-    Neg, Not,
-    Add, Sub, Mul, Div, Mod, Pow, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
-    Sin, Cos, Tan, Asin, Acos, Atan, Sqrt, Exp, Log, Abs, Floor, Ceil, Round, Sign,
-    Atan2, Min, Max, PowFn,
-    Ran, Uniform, Normal,
+    Const,
+    Param,
+    Step,
+    Steps,
+    Neg,
+    Not,
+    Add,
+    Sub,
+    Mul,
+    Div,
+    Mod,
+    Pow,
+    Lt,
+    Le,
+    Gt,
+    Ge,
+    Eq,
+    Ne,
+    And,
+    Or,
+    Sin,
+    Cos,
+    Tan,
+    Asin,
+    Acos,
+    Atan,
+    Sqrt,
+    Exp,
+    Log,
+    Abs,
+    Floor,
+    Ceil,
+    Round,
+    Sign,
+    Atan2,
+    Min,
+    Max,
+    PowFn,
+    Ran,
+    Uniform,
+    Normal,
 };
 
 struct Instruction {
@@ -38,10 +73,10 @@ struct Instruction {
 
 // What names an expression may use.
 struct NameScope {
-    const std::vector<std::string>* formals = nullptr;                     // rule parameters -> slots
-    const std::unordered_map<std::string, double>* constants = nullptr;    // #define values
-    bool allow_step = false;    // `step` (1-based number of the step being applied), `steps`
-    bool allow_random = false;  // ran(), uniform(), normal()
+    const std::vector<std::string>* formals = nullptr;                   // rule parameters -> slots
+    const std::unordered_map<std::string, double>* constants = nullptr;  // #define values
+    bool allow_step = false;                                             // `step` (1-based number of the step being applied), `steps`
+    bool allow_random = false;                                           // ran(), uniform(), normal()
 };
 
 struct EvalContext {

@@ -53,7 +53,7 @@ struct NodeFoliage {
     std::size_t module_end = 0;
     std::size_t leaf_begin = 0, leaf_end = 0;
     std::size_t own_leaves = 0;
-    int rep = -1;  // the node whose box this subtree uses; -1 without leaves
+    int rep = -1;             // the node whose box this subtree uses; -1 without leaves
     Eigen::AlignedBox3d raw;  // bounds of the subtree's leaf blades
 };
 
@@ -61,10 +61,10 @@ void check_leaves(const Tadt& tadt, std::span<const LeafPlacement> leaves) {
     for (std::size_t i = 0; i < leaves.size(); ++i) {
         if (leaves[i].module >= tadt.string.size())
             throw Error::input("foliage", "leaf " + std::to_string(i) + " refers to module " + std::to_string(leaves[i].module) +
-                                              " beyond the string (" + std::to_string(tadt.string.size()) + " modules)");
+                                                  " beyond the string (" + std::to_string(tadt.string.size()) + " modules)");
         if (i > 0 && leaves[i].module <= leaves[i - 1].module)
             throw Error::input("foliage", "leaves are not in string order at leaf " + std::to_string(i) +
-                                              " (interpret the whole string, not a chain prefix)");
+                                                  " (interpret the whole string, not a chain prefix)");
     }
 }
 
@@ -83,8 +83,7 @@ Eigen::AlignedBox3d padded(const Eigen::AlignedBox3d& box, double side) {
 
 }  // namespace
 
-FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafPlacement> leaves,
-                                         const FoliageOptions& options) {
+FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafPlacement> leaves, const FoliageOptions& options) {
     if (!(options.texture_threshold >= 0.0 && options.texture_threshold < 1.0))
         throw Error::usage("foliage: the texture threshold must be in [0, 1), got " + std::to_string(options.texture_threshold));
     if (!(options.min_side_fraction >= 0.0 && options.min_side_fraction <= 1.0))
@@ -102,9 +101,8 @@ FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafP
     std::vector<NodeFoliage> info(n);
     const auto leaf_at_or_after = [&](std::size_t module) {
         return static_cast<std::size_t>(
-            std::lower_bound(leaves.begin(), leaves.end(), module,
-                             [](const LeafPlacement& l, std::size_t m) { return l.module < m; }) -
-            leaves.begin());
+                std::lower_bound(leaves.begin(), leaves.end(), module, [](const LeafPlacement& l, std::size_t m) { return l.module < m; }) -
+                leaves.begin());
     };
     out.ornament.assign(n, 0);
     for (std::size_t i = 1; i < n; ++i) out.ornament[i] = tadt.nodes[i].subtree_length == 0.0;
@@ -133,8 +131,7 @@ FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafP
         f.own_leaves = f.leaf_end - f.leaf_begin - in_branches;
         if (f.leaf_end == f.leaf_begin || out.ornament[i]) continue;
         // Same foliage as its only leafy sub-branch: share that child's box.
-        f.rep = (f.own_leaves == 0 && leafy_branches == 1) ? info[static_cast<std::size_t>(last_leafy)].rep
-                                                           : static_cast<int>(i);
+        f.rep = (f.own_leaves == 0 && leafy_branches == 1) ? info[static_cast<std::size_t>(last_leafy)].rep : static_cast<int>(i);
     }
 
     // Top-down: one box per representative node, parents first.
@@ -167,8 +164,7 @@ FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafP
     }
 
     // Padding may let a child stick out of its parent: grow parents bottom-up to keep nesting.
-    for (std::size_t b = out.boxes.size(); b-- > 1;)
-        out.boxes[static_cast<std::size_t>(out.boxes[b].parent)].box.extend(out.boxes[b].box);
+    for (std::size_t b = out.boxes.size(); b-- > 1;) out.boxes[static_cast<std::size_t>(out.boxes[b].parent)].box.extend(out.boxes[b].box);
     const double root_volume = out.boxes[0].box.volume();
     for (FoliageBox& box : out.boxes) {
         box.volume_ratio = root_volume > 0 ? box.box.volume() / root_volume : 1.0;
@@ -192,8 +188,7 @@ FoliageLod foliage_for_prefix(const Tadt& tadt, const FoliageHierarchy& hierarch
             return lod;
         }
         if (hierarchy.ornament[i]) {
-            for (std::size_t l = hierarchy.node_leaves[i].first; l < hierarchy.node_leaves[i].second; ++l)
-                lod.attached_leaves.push_back(l);
+            for (std::size_t l = hierarchy.node_leaves[i].first; l < hierarchy.node_leaves[i].second; ++l) lod.attached_leaves.push_back(l);
             continue;
         }
         const int b = hierarchy.box_of_node[i];

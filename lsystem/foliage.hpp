@@ -44,28 +44,28 @@ TriangleMesh foliage_mesh(std::span<const LeafPlacement> leaves, const LeafShape
 
 struct FoliageOptions {
     LeafShape shape;
-    double texture_threshold = 0.01;   // texture boxes with volume ratio above this (0 <= t < 1)
-    double min_side_fraction = 0.01;   // smallest box side, as a fraction of the root's largest side
+    double texture_threshold = 0.01;  // texture boxes with volume ratio above this (0 <= t < 1)
+    double min_side_fraction = 0.01;  // smallest box side, as a fraction of the root's largest side
 };
 
 struct FoliageBox {
-    Eigen::AlignedBox3d box;   // local coordinates of the turtle (TreeGraph::origin not included)
-    int tadt_node = 0;         // the deepest tADT node with this foliage (the box's own node)
-    int parent = -1;           // box index, -1 for the root box
-    std::vector<int> children; // box indices, string order
-    int depth = 0;             // 0 for the root box
+    Eigen::AlignedBox3d box;                   // local coordinates of the turtle (TreeGraph::origin not included)
+    int tadt_node = 0;                         // the deepest tADT node with this foliage (the box's own node)
+    int parent = -1;                           // box index, -1 for the root box
+    std::vector<int> children;                 // box indices, string order
+    int depth = 0;                             // 0 for the root box
     std::size_t leaf_begin = 0, leaf_end = 0;  // range of TurtleResult::leaves
-    std::size_t own_leaves = 0;  // leaves of the tADT node itself and its ornaments (not in sub-branches)
-    double volume_ratio = 0.0;   // box volume / root box volume
+    std::size_t own_leaves = 0;                // leaves of the tADT node itself and its ornaments (not in sub-branches)
+    double volume_ratio = 0.0;                 // box volume / root box volume
     bool textured = false;
 
     std::size_t leaf_count() const { return leaf_end - leaf_begin; }
 };
 
 struct FoliageHierarchy {
-    std::vector<FoliageBox> boxes;   // box 0 is the root box; parents before children
-    std::vector<int> box_of_node;    // per tADT node: its box, -1 without leaves or for an ornament
-    std::vector<char> ornament;      // per tADT node: a bracket without length modules (see above)
+    std::vector<FoliageBox> boxes;                                 // box 0 is the root box; parents before children
+    std::vector<int> box_of_node;                                  // per tADT node: its box, -1 without leaves or for an ornament
+    std::vector<char> ornament;                                    // per tADT node: a bracket without length modules (see above)
     std::vector<std::pair<std::size_t, std::size_t>> node_leaves;  // per tADT node: its subtree's leaf range
     std::size_t leaf_count = 0;
 
@@ -77,8 +77,7 @@ struct FoliageHierarchy {
 // `leaves` must come from interpreting tadt.string (TurtleResult::leaves, in string order).
 // Throws Error::usage for a threshold outside [0, 1) or a negative side fraction, Error::input when
 // the leaves do not belong to the string (module index out of range or out of order).
-FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafPlacement> leaves,
-                                         const FoliageOptions& options = {});
+FoliageHierarchy build_foliage_hierarchy(const Tadt& tadt, std::span<const LeafPlacement> leaves, const FoliageOptions& options = {});
 
 // Foliage of a combined level (Lluch et al. 2010, via Ong's seminar report, §3.3): the chain prefix draws its own leaves as geometry,
 // and so are the ornaments of its nodes (the greedy chain reaches those zero-length nodes last, but
@@ -89,7 +88,7 @@ struct FoliageLod {
     std::vector<std::size_t> attached_leaves;  // leaves of unvisited ornaments of visited nodes
     std::vector<int> textured_boxes;           // boxes standing in for unvisited sub-branches
     std::size_t leaves_in_textures = 0;
-    std::vector<int> small_boxes;              // unvisited sub-branches without textures
+    std::vector<int> small_boxes;  // unvisited sub-branches without textures
     std::size_t leaves_in_small_boxes = 0;
 };
 

@@ -45,27 +45,27 @@ struct SuccessorModule {
 
 // One production `left < predecessor > right : condition -> successor : probability`.
 struct Rule {
-    int line = 0;                              // in the source file, for messages
-    std::vector<ModulePattern> left_context;   // nearest module last
+    int line = 0;                             // in the source file, for messages
+    std::vector<ModulePattern> left_context;  // nearest module last
     ModulePattern predecessor;
     std::vector<ModulePattern> right_context;  // nearest module first
     std::optional<detail::Expression> condition;
     std::vector<SuccessorModule> successor;
-    double probability = 0.0;                  // > 0: stochastic rule (weight among its siblings)
-    std::size_t bound_params = 0;              // left, predecessor and right parameters, in order
+    double probability = 0.0;      // > 0: stochastic rule (weight among its siblings)
+    std::size_t bound_params = 0;  // left, predecessor and right parameters, in order
 };
 
 struct LSystem {
-    std::string source;                         // file name (or "<string>") used in messages
+    std::string source;  // file name (or "<string>") used in messages
     std::shared_ptr<Alphabet> alphabet = std::make_shared<Alphabet>();
     ModuleString axiom{alphabet};
-    std::optional<int> derivation_length;       // `derivation length:`
-    std::uint64_t seed = 0;                     // `seed:`
-    std::vector<Rule> productions;              // in file order
-    std::vector<Rule> homomorphism;             // `homomorphism:` / `interpretation:` section
-    std::vector<int> ignored;                   // `#ignore:` symbols, skipped when matching contexts
+    std::optional<int> derivation_length;               // `derivation length:`
+    std::uint64_t seed = 0;                             // `seed:`
+    std::vector<Rule> productions;                      // in file order
+    std::vector<Rule> homomorphism;                     // `homomorphism:` / `interpretation:` section
+    std::vector<int> ignored;                           // `#ignore:` symbols, skipped when matching contexts
     std::unordered_map<std::string, double> constants;  // #define values (after overrides)
-    TurtleOptions turtle;                       // `angle:`, `step:`, `width:`, `tropism:`, ...
+    TurtleOptions turtle;                               // `angle:`, `step:`, `width:`, `tropism:`, ...
 };
 
 struct ParseOptions {
@@ -87,8 +87,8 @@ constexpr int kMaxDerivationLength = 100'000;
 constexpr std::size_t kWorkFactor = 50;
 
 struct DeriveOptions {
-    std::optional<int> steps;               // overrides `derivation length:`
-    std::optional<std::uint64_t> seed;      // overrides `seed:`
+    std::optional<int> steps;                      // overrides `derivation length:`
+    std::optional<std::uint64_t> seed;             // overrides `seed:`
     std::size_t max_modules = kDefaultMaxModules;  // per string
 };
 

@@ -25,8 +25,7 @@ std::string_view trim(std::string_view s) {
 }
 
 bool starts_with_word(std::string_view text, std::string_view word) {
-    return text.substr(0, word.size()) == word &&
-           (text.size() == word.size() || !detail::is_identifier_char(text[word.size()]));
+    return text.substr(0, word.size()) == word && (text.size() == word.size() || !detail::is_identifier_char(text[word.size()]));
 }
 
 // Replaces /* ... */ and # comments by spaces; `#define`, `#ignore`, `#module` at the start of a
@@ -38,14 +37,20 @@ std::string blank_comments(std::string_view text, const std::string& source) {
     bool line_start = true;  // only spaces so far on this line
     while (i < out.size()) {
         const char c = out[i];
-        if (c == '\n') { ++line; line_start = true; ++i; continue; }
+        if (c == '\n') {
+            ++line;
+            line_start = true;
+            ++i;
+            continue;
+        }
         if (c == '/' && i + 1 < out.size() && out[i + 1] == '*') {
             const std::size_t end = out.find("*/", i + 2);
-            if (end == std::string::npos)
-                throw Error::input(source, "line " + std::to_string(line) + ": '/*' comment is never closed");
+            if (end == std::string::npos) throw Error::input(source, "line " + std::to_string(line) + ": '/*' comment is never closed");
             for (std::size_t k = i; k < end + 2; ++k)
-                if (out[k] == '\n') ++line;
-                else out[k] = ' ';
+                if (out[k] == '\n')
+                    ++line;
+                else
+                    out[k] = ' ';
             i = end + 2;
             continue;
         }
@@ -90,17 +95,20 @@ template <typename Predicate>
 std::size_t find_top_level(std::string_view text, std::size_t from, Predicate at) {
     int depth = 0;
     for (std::size_t i = from; i < text.size(); ++i) {
-        if (text[i] == '(') ++depth;
-        else if (text[i] == ')') --depth;
-        else if (depth == 0 && at(i)) return i;
+        if (text[i] == '(')
+            ++depth;
+        else if (text[i] == ')')
+            --depth;
+        else if (depth == 0 && at(i))
+            return i;
     }
     return std::string_view::npos;
 }
 
 const std::set<std::string>& reserved_names() {
-    static const std::set<std::string> names = {"step", "steps", "pi", "and", "or", "not", "sin", "cos", "tan",
-                                                 "asin", "acos", "atan", "atan2", "sqrt", "exp", "log", "abs", "floor",
-                                                 "ceil", "round", "sign", "min", "max", "pow", "ran", "uniform", "normal"};
+    static const std::set<std::string> names = {"step", "steps", "pi",   "and",   "or",   "not", "sin", "cos",     "tan",
+                                                "asin", "acos",  "atan", "atan2", "sqrt", "exp", "log", "abs",     "floor",
+                                                "ceil", "round", "sign", "min",   "max",  "pow", "ran", "uniform", "normal"};
     return names;
 }
 
@@ -188,8 +196,7 @@ private:
             if (cursor.at_end()) break;
             const std::size_t pos = cursor.pos();
             const std::string name = read_identifier(cursor, "a module name");
-            if (!std::isalpha(static_cast<unsigned char>(name[0])))
-                cursor.fail_at(pos, "module names start with a letter");
+            if (!std::isalpha(static_cast<unsigned char>(name[0]))) cursor.fail_at(pos, "module names start with a letter");
             system_.alphabet->declare_long_name(name);
             cursor.skip_space();
             cursor.consume(',');
@@ -221,8 +228,7 @@ private:
             expect_end(*value_cursor(after), "'homomorphism:'");
             return true;
         }
-        if ((after = match_header(body, "decomposition")) != std::string_view::npos)
-            cursor.fail("decomposition rules are not supported");
+        if ((after = match_header(body, "decomposition")) != std::string_view::npos) cursor.fail("decomposition rules are not supported");
         if ((after = match_header(body, "ignore")) != std::string_view::npos) {
             parse_ignore(*value_cursor(after));
             return true;
@@ -388,8 +394,7 @@ private:
             }
             const std::size_t pos = cursor.pos();
             const std::string name = detail::read_module_name(cursor, *system_.alphabet);
-            if (name == "[" || name == "]")
-                cursor.fail_at(pos, "brackets are not supported in predecessors or contexts");
+            if (name == "[" || name == "]") cursor.fail_at(pos, "brackets are not supported in predecessors or contexts");
             ModulePattern pattern;
             pattern.symbol = system_.alphabet->intern(name);
             cursor.skip_space();
@@ -400,7 +405,7 @@ private:
         const std::size_t last = greater >= 0 ? static_cast<std::size_t>(greater) : items.size();
         if (last != first + 1)
             cursor.fail_at(0, items.empty() ? "the rule has no predecessor"
-                                             : "the predecessor must be one module; write contexts as 'left < A > right'");
+                                            : "the predecessor must be one module; write contexts as 'left < A > right'");
         rule.left_context.assign(items.begin(), items.begin() + static_cast<std::ptrdiff_t>(first));
         rule.predecessor = items[first];
         rule.right_context.assign(items.begin() + static_cast<std::ptrdiff_t>(last), items.end());

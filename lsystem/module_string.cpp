@@ -38,8 +38,7 @@ void Alphabet::declare_long_name(std::string_view name) {
                      [](const std::string& a, const std::string& b) { return a.size() > b.size(); });
 }
 
-ModuleString::ModuleString(std::shared_ptr<Alphabet> alphabet)
-    : alphabet_(alphabet ? std::move(alphabet) : std::make_shared<Alphabet>()) {}
+ModuleString::ModuleString(std::shared_ptr<Alphabet> alphabet) : alphabet_(alphabet ? std::move(alphabet) : std::make_shared<Alphabet>()) {}
 
 void ModuleString::push_back(int symbol, std::span<const double> params) {
     // Offsets are 32-bit to keep strings compact; 4 billion parameters is far beyond any tree.
@@ -50,9 +49,7 @@ void ModuleString::push_back(int symbol, std::span<const double> params) {
     offsets_.push_back(static_cast<std::uint32_t>(params_.size()));
 }
 
-void ModuleString::push_back(std::string_view name, std::initializer_list<double> params) {
-    push_back(alphabet_->intern(name), params);
-}
+void ModuleString::push_back(std::string_view name, std::initializer_list<double> params) { push_back(alphabet_->intern(name), params); }
 
 void ModuleString::append(const ModuleString& other, std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) push_back(other.symbol(i), other.params(i));

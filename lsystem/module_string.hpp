@@ -50,14 +50,10 @@ public:
     bool empty() const { return symbols_.empty(); }
     int symbol(std::size_t i) const { return symbols_[i]; }
     const std::string& name(std::size_t i) const { return alphabet_->name(symbols_[i]); }
-    std::span<const double> params(std::size_t i) const {
-        return {params_.data() + offsets_[i], params_.data() + offsets_[i + 1]};
-    }
+    std::span<const double> params(std::size_t i) const { return {params_.data() + offsets_[i], params_.data() + offsets_[i + 1]}; }
     std::size_t param_count(std::size_t i) const { return offsets_[i + 1] - offsets_[i]; }
     // First parameter, or `fallback` when the module has none.
-    double param_or(std::size_t i, double fallback) const {
-        return offsets_[i + 1] > offsets_[i] ? params_[offsets_[i]] : fallback;
-    }
+    double param_or(std::size_t i, double fallback) const { return offsets_[i + 1] > offsets_[i] ? params_[offsets_[i]] : fallback; }
 
     void push_back(int symbol, std::span<const double> params = {});
     void push_back(int symbol, std::initializer_list<double> params) {

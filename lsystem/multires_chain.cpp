@@ -54,10 +54,18 @@ public:
         unvisited_[static_cast<std::size_t>(n)] = unvisited;
         double& v = value_[static_cast<std::size_t>(n)];
         switch (metric_) {
-        case ChainMetric::branching_length: v = (open ? node.length : 0.0) + sum; break;
-        case ChainMetric::descendants: v = static_cast<double>(unvisited); break;
-        case ChainMetric::longest_path: v = (open ? 1.0 : 0.0) + longest; break;
-        case ChainMetric::children: v = open_children; break;
+            case ChainMetric::branching_length:
+                v = (open ? node.length : 0.0) + sum;
+                break;
+            case ChainMetric::descendants:
+                v = static_cast<double>(unvisited);
+                break;
+            case ChainMetric::longest_path:
+                v = (open ? 1.0 : 0.0) + longest;
+                break;
+            case ChainMetric::children:
+                v = open_children;
+                break;
         }
     }
 
@@ -71,9 +79,7 @@ private:
 
 class ChainBuilder {
 public:
-    ChainBuilder(MultiresChain& chain) : chain_(chain), tadt_(chain.tadt) {
-        chain_.save_slot.assign(tadt_.nodes.size(), -1);
-    }
+    ChainBuilder(MultiresChain& chain) : chain_(chain), tadt_(chain.tadt) { chain_.save_slot.assign(tadt_.nodes.size(), -1); }
 
     void emit_node(int n) {
         chain_.entries.push_back({ChainEntry::Kind::node, n});
@@ -181,10 +187,14 @@ std::string node_content(const Tadt& tadt, int n) {
 
 std::string_view to_string(ChainMetric metric) {
     switch (metric) {
-    case ChainMetric::branching_length: return "branching-length";
-    case ChainMetric::children: return "children";
-    case ChainMetric::descendants: return "descendants";
-    case ChainMetric::longest_path: return "longest-path";
+        case ChainMetric::branching_length:
+            return "branching-length";
+        case ChainMetric::children:
+            return "children";
+        case ChainMetric::descendants:
+            return "descendants";
+        case ChainMetric::longest_path:
+            return "longest-path";
     }
     return "branching-length";
 }
@@ -192,8 +202,7 @@ std::string_view to_string(ChainMetric metric) {
 std::optional<ChainMetric> parse_chain_metric(std::string_view name) {
     std::string n(name);
     std::replace(n.begin(), n.end(), '_', '-');
-    for (ChainMetric m : {ChainMetric::branching_length, ChainMetric::children, ChainMetric::descendants,
-                          ChainMetric::longest_path})
+    for (ChainMetric m : {ChainMetric::branching_length, ChainMetric::children, ChainMetric::descendants, ChainMetric::longest_path})
         if (to_string(m) == n) return m;
     return std::nullopt;
 }
@@ -220,8 +229,8 @@ MultiresChain build_multires_chain(Tadt tadt, const MultiresOptions& options) {
         const std::size_t work = greedy_work(chain.tadt);
         if (work > options.max_greedy_work)
             throw Error::input("multiresolution chain", "the greedy order would take about " + std::to_string(work) +
-                                                            " steps on this tADT (" + std::to_string(chain.tadt.nodes.size()) +
-                                                            " nodes, deep nesting); use the depth-first order");
+                                                                " steps on this tADT (" + std::to_string(chain.tadt.nodes.size()) +
+                                                                " nodes, deep nesting); use the depth-first order");
         builder.greedy(options.metric);
     } else {
         builder.depth_first(options.metric);
@@ -247,9 +256,15 @@ std::string format_chain(const MultiresChain& chain, ChainLabels labels, std::si
         const ChainEntry& entry = chain.entries[e];
         if (e) text += ' ';
         switch (entry.kind) {
-        case ChainEntry::Kind::node: text += node_content(chain.tadt, entry.node); break;
-        case ChainEntry::Kind::save: text += "SAVE(" + label(entry.node) + ")"; break;
-        case ChainEntry::Kind::restore: text += "RESTORE(" + label(entry.node) + ")"; break;
+            case ChainEntry::Kind::node:
+                text += node_content(chain.tadt, entry.node);
+                break;
+            case ChainEntry::Kind::save:
+                text += "SAVE(" + label(entry.node) + ")";
+                break;
+            case ChainEntry::Kind::restore:
+                text += "RESTORE(" + label(entry.node) + ")";
+                break;
         }
     }
     return text;
@@ -257,21 +272,24 @@ std::string format_chain(const MultiresChain& chain, ChainLabels labels, std::si
 
 std::string chain_file_text(const MultiresChain& chain) {
     std::string text = "# treelobes multiresolution chain (Lluch et al. 2010): metric " + std::string(to_string(chain.metric)) +
-                       ", order " + std::string(to_string(chain.order)) + "\n# tadt_nodes " +
-                       std::to_string(chain.tadt.nodes.size()) + ", entries " + std::to_string(chain.entries.size()) +
-                       ", lods " + std::to_string(chain.lod_count()) +
+                       ", order " + std::string(to_string(chain.order)) + "\n# tadt_nodes " + std::to_string(chain.tadt.nodes.size()) +
+                       ", entries " + std::to_string(chain.entries.size()) + ", lods " + std::to_string(chain.lod_count()) +
                        "\n# LOD k = the entries before the (k+1)-th RESTORE\n";
     for (const ChainEntry& entry : chain.entries) {
         const std::string id = std::to_string(entry.node);
         switch (entry.kind) {
-        case ChainEntry::Kind::node: {
-            const TadtNode& node = chain.tadt.nodes[static_cast<std::size_t>(entry.node)];
-            const char* kind = node.parent < 0 ? "root" : node.lateral ? "lateral" : "continuation";
-            text += "node " + id + " " + kind + " " + chain.tadt.string.to_string(node.begin, node.end) + "\n";
-            break;
-        }
-        case ChainEntry::Kind::save: text += "SAVE " + id + "\n"; break;
-        case ChainEntry::Kind::restore: text += "RESTORE " + id + "\n"; break;
+            case ChainEntry::Kind::node: {
+                const TadtNode& node = chain.tadt.nodes[static_cast<std::size_t>(entry.node)];
+                const char* kind = node.parent < 0 ? "root" : node.lateral ? "lateral" : "continuation";
+                text += "node " + id + " " + kind + " " + chain.tadt.string.to_string(node.begin, node.end) + "\n";
+                break;
+            }
+            case ChainEntry::Kind::save:
+                text += "SAVE " + id + "\n";
+                break;
+            case ChainEntry::Kind::restore:
+                text += "RESTORE " + id + "\n";
+                break;
         }
     }
     return text;
@@ -287,12 +305,16 @@ TurtleResult interpret_chain(const MultiresChain& chain, std::size_t end, const 
         const TadtNode& node = chain.tadt.nodes[static_cast<std::size_t>(entry.node)];
         const auto slot = static_cast<std::size_t>(chain.save_slot[static_cast<std::size_t>(entry.node)]);
         switch (entry.kind) {
-        case ChainEntry::Kind::node:
-            if (node.lateral) turtle.enter_lateral();
-            turtle.apply(string, node.begin, node.end);
-            break;
-        case ChainEntry::Kind::save: saved[slot] = turtle.state(); break;
-        case ChainEntry::Kind::restore: turtle.set_state(saved[slot]); break;
+            case ChainEntry::Kind::node:
+                if (node.lateral) turtle.enter_lateral();
+                turtle.apply(string, node.begin, node.end);
+                break;
+            case ChainEntry::Kind::save:
+                saved[slot] = turtle.state();
+                break;
+            case ChainEntry::Kind::restore:
+                turtle.set_state(saved[slot]);
+                break;
         }
     }
     return turtle.take_result();

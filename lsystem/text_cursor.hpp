@@ -14,7 +14,7 @@ class Cursor {
 public:
     // `text` is one line (or a part of one starting at `first_column`, 1-based).
     Cursor(std::string_view text, const std::string& source, int line, int first_column = 1)
-        : text_(text), source_(source), line_(line), first_column_(first_column) {}
+            : text_(text), source_(source), line_(line), first_column_(first_column) {}
 
     bool at_end() const { return pos_ >= text_.size(); }
     char peek(std::size_t ahead = 0) const { return pos_ + ahead < text_.size() ? text_[pos_ + ahead] : '\0'; }
@@ -42,8 +42,7 @@ public:
 
     [[noreturn]] void fail(const std::string& what) const { fail_at(pos_, what); }
     [[noreturn]] void fail_at(std::size_t pos, const std::string& what) const {
-        throw Error::input(source_, "line " + std::to_string(line_) + ", column " + std::to_string(column(pos)) +
-                                        ": " + what);
+        throw Error::input(source_, "line " + std::to_string(line_) + ", column " + std::to_string(column(pos)) + ": " + what);
     }
     // "'x'" for messages, or "end of line".
     std::string describe_next() const {

@@ -40,8 +40,10 @@ TreeString tree_to_module_string(const TreeGraph& tree) {
     while (!stack.empty()) {
         const auto [action, node] = stack.back();
         stack.pop_back();
-        if (action == Action::Push) s.push_back(Alphabet::kPush, {});
-        else if (action == Action::Pop) s.push_back(Alphabet::kPop, {});
+        if (action == Action::Push)
+            s.push_back(Alphabet::kPush, {});
+        else if (action == Action::Pop)
+            s.push_back(Alphabet::kPop, {});
         else {
             emit_internode(node);
             expand(node);

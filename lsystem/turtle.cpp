@@ -30,8 +30,7 @@ void check_brackets(const ModuleString& string, const std::string& source_name) 
             open.pop_back();
         }
     }
-    if (!open.empty())
-        throw Error::input(source, "'[' at module " + std::to_string(open.back()) + " is never closed");
+    if (!open.empty()) throw Error::input(source, "'[' at module " + std::to_string(open.back()) + " is never closed");
 }
 
 Turtle::Turtle(const Alphabet& alphabet, const TurtleOptions& options) : options_(options) {
@@ -75,61 +74,81 @@ void Turtle::rotate(Eigen::Vector3d& a, Eigen::Vector3d& b, double degrees) {
 
 void Turtle::apply(const ModuleString& string, std::size_t i) {
     const int symbol = string.symbol(i);
-    const Command command = static_cast<std::size_t>(symbol) < commands_.size() ? commands_[static_cast<std::size_t>(symbol)]
-                                                                                : Command::None;
+    const Command command =
+            static_cast<std::size_t>(symbol) < commands_.size() ? commands_[static_cast<std::size_t>(symbol)] : Command::None;
     const double angle = string.param_or(i, options_.angle_deg);
     switch (command) {
-    case Command::None: break;
-    case Command::Forward: forward(string, i, true); break;
-    case Command::Move: forward(string, i, false); break;
-    case Command::Left: rotate(state_.heading, state_.left, angle); break;
-    case Command::Right: rotate(state_.heading, state_.left, -angle); break;
-    case Command::PitchDown: rotate(state_.heading, state_.up, -angle); break;
-    case Command::PitchUp: rotate(state_.heading, state_.up, angle); break;
-    case Command::RollLeft: rotate(state_.left, state_.up, angle); break;
-    case Command::RollRight: rotate(state_.left, state_.up, -angle); break;
-    case Command::TurnAround:
-        state_.heading = -state_.heading;
-        state_.left = -state_.left;
-        break;
-    case Command::RollHorizontal: {
-        const Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(state_.heading);
-        // Undefined when heading straight up or down: keep the frame (as cpfg does).
-        if (left.norm() > 1e-12) {
-            state_.left = left.normalized();
-            state_.up = state_.heading.cross(state_.left);
+        case Command::None:
+            break;
+        case Command::Forward:
+            forward(string, i, true);
+            break;
+        case Command::Move:
+            forward(string, i, false);
+            break;
+        case Command::Left:
+            rotate(state_.heading, state_.left, angle);
+            break;
+        case Command::Right:
+            rotate(state_.heading, state_.left, -angle);
+            break;
+        case Command::PitchDown:
+            rotate(state_.heading, state_.up, -angle);
+            break;
+        case Command::PitchUp:
+            rotate(state_.heading, state_.up, angle);
+            break;
+        case Command::RollLeft:
+            rotate(state_.left, state_.up, angle);
+            break;
+        case Command::RollRight:
+            rotate(state_.left, state_.up, -angle);
+            break;
+        case Command::TurnAround:
+            state_.heading = -state_.heading;
+            state_.left = -state_.left;
+            break;
+        case Command::RollHorizontal: {
+            const Eigen::Vector3d left = Eigen::Vector3d::UnitZ().cross(state_.heading);
+            // Undefined when heading straight up or down: keep the frame (as cpfg does).
+            if (left.norm() > 1e-12) {
+                state_.left = left.normalized();
+                state_.up = state_.heading.cross(state_.left);
+            }
+            break;
         }
-        break;
-    }
-    case Command::Push:
-        stack_.push_back(state_);
-        ++state_.depth;
-        break;
-    case Command::Pop:
-        if (stack_.empty()) throw Error::input("", "module string: ']' at module " + std::to_string(i) + " has no matching '['");
-        state_ = stack_.back();
-        stack_.pop_back();
-        break;
-    case Command::Width:
-        if (string.param_count(i) == 0) state_.width *= options_.width_factor;
-        else {
-            const double w = string.params(i)[0];
-            if (!(w >= 0.0)) throw Error::input("", "module string: " + module_text(string, i) + " sets a negative width");
-            state_.width = w;
+        case Command::Push:
+            stack_.push_back(state_);
+            ++state_.depth;
+            break;
+        case Command::Pop:
+            if (stack_.empty()) throw Error::input("", "module string: ']' at module " + std::to_string(i) + " has no matching '['");
+            state_ = stack_.back();
+            stack_.pop_back();
+            break;
+        case Command::Width:
+            if (string.param_count(i) == 0)
+                state_.width *= options_.width_factor;
+            else {
+                const double w = string.params(i)[0];
+                if (!(w >= 0.0)) throw Error::input("", "module string: " + module_text(string, i) + " sets a negative width");
+                state_.width = w;
+            }
+            break;
+        case Command::SetHead:
+            set_heading(string.params(i), i);
+            break;
+        case Command::Leaf: {
+            LeafPlacement leaf;
+            leaf.position = state_.position.cast<float>();
+            leaf.heading = state_.heading.cast<float>();
+            leaf.up = state_.up.cast<float>();
+            leaf.size = static_cast<float>(string.param_or(i, options_.leaf_size));
+            leaf.node = state_.node;
+            leaf.module = static_cast<std::uint32_t>(i);
+            result_.leaves.push_back(leaf);
+            break;
         }
-        break;
-    case Command::SetHead: set_heading(string.params(i), i); break;
-    case Command::Leaf: {
-        LeafPlacement leaf;
-        leaf.position = state_.position.cast<float>();
-        leaf.heading = state_.heading.cast<float>();
-        leaf.up = state_.up.cast<float>();
-        leaf.size = static_cast<float>(string.param_or(i, options_.leaf_size));
-        leaf.node = state_.node;
-        leaf.module = static_cast<std::uint32_t>(i);
-        result_.leaves.push_back(leaf);
-        break;
-    }
     }
 }
 

@@ -36,17 +36,17 @@
 namespace treelobes::lsystem {
 
 struct TurtleOptions {
-    double step = 1.0;              // F and f without parameter
-    double angle_deg = 45.0;        // + - & ^ \ / without parameter
-    double initial_width = 1.0;     // width before the first '!'
-    double width_factor = 0.7;      // '!' without parameter multiplies the width by this
-    double radius_per_width = 0.5;  // widths are diameters: radius = width / 2
-    std::optional<double> root_width;        // root radius = root_width * radius_per_width when set
+    double step = 1.0;                        // F and f without parameter
+    double angle_deg = 45.0;                  // + - & ^ \ / without parameter
+    double initial_width = 1.0;               // width before the first '!'
+    double width_factor = 0.7;                // '!' without parameter multiplies the width by this
+    double radius_per_width = 0.5;            // widths are diameters: radius = width / 2
+    std::optional<double> root_width;         // root radius = root_width * radius_per_width when set
     Eigen::Vector3d tropism{0.0, 0.0, -1.0};  // T, the direction branches bend toward (gravity)
     double elasticity = 0.0;                  // e of ABOP; 0 = no tropism
     Eigen::Vector3d start{0.0, 0.0, 0.0};     // root position (local coordinates)
     std::vector<std::string> leaf_modules{"L"};
-    double leaf_size = 1.0;                   // leaf module without parameter
+    double leaf_size = 1.0;  // leaf module without parameter
 };
 
 // A leaf recorded by the turtle (for foliage meshes and the foliage box hierarchy, Lluch et al. 2010, via Ong's seminar report, §3.2).
@@ -61,9 +61,9 @@ struct LeafPlacement {
 
 struct TurtleResult {
     TreeGraph tree;
-    std::vector<int> depth;               // per node: bracket depth at which it was drawn
-    std::vector<std::uint32_t> module;    // per node: index of its F/f module (root: UINT32_MAX)
-    std::vector<unsigned char> drawn;     // per node: 1 for F, 0 for f and the root
+    std::vector<int> depth;             // per node: bracket depth at which it was drawn
+    std::vector<std::uint32_t> module;  // per node: index of its F/f module (root: UINT32_MAX)
+    std::vector<unsigned char> drawn;   // per node: 1 for F, 0 for f and the root
     std::vector<LeafPlacement> leaves;
 };
 
@@ -102,8 +102,22 @@ public:
 
 private:
     enum class Command : unsigned char {
-        None, Forward, Move, Left, Right, PitchDown, PitchUp, RollLeft, RollRight, TurnAround,
-        RollHorizontal, Push, Pop, Width, SetHead, Leaf,
+        None,
+        Forward,
+        Move,
+        Left,
+        Right,
+        PitchDown,
+        PitchUp,
+        RollLeft,
+        RollRight,
+        TurnAround,
+        RollHorizontal,
+        Push,
+        Pop,
+        Width,
+        SetHead,
+        Leaf,
     };
 
     void forward(const ModuleString& string, std::size_t i, bool draw);

@@ -119,7 +119,8 @@ std::size_t fit_cylinder_axes(TreeGraph& tree, std::span<const Eigen::Vector3f> 
             members.clear();
             for (std::size_t j = lo; j <= hi; ++j) {
                 const auto v = static_cast<std::size_t>(axis[j]);
-                members.insert(members.end(), grouped.begin() + static_cast<long>(start[v]), grouped.begin() + static_cast<long>(start[v + 1]));
+                members.insert(members.end(), grouped.begin() + static_cast<long>(start[v]),
+                               grouped.begin() + static_cast<long>(start[v + 1]));
             }
             if (members.size() < static_cast<std::size_t>(o.min_points)) continue;
             const Eigen::Vector3d a = tree.nodes[axis[lo - 1]].position.cast<double>();
@@ -141,14 +142,20 @@ std::size_t fit_cylinder_axes(TreeGraph& tree, std::span<const Eigen::Vector3f> 
             const CylinderFit fit = fit_cylinder(window, node, d0, r0);
             const double r = fit.radius;
             int reason = -1;
-            if (!fit.converged) reason = 0;
-            else if (!(r >= o.min_radius && r <= o.max_radius)) reason = 1;
+            if (!fit.converged)
+                reason = 0;
+            else if (!(r >= o.min_radius && r <= o.max_radius))
+                reason = 1;
             else if (fit.rms > o.max_rms * r || cross_section_spread(tree, axis, lo, hi, points, start, grouped) < o.min_spread * r)
                 reason = 2;
-            else if (fit.arc < o.min_arc) reason = 3;
-            else if (std::abs(fit.direction.dot(d0)) < cos_tilt) reason = 4;
-            if (reason >= 0) ++rejected[reason];
-            else fits[c] = fit;
+            else if (fit.arc < o.min_arc)
+                reason = 3;
+            else if (std::abs(fit.direction.dot(d0)) < cos_tilt)
+                reason = 4;
+            if (reason >= 0)
+                ++rejected[reason];
+            else
+                fits[c] = fit;
         }
         std::size_t c = 0;
         for (std::size_t i = 1; i < axis.size(); ++i) {
@@ -168,8 +175,9 @@ std::size_t fit_cylinder_axes(TreeGraph& tree, std::span<const Eigen::Vector3f> 
     }
     for (std::size_t u = 1; u < n; ++u) tree.nodes[u].position += shift[u];
     log_debug("cylinder axes: " + std::to_string(moved) + " nodes moved, " + std::to_string(tried) + " fits; rejected: no fit " +
-              std::to_string(rejected[0]) + ", radius " + std::to_string(rejected[1]) + ", residual or spread " + std::to_string(rejected[2]) +
-              ", arc " + std::to_string(rejected[3]) + ", tilt " + std::to_string(rejected[4]) + ", nodes beyond the shift limit " + std::to_string(rejected[5]));
+              std::to_string(rejected[0]) + ", radius " + std::to_string(rejected[1]) + ", residual or spread " +
+              std::to_string(rejected[2]) + ", arc " + std::to_string(rejected[3]) + ", tilt " + std::to_string(rejected[4]) +
+              ", nodes beyond the shift limit " + std::to_string(rejected[5]));
     return moved;
 }
 

@@ -36,16 +36,16 @@
 namespace treelobes {
 
 struct CylinderAxesOptions {
-    bool enabled = false;      // off by default: it lowers the WoodSKE medians but raises archi tree1's (see docs/reconstruct.md)
-    float window = 0.4f;       // metres of branch axis whose points one cylinder is fitted to
-    int min_points = 20;       // stretches with fewer points keep their nodes
-    float min_radius = 0.004f; // metres: thinner fits are rejected (noise fits)
-    float max_radius = 0.15f;  // metres: wider fits are rejected
-    float max_rms = 0.25f;     // x radius: RMS of the points' distances from the cylinder surface
-    float min_spread = 0.7f;   // x radius: the points' cross-section spread (RMS about each internode's centroid) must reach this
-    float min_arc = 100.0f;    // degrees of bark around the fitted axis that must hold points
-    float max_tilt = 30.0f;    // degrees between the fitted axis and the skeleton's direction
-    float max_shift = 1.5f;    // x radius: nodes that would move farther stay where they are
+    bool enabled = false;       // off by default: it lowers the WoodSKE medians but raises archi tree1's (see docs/reconstruct.md)
+    float window = 0.4f;        // metres of branch axis whose points one cylinder is fitted to
+    int min_points = 20;        // stretches with fewer points keep their nodes
+    float min_radius = 0.004f;  // metres: thinner fits are rejected (noise fits)
+    float max_radius = 0.15f;   // metres: wider fits are rejected
+    float max_rms = 0.25f;      // x radius: RMS of the points' distances from the cylinder surface
+    float min_spread = 0.7f;    // x radius: the points' cross-section spread (RMS about each internode's centroid) must reach this
+    float min_arc = 100.0f;     // degrees of bark around the fitted axis that must hold points
+    float max_tilt = 30.0f;     // degrees between the fitted axis and the skeleton's direction
+    float max_shift = 1.5f;     // x radius: nodes that would move farther stay where they are
 };
 
 // Moves the non-fixed nodes of `tree` across onto trusted cylinder fits (see above); a window

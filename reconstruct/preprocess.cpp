@@ -35,7 +35,8 @@ OutlierTest parse_outlier_test(const std::string& text) {
 namespace {
 
 void check_options(const PreprocessOptions& o) {
-    if (!(o.duplicate_distance >= 0) || !(o.voxel_size >= 0)) throw Error::usage("preprocess: duplicate distance and voxel size must be >= 0");
+    if (!(o.duplicate_distance >= 0) || !(o.voxel_size >= 0))
+        throw Error::usage("preprocess: duplicate distance and voxel size must be >= 0");
     if (o.outlier_neighbours < 0 || o.outlier_neighbours > 64) throw Error::usage("preprocess: outlier neighbours must be in 0..64");
     if (o.table_width < 0 || o.table_width > 64) throw Error::usage("preprocess: table width must be in 0..64");
     if (!(o.outlier_sigma > 0)) throw Error::usage("preprocess: outlier sigma must be > 0");
@@ -65,8 +66,7 @@ std::vector<int> merge_cells(const std::vector<Eigen::Vector3f>& input, float ce
     std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key[a] < key[b]; });
     // The first input index of each cell represents it; kept points stay in input order.
     std::vector<int> leader(n);
-    for (std::size_t i = 0; i < n; ++i)
-        leader[order[i]] = (i > 0 && key[order[i]] == key[order[i - 1]]) ? leader[order[i - 1]] : order[i];
+    for (std::size_t i = 0; i < n; ++i) leader[order[i]] = (i > 0 && key[order[i]] == key[order[i - 1]]) ? leader[order[i - 1]] : order[i];
     std::vector<int> kept_index(n, -1);
     for (std::size_t i = 0; i < n; ++i)
         if (leader[i] == static_cast<int>(i)) {
@@ -183,8 +183,8 @@ bool looks_leafy(const NeighbourhoodShapes& shapes, float max_linear) {
 // The kNN table of the kept points, read from the table of all points where a row still holds
 // `width` kept points (the nearest kept ones, in the same order); rows that lost too many
 // neighbours to the filters are queried again on `kept_tree`.
-KnnTable kept_neighbours(const KnnTable& all, const std::vector<int>& final_index, const std::vector<int>& source,
-                         const KdTree& kept_tree, int width) {
+KnnTable kept_neighbours(const KnnTable& all, const std::vector<int>& final_index, const std::vector<int>& source, const KdTree& kept_tree,
+                         int width) {
     KnnTable table;
     table.k = width;
     const std::size_t n = source.size(), w = static_cast<std::size_t>(width);
@@ -245,8 +245,8 @@ std::vector<bool> on_ground_plane(const std::vector<Eigen::Vector3f>& points, co
 
 // Ground: a near-horizontal plane among the lowest points that is wider than any stem. Returns
 // the points at most `tolerance` above it (or below it).
-std::vector<bool> find_ground(const std::vector<Eigen::Vector3f>& points, const std::vector<bool>& removed,
-                              const PreprocessOptions& o, Preprocessed& out) {
+std::vector<bool> find_ground(const std::vector<Eigen::Vector3f>& points, const std::vector<bool>& removed, const PreprocessOptions& o,
+                              Preprocessed& out) {
     std::vector<bool> ground(points.size(), false);
     if (o.ground == GroundMode::Keep) return ground;
     float z_low = std::numeric_limits<float>::infinity(), z_high = -z_low;
@@ -335,8 +335,8 @@ Preprocessed preprocess_cloud(const PointCloud& cloud, const PreprocessOptions& 
     out.point_of_input.resize(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) out.point_of_input[i] = final_index[representative[i]];
     if (out.points.size() < 10)
-        throw Error::input(name, "too few points left after removing duplicates, outliers and ground (" +
-                                     std::to_string(out.points.size()) + ")");
+        throw Error::input(
+                name, "too few points left after removing duplicates, outliers and ground (" + std::to_string(out.points.size()) + ")");
     if (options.table_width > 0) {
         auto index = std::make_shared<const KdTree>(out.points);
         out.neighbours = std::make_shared<const KnnTable>(filter ? kept_neighbours(all, final_index, source, *index, options.table_width)

@@ -30,15 +30,15 @@
 namespace treelobes {
 
 struct RecentreOptions {
-    bool enabled = true;      // off: the skeleton is left as extracted
-    float max_spread = 0.10f; // metres: internodes whose points spread wider around their centroid stay put
-    int min_points = 3;       // internodes with fewer points stay put
-    int passes = 3;           // Gaussian reweighting rounds around the centre (0 = plain centroid)
-    double min_sigma = 0.02;  // metres: the reweighting never narrows below this
-    double inside_band = 1.0; // x the points' spread: nodes closer than this to their centroid are inside
-                              // their branch and stay (0 = every thin node moves)
-    double dead_band = 0.5;   // x the bark's spread around the robust centre: a moving node stops at this
-                              // distance from it (0 = right onto the centre)
+    bool enabled = true;       // off: the skeleton is left as extracted
+    float max_spread = 0.10f;  // metres: internodes whose points spread wider around their centroid stay put
+    int min_points = 3;        // internodes with fewer points stay put
+    int passes = 3;            // Gaussian reweighting rounds around the centre (0 = plain centroid)
+    double min_sigma = 0.02;   // metres: the reweighting never narrows below this
+    double inside_band = 1.0;  // x the points' spread: nodes closer than this to their centroid are inside
+                               // their branch and stay (0 = every thin node moves)
+    double dead_band = 0.5;    // x the bark's spread around the robust centre: a moving node stops at this
+                               // distance from it (0 = right onto the centre)
 };
 
 // Moves every non-root node u towards the lateral centre of u's internode points (their

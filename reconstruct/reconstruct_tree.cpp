@@ -122,9 +122,9 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     out.trunk = fit_trunk(pre.points, sk.point_internode, sk.tree, o.trunk);
     for (const auto& slice : out.trunk.slices) {
         char line[200];
-        std::snprintf(line, sizeof line, "stem slice at %.2f m: %zu points, centre %.3f %.3f %.3f, radius %.3f, rms %.3f, coverage %.2f%s", slice.height,
-                      slice.points, slice.centre.x(), slice.centre.y(), slice.centre.z(),
-                      slice.radius, slice.rms, slice.coverage, slice.good ? "" : " (rejected)");
+        std::snprintf(line, sizeof line, "stem slice at %.2f m: %zu points, centre %.3f %.3f %.3f, radius %.3f, rms %.3f, coverage %.2f%s",
+                      slice.height, slice.points, slice.centre.x(), slice.centre.y(), slice.centre.z(), slice.radius, slice.rms,
+                      slice.coverage, slice.good ? "" : " (rejected)");
         log_debug(line);
     }
     // The root sits on the stem axis continued from the fitted slices to the foot.
@@ -140,8 +140,8 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     s.root_diameter = static_cast<float>(d_root);
     out.diameters = apply_allometry(sk.tree, d_root, o.allometry);
     describe_tree(sk.tree, s);
-    if (s.quality.not_a_tree) log_warn(name + ": does not look like a tree (" + std::to_string(s.quality.planar_fraction) +
-                                       " of the points lie on wide planes)");
+    if (s.quality.not_a_tree)
+        log_warn(name + ": does not look like a tree (" + std::to_string(s.quality.planar_fraction) + " of the points lie on wide planes)");
     clock.mark("trunk and radii");
 
     out.point_internode.assign(cloud.size(), -1);

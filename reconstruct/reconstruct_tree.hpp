@@ -22,7 +22,7 @@ namespace treelobes {
 struct ReconstructOptions {
     PreprocessOptions preprocess;
     SkeletonOptions skeleton;
-    RecentreOptions recentre;  // thin internodes moved across onto their points (reconstruct/recentre.hpp)
+    RecentreOptions recentre;           // thin internodes moved across onto their points (reconstruct/recentre.hpp)
     CylinderAxesOptions cylinder_axes;  // nodes moved onto cylinders fitted to stretches of branch (reconstruct/cylinder_axes.hpp)
     TrunkOptions trunk;
     AllometryOptions allometry;
@@ -40,16 +40,16 @@ struct TreeSummary {
     std::size_t ground_points = 0;
     std::size_t detached_points = 0;  // in pieces left out of the skeleton beyond gaps (--max-gap); they keep an internode
     bool ground_removed = false;
-    float height = 0.0f;           // metres from the stem foot to the highest point
+    float height = 0.0f;  // metres from the stem foot to the highest point
     bool dbh_fitted = false;
-    float dbh = 0.0f;              // metres (diameter at 1.3 m), when fitted
-    float root_diameter = 0.0f;    // d_root of Livny et al. 2011, Eq. 1 (metres)
+    float dbh = 0.0f;                  // metres (diameter at 1.3 m), when fitted
+    float root_diameter = 0.0f;        // d_root of Livny et al. 2011, Eq. 1 (metres)
     std::string root_diameter_source;  // "base fit", "breast height fit", "given", "height / 50"
-    float crown_width = 0.0f;      // mean of the two principal horizontal extents (metres)
-    float total_length = 0.0f;     // sum of skeleton internode lengths (metres)
-    std::size_t branches = 0;      // axes: the trunk plus one per lateral child
+    float crown_width = 0.0f;          // mean of the two principal horizontal extents (metres)
+    float total_length = 0.0f;         // sum of skeleton internode lengths (metres)
+    std::size_t branches = 0;          // axes: the trunk plus one per lateral child
     std::size_t internodes = 0;
-    std::size_t recentred_nodes = 0;  // nodes moved onto their internode's points
+    std::size_t recentred_nodes = 0;      // nodes moved onto their internode's points
     std::size_t cylinder_axis_nodes = 0;  // nodes moved onto the axis of a fitted cylinder
     std::size_t tips = 0;
     int max_branch_order = 0;
@@ -65,8 +65,8 @@ struct TreeSummary {
 };
 
 struct TreeReconstruction {
-    TreeGraph skeleton;                 // radii = d(u)/2, origin of the input cloud
-    AllometricDiameters diameters;      // d and d' per node
+    TreeGraph skeleton;             // radii = d(u)/2, origin of the input cloud
+    AllometricDiameters diameters;  // d and d' per node
     TrunkFit trunk;
     std::vector<int> point_internode;   // per input point; -1 for points removed as outliers/ground
     std::vector<float> point_geodesic;  // per input point (metres); -1 for removed points

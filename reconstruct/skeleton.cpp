@@ -81,9 +81,7 @@ struct Clusters {
     Eigen::Vector3d centroid(int c) const { return sum[c] / static_cast<double>(count[c]); }
     // RMS distance of the points from their centroid: about the branch radius for a slice of
     // a thick branch, about w / sqrt(12) for a thin one.
-    double spread(int c) const {
-        return std::sqrt(std::max(0.0, sum_sq[c] / static_cast<double>(count[c]) - centroid(c).squaredNorm()));
-    }
+    double spread(int c) const { return std::sqrt(std::max(0.0, sum_sq[c] / static_cast<double>(count[c]) - centroid(c).squaredNorm())); }
 };
 
 // Even the geodesic distance on a kNN graph is ragged by a few per cent between neighbours
@@ -159,8 +157,8 @@ std::vector<float> slice_thickness(std::span<const Eigen::Vector3f> points, cons
 // point it reaches (accumulated along the geodesic tree, parents first), so thin branches are cut
 // into finer slices than thick stems. The width changes only from one slice to the next, so
 // every level set stays a cross-section.
-std::vector<float> bin_levels(const NeighbourGraph& graph, const ShortestPaths& sp, float width,
-                              const std::vector<float>& point_width, int smoothing) {
+std::vector<float> bin_levels(const NeighbourGraph& graph, const ShortestPaths& sp, float width, const std::vector<float>& point_width,
+                              int smoothing) {
     if (point_width.empty()) {
         std::vector<float> level = smoothed_lengths(graph, sp.length, smoothing);
         for (float& l : level) l /= width;
@@ -175,9 +173,8 @@ std::vector<float> bin_levels(const NeighbourGraph& graph, const ShortestPaths& 
 }
 
 // `point_width` (empty: `width` everywhere) gives each point its own bin width.
-Clusters cluster_bins(std::span<const Eigen::Vector3f> points, const NeighbourGraph& graph, const KnnTable& near,
-                      const ShortestPaths& sp, const ShortestPaths& weighted, float width, const std::vector<float>& point_width,
-                      float join, int smoothing) {
+Clusters cluster_bins(std::span<const Eigen::Vector3f> points, const NeighbourGraph& graph, const KnnTable& near, const ShortestPaths& sp,
+                      const ShortestPaths& weighted, float width, const std::vector<float>& point_width, float join, int smoothing) {
     const int n = static_cast<int>(points.size());
     const std::vector<float> level = bin_levels(graph, sp, width, point_width, smoothing);
     std::vector<int> bin(points.size());
@@ -275,7 +272,8 @@ Clusters merge_fragments(std::span<const Eigen::Vector3f> points, const Clusters
     for (int p = -1; p < m; ++p) {
         if (p >= 0 && rep[p] != p) continue;
         std::vector<int> kids;
-        if (p < 0) kids = children[m];
+        if (p < 0)
+            kids = children[m];
         else
             for (int x : members[p]) kids.insert(kids.end(), children[x].begin(), children[x].end());
         std::sort(kids.begin(), kids.end());
@@ -332,14 +330,14 @@ struct SlabFit {
     float rise = 0.0f;          // metres along the axis from the node below
 };
 
-std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, const Clusters& c,
-                                   const std::vector<std::vector<int>>& members, const std::vector<std::vector<int>>& children,
-                                   const std::vector<Eigen::Vector3f>& position, const std::vector<bool>& on_axis, float stem,
-                                   float extrapolated, int k, float spacing, float bin_width) {
-    constexpr std::size_t sparse_slab = 24;  // points a slab needs for a circle fit
+std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, const Clusters& c, const std::vector<std::vector<int>>& members,
+                                   const std::vector<std::vector<int>>& children, const std::vector<Eigen::Vector3f>& position,
+                                   const std::vector<bool>& on_axis, float stem, float extrapolated, int k, float spacing,
+                                   float bin_width) {
+    constexpr std::size_t sparse_slab = 24;    // points a slab needs for a circle fit
     constexpr float max_extrapolated = 16.0f;  // bin widths of axis length
-    constexpr float min_slab_radius = 0.12f;  // metres: thinner stems keep the clusters' own fits
-    constexpr int reach = 8;                 // bins either side whose clusters the slab draws from
+    constexpr float min_slab_radius = 0.12f;   // metres: thinner stems keep the clusters' own fits
+    constexpr int reach = 8;                   // bins either side whose clusters the slab draws from
     if (!(stem >= std::max(2.0f * spacing, min_slab_radius))) return std::nullopt;
     const int below = c.parent[k];
     const Eigen::Vector3f base = position[below];
@@ -392,8 +390,8 @@ std::optional<SlabFit> slab_centre(std::span<const Eigen::Vector3f> points, cons
         return SlabFit{centre, stem, true, std::max(t, 0.0f)};
     }
     const CircleFit circle = fit_circle(flat, std::max(0.005f, spacing), stem / 1.6f, 1.6f * stem, 100);
-    const bool trusted = circle.ok && circle.coverage >= 0.2f && circle.inliers * 2 >= flat.size() &&
-                         circle.rms < 0.25f * circle.radius && circle.centre.norm() < 0.5f * circle.radius;
+    const bool trusted = circle.ok && circle.coverage >= 0.2f && circle.inliers * 2 >= flat.size() && circle.rms < 0.25f * circle.radius &&
+                         circle.centre.norm() < 0.5f * circle.radius;
     if (!trusted) return std::nullopt;
     return SlabFit{centre + circle.centre.x() * u + circle.centre.y() * v, circle.radius, false};
 }
@@ -419,8 +417,8 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
     // takes its parent's (a one-sided scan is one-sided all along the stem).
     std::vector<Eigen::Vector3f> offset(c.size(), Eigen::Vector3f::Zero());
     std::vector<bool> has_offset(c.size(), false);
-    std::vector<bool> on_axis(c.size(), false);      // placed by a trusted circle or slab fit
-    std::vector<float> axis_radius(c.size(), 0.0f);  // of that circle
+    std::vector<bool> on_axis(c.size(), false);       // placed by a trusted circle or slab fit
+    std::vector<float> axis_radius(c.size(), 0.0f);   // of that circle
     std::vector<float> extrapolated(c.size(), 0.0f);  // axis length over consecutive slabs too sparse to fit, up to this cluster
     std::size_t resliced = 0;
     for (std::size_t k = 0; k < c.size(); ++k) {
@@ -430,8 +428,8 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
         // A cluster on a thick stem whose axis is known below is placed by a slab across that
         // axis (its own bin may be an arc of a winding geodesic); elsewhere by its own fit.
         if (below >= 0 && on_axis[below]) {
-            if (const auto slab = slab_centre(points, c, members, children, position, on_axis, axis_radius[below],
-                                              extrapolated[below], static_cast<int>(k), spacing, bin_width)) {
+            if (const auto slab = slab_centre(points, c, members, children, position, on_axis, axis_radius[below], extrapolated[below],
+                                              static_cast<int>(k), spacing, bin_width)) {
                 ++resliced;
                 extrapolated[k] = slab->extrapolated ? extrapolated[below] + slab->rise : 0.0f;
                 position[k] = slab->position;
@@ -450,8 +448,9 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
             if (children[high].size() == 1) high = children[high].front();
         }
         const Eigen::Vector3f from = position[low];
-        const Eigen::Vector3f to = high != static_cast<int>(k) ? c.centroid(high).cast<float>()
-                                   : (below >= 0 && low != below) ? position[below] : position[k];
+        const Eigen::Vector3f to = high != static_cast<int>(k)    ? c.centroid(high).cast<float>()
+                                   : (below >= 0 && low != below) ? position[below]
+                                                                  : position[k];
         if ((to - from).norm() < 1e-6f) continue;
         const Eigen::Vector3f direction = (to - from).normalized();
         const Eigen::Vector3f u = direction.unitOrthogonal(), v = direction.cross(u);
@@ -469,8 +468,8 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
         spread = std::sqrt(spread / static_cast<double>(flat.size()));
         if (spread < std::max(2.0 * spacing, 0.04)) continue;  // thin branch: the centroid is near the axis already
         ++tried;
-        const CircleFit circle = fit_circle(flat, std::max(0.005f, spacing), 0.5f * static_cast<float>(spread),
-                                            4.0f * static_cast<float>(spread), 100);
+        const CircleFit circle =
+                fit_circle(flat, std::max(0.005f, spacing), 0.5f * static_cast<float>(spread), 4.0f * static_cast<float>(spread), 100);
         const bool trusted = circle.ok && circle.coverage >= 0.2f && circle.inliers * 2 >= flat.size() &&
                              circle.rms < 0.25f * circle.radius && circle.centre.norm() < circle.radius;
         if (!trusted) {
@@ -495,8 +494,8 @@ std::vector<Eigen::Vector3f> axis_positions(std::span<const Eigen::Vector3f> poi
         position[k] += offset[k];
     }
     log_debug("skeleton: circle fits tried on " + std::to_string(tried) + " of " + std::to_string(c.size()) + " clusters, " +
-              std::to_string(moved) + " moved onto the fitted axis, " + std::to_string(resliced) + " onto a slab fit across the axis below, " +
-              std::to_string(inherited) + " took their parent's offset");
+              std::to_string(moved) + " moved onto the fitted axis, " + std::to_string(resliced) +
+              " onto a slab fit across the axis below, " + std::to_string(inherited) + " took their parent's offset");
     for (std::size_t k = 0; k < c.size(); ++k) fitted[k] = on_axis[k];
     return position;
 }
@@ -520,7 +519,7 @@ std::vector<bool> detached_clusters(const Clusters& c, const NeighbourGraph& gra
         for (std::uint32_t e = graph.offsets[v]; e < graph.offsets[v + 1]; ++e)
             if (graph.targets[e] == u) hop[v] = graph.lengths[e];
     }
-    std::vector<int> above(n, 1);  // points of the shortest-path subtree from each point up
+    std::vector<int> above(n, 1);                                   // points of the shortest-path subtree from each point up
     for (auto it = sp.order.rbegin(); it != sp.order.rend(); ++it)  // children before parents
         if (sp.parent[*it] >= 0) above[sp.parent[*it]] += above[*it];
     std::vector<char> gone(n, 0);
@@ -538,8 +537,7 @@ std::vector<bool> detached_clusters(const Clusters& c, const NeighbourGraph& gra
 
 // Node 0 at the stem foot, node c+1 at the axis position of cluster c. Until allometry sets
 // the radii, a node's radius holds its cluster's spread (a measured thickness) for pruning.
-TreeGraph cluster_tree(const Clusters& c, const std::vector<Eigen::Vector3f>& position, const Eigen::Vector3f& root,
-                       float root_spread) {
+TreeGraph cluster_tree(const Clusters& c, const std::vector<Eigen::Vector3f>& position, const Eigen::Vector3f& root, float root_spread) {
     TreeGraph tree;
     tree.add_node(root, root_spread, -1);
     for (std::size_t k = 0; k < c.size(); ++k)
@@ -605,7 +603,8 @@ std::size_t prune_twigs(TreeGraph& tree, float min_length, std::vector<int>& nod
         for (const auto& [fork, list] : by_fork) {
             if (list.size() < 2) continue;
             std::size_t longest = list.front();  // the fork's main chain
-            for (std::size_t k : list) if (weight[k] > weight[longest]) longest = k;
+            for (std::size_t k : list)
+                if (weight[k] > weight[longest]) longest = k;
             std::vector<int> axis = chains[longest];
             if (tree.nodes[fork].parent >= 0) axis.insert(axis.begin(), tree.nodes[fork].parent);
             const float limit = std::max(min_length, 2.0f * tree.nodes[fork].radius);
@@ -682,9 +681,10 @@ TreeGraph resample(const TreeGraph& tree, float l, std::vector<int>& new_of_old,
             const Eigen::Vector3f pos = t == m ? p.back() : point_at(p, arc, s);
             previous = out.add_node(pos, 0.0f, previous);
             created[t] = previous;
-            const std::size_t i = t == m ? chain.size() - 1
-                                         : std::clamp<std::size_t>(static_cast<std::size_t>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()), 1,
-                                                                   chain.size() - 1);
+            const std::size_t i =
+                    t == m ? chain.size() - 1
+                           : std::clamp<std::size_t>(static_cast<std::size_t>(std::upper_bound(arc.begin(), arc.end(), s) - arc.begin()), 1,
+                                                     chain.size() - 1);
             new_flags.push_back(flags[chain[i - 1]] && flags[chain[i]]);
         }
         for (std::size_t i = 1; i < chain.size(); ++i) {
@@ -712,7 +712,8 @@ struct Slicing {
     int geodesic_smoothing;
 
     Clusters clusters(const std::vector<float>& point_width) const {
-        return merge_fragments(points, cluster_bins(points, graph, near, sp, weighted, bin_width, point_width, bin_width, geodesic_smoothing),
+        return merge_fragments(points,
+                               cluster_bins(points, graph, near, sp, weighted, bin_width, point_width, bin_width, geodesic_smoothing),
                                merge, root_spread);
     }
 };
@@ -813,7 +814,8 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     r.spacing = median_nearest_distance(graph);
     const float sampling = sampling_distance(near);
     r.bin_width = o.bin_width > 0 ? o.bin_width : std::clamp(2.5f * sampling, 0.02f, 0.5f);
-    log_debug("skeleton: nearest-neighbour spacing " + std::to_string(r.spacing) + " m, sampling distance " + std::to_string(sampling) + " m");
+    log_debug("skeleton: nearest-neighbour spacing " + std::to_string(r.spacing) + " m, sampling distance " + std::to_string(sampling) +
+              " m");
     r.internode_length = o.internode_length > 0 ? o.internode_length : r.bin_width;
     const float twig = o.min_twig_length > 0 ? o.min_twig_length : 2.0f * r.bin_width;
     const float merge = o.merge_distance > 0 ? o.merge_distance : r.bin_width;
@@ -831,8 +833,8 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     lap("bins");
 
     std::vector<char> fitted;
-    TreeGraph tree =
-        cluster_tree(clusters, axis_positions(points, clusters, r.spacing, r.bin_width, o.fit_axes, fitted), r.base.position, root_spread);
+    TreeGraph tree = cluster_tree(clusters, axis_positions(points, clusters, r.spacing, r.bin_width, o.fit_axes, fitted), r.base.position,
+                                  root_spread);
     // Node flags: placed on a measured axis (the root by the foot's circle fit).
     std::vector<char> on_axis(tree.size(), 0);
     on_axis[0] = r.base.circle_fitted;

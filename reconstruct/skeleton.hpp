@@ -65,13 +65,13 @@ struct SkeletonResult {
     // one-sided scans of thick stems), so later re-centring on those points must leave it.
     std::vector<bool> node_on_axis;
     TreeBase base;
-    float spacing = 0.0f;               // median nearest-neighbour distance (metres)
+    float spacing = 0.0f;  // median nearest-neighbour distance (metres)
     float bin_width = 0.0f;
     float internode_length = 0.0f;
-    std::size_t clusters = 0;           // bin clusters after merging fragments
-    std::size_t pruned_nodes = 0;       // clusters removed as spurious twigs
-    std::size_t detached_points = 0;    // points beyond a gap > max_gap, assigned to the internode they hang from
-    std::size_t graph_components = 0;   // pieces of the neighbour graph before bridging
+    std::size_t clusters = 0;          // bin clusters after merging fragments
+    std::size_t pruned_nodes = 0;      // clusters removed as spurious twigs
+    std::size_t detached_points = 0;   // points beyond a gap > max_gap, assigned to the internode they hang from
+    std::size_t graph_components = 0;  // pieces of the neighbour graph before bridging
     std::size_t bridges = 0;
     float longest_bridge = 0.0f;
 };
@@ -81,9 +81,8 @@ struct SkeletonResult {
 // `index` (a kd-tree over exactly these points) and `near` (their kNN table, skeleton_table_width
 // wide) may be passed when the caller has them already (preprocess_cloud does); they are built
 // here otherwise.
-SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, const SkeletonOptions& options,
-                                    const std::string& name = {}, const KdTree* index = nullptr,
-                                    const KnnTable* near = nullptr);
+SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, const SkeletonOptions& options, const std::string& name = {},
+                                    const KdTree* index = nullptr, const KnnTable* near = nullptr);
 
 // Width of the kNN table the skeleton works from: it serves the graph, the bridges, the
 // sampling distance and the joining of bin clusters.

@@ -103,7 +103,7 @@ std::vector<std::vector<double>> read_table(const fs::path& path) {
         }
         if (!rows.empty() && values.size() != rows.front().size())
             throw Error::input(path.string(), "line " + std::to_string(line_number) + ": expected " + std::to_string(rows.front().size()) +
-                                                  " columns, found " + std::to_string(values.size()));
+                                                      " columns, found " + std::to_string(values.size()));
         for (double v : values)
             if (!std::isfinite(v)) throw Error::input(path.string(), "line " + std::to_string(line_number) + ": non-finite value");
         rows.push_back(values);
@@ -184,7 +184,7 @@ float point_segment_distance(const Eigen::Vector3f& p, const Eigen::Vector3f& a,
 class NearestSegment {
 public:
     NearestSegment(const SkeletonGraph& g, const Eigen::Vector3d& origin, double step)
-        : graph_(g), origin_(origin), samples_(sample_graph(g, origin, step)), index_(samples_.position) {}
+            : graph_(g), origin_(origin), samples_(sample_graph(g, origin, step)), index_(samples_.position) {}
 
     // Distance and the segment (edge index, -1 for points) it was measured to.
     std::pair<float, int> operator()(const Eigen::Vector3f& q, std::vector<int>& found, std::vector<float>& d2) const {
@@ -296,7 +296,8 @@ BranchDetection detect_branches(const SkeletonGraph& ours, const SkeletonGraph& 
         // Thickness of an axis: its first node above the fork.
         if (2.0 * ref.tree->nodes[axis[1]].radius <= o.min_branch_diameter) continue;
         ++b.reference_branches;
-        b.detected += matched_fraction(*ref.tree, ref.tree->origin, axis, to_ours, ours, true, o.min_branch_diameter, o, origin) >= o.min_matched_fraction;
+        b.detected += matched_fraction(*ref.tree, ref.tree->origin, axis, to_ours, ours, true, o.min_branch_diameter, o, origin) >=
+                      o.min_matched_fraction;
     }
     for (const auto& axis : axes_of(*ours.tree)) {
         if (axis_length(*ours.tree, axis) < o.min_branch_length) continue;

@@ -32,14 +32,14 @@ namespace treelobes {
 
 // A skeleton as a general graph (possibly several pieces), in double global coordinates.
 struct SkeletonGraph {
-    std::string kind;                      // "skeleton", "treeqsm", "points"
+    std::string kind;  // "skeleton", "treeqsm", "points"
     std::vector<Eigen::Vector3d> vertices;
-    std::vector<float> radius;             // per vertex (0 when unknown)
+    std::vector<float> radius;  // per vertex (0 when unknown)
     std::vector<std::pair<int, int>> edges;
     std::vector<std::pair<int, int>> links;  // connections without length (TreeQSM child -> parent cylinder)
-    std::optional<double> trunk_radius;    // skeleton: radius of vertex 0; treeqsm: largest stem (order 0) cylinder
-    std::optional<TreeGraph> tree;         // when the edges form one tree rooted at vertex 0
-    std::size_t components() const;        // connected pieces (isolated vertices count, except for point lists)
+    std::optional<double> trunk_radius;      // skeleton: radius of vertex 0; treeqsm: largest stem (order 0) cylinder
+    std::optional<TreeGraph> tree;           // when the edges form one tree rooted at vertex 0
+    std::size_t components() const;          // connected pieces (isolated vertices count, except for point lists)
     double total_length() const;
 };
 
@@ -55,17 +55,17 @@ struct DistanceStats {
 struct BranchDetection {
     std::size_t reference_branches = 0;  // reference axes thicker than min_branch_diameter
     std::size_t detected = 0;
-    std::size_t skeleton_branches = 0;   // our axes at least min_branch_length long
+    std::size_t skeleton_branches = 0;  // our axes at least min_branch_length long
     std::size_t correct = 0;
     double recall = 0, precision = 0;
 };
 
 struct SkeletonComparison {
-    DistanceStats to_reference;            // skeleton samples -> reference
-    DistanceStats from_reference;          // reference samples -> skeleton
+    DistanceStats to_reference;    // skeleton samples -> reference
+    DistanceStats from_reference;  // reference samples -> skeleton
     double length = 0;
-    std::optional<double> reference_length;  // not for point lists
-    std::optional<double> length_ratio;      // length / reference_length
+    std::optional<double> reference_length;                                          // not for point lists
+    std::optional<double> length_ratio;                                              // length / reference_length
     std::optional<double> trunk_radius, reference_trunk_radius, trunk_radius_error;  // error relative to the reference
     std::size_t components = 0, reference_components = 0;
     std::optional<BranchDetection> branches;  // when the reference is a tree with radii

@@ -84,8 +84,10 @@ TreeBase find_tree_base(std::span<const Eigen::Vector3f> points, const Neighbour
     std::size_t pick = 0;
     bool any_narrow = false;
     for (std::size_t k = 0; k < pieces.size(); ++k) {
-        if (narrow[k] && (!any_narrow || bigger(pieces[k], pieces[pick]))) pick = k;
-        else if (!narrow[k] && !any_narrow && bigger(pieces[k], pieces[pick])) pick = k;
+        if (narrow[k] && (!any_narrow || bigger(pieces[k], pieces[pick])))
+            pick = k;
+        else if (!narrow[k] && !any_narrow && bigger(pieces[k], pieces[pick]))
+            pick = k;
         any_narrow |= narrow[k];
     }
     const Piece& stem = pieces[pick];

@@ -15,18 +15,18 @@
 namespace treelobes {
 
 struct TreeBaseOptions {
-    float slab_height = 0.0f;     // metres of the bottom slab searched for the stem (0 = 3 % of the height, 0.2..0.6 m)
-    float foot_height = 0.10f;    // metres: stem points this far above its lowest point are the Dijkstra sources
-    float max_stem_radius = 1.0f; // metres: a bottom piece wider than this is not a visible stem
+    float slab_height = 0.0f;      // metres of the bottom slab searched for the stem (0 = 3 % of the height, 0.2..0.6 m)
+    float foot_height = 0.10f;     // metres: stem points this far above its lowest point are the Dijkstra sources
+    float max_stem_radius = 1.0f;  // metres: a bottom piece wider than this is not a visible stem
 };
 
 struct TreeBase {
     Eigen::Vector3f position{0, 0, 0};  // the root node: stem centre at its lowest point
     std::vector<int> sources;           // points of the stem foot, sorted
     bool stem_visible = false;
-    bool circle_fitted = false;         // position from a circle fit (else from the foot centroid)
-    float foot_radius = 0.0f;           // fitted foot circle radius (0 when not fitted)
-    std::size_t bottom_pieces = 0;      // connected pieces found in the bottom slab
+    bool circle_fitted = false;     // position from a circle fit (else from the foot centroid)
+    float foot_radius = 0.0f;       // fitted foot circle radius (0 when not fitted)
+    std::size_t bottom_pieces = 0;  // connected pieces found in the bottom slab
 };
 
 TreeBase find_tree_base(std::span<const Eigen::Vector3f> points, const NeighbourGraph& graph, const TreeBaseOptions& options = {});

@@ -12,7 +12,8 @@ namespace treelobes {
 namespace {
 
 // Robust (5th..95th percentile) extents of points within their plane.
-Eigen::Vector2f in_plane_extent(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& inliers, const Eigen::Vector3f& normal) {
+Eigen::Vector2f in_plane_extent(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& inliers,
+                                const Eigen::Vector3f& normal) {
     // In-plane axes from the principal direction of the inliers, so a long thin strip along a
     // stem is measured as long and thin, whatever its orientation.
     Eigen::Vector3f mean = Eigen::Vector3f::Zero();

@@ -75,8 +75,10 @@ void locate_foot(TrunkFit& fit, float foot_z) {
     const StemSlice* second = nullptr;
     for (const auto& slice : fit.slices) {
         if (!slice.good) continue;
-        if (!first) first = &slice;
-        else if (!second && slice.height >= first->height + 0.3f) second = &slice;
+        if (!first)
+            first = &slice;
+        else if (!second && slice.height >= first->height + 0.3f)
+            second = &slice;
     }
     if (!first) return;
     Eigen::Vector3f direction = Eigen::Vector3f::UnitZ();

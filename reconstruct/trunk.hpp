@@ -14,12 +14,12 @@
 namespace treelobes {
 
 struct TrunkOptions {
-    float breast_height = 1.3f;     // metres above the stem foot
-    float slice_thickness = 0.10f;  // metres
-    float base_low = 0.1f;          // metres: base diameter from slices between base_low ...
-    float base_high = 1.5f;         // ... and base_high above the foot
-    float max_radius = 1.5f;        // metres
-    float min_coverage = 0.25f;     // fraction of the circle that must hold points for a trusted fit
+    float breast_height = 1.3f;       // metres above the stem foot
+    float slice_thickness = 0.10f;    // metres
+    float base_low = 0.1f;            // metres: base diameter from slices between base_low ...
+    float base_high = 1.5f;           // ... and base_high above the foot
+    float max_radius = 1.5f;          // metres
+    float min_coverage = 0.25f;       // fraction of the circle that must hold points for a trusted fit
     float circle_tolerance = 0.015f;  // metres: RANSAC inlier band of the circle fit
 };
 
@@ -34,18 +34,18 @@ struct StemSlice {
 };
 
 struct TrunkFit {
-    std::vector<StemSlice> slices;    // every 0.1 m from base_low up to breast height + 0.2 m
+    std::vector<StemSlice> slices;  // every 0.1 m from base_low up to breast height + 0.2 m
     bool dbh_fitted = false;
-    float dbh = 0.0f;                 // diameter at breast height (metres)
+    float dbh = 0.0f;  // diameter at breast height (metres)
     bool foot_fitted = false;
     Eigen::Vector3f foot_centre{0, 0, 0};  // stem axis at the foot height, from the lowest good slices
     bool base_fitted = false;
-    float base_diameter = 0.0f;       // median diameter of the good slices between base_low and base_high
+    float base_diameter = 0.0f;  // median diameter of the good slices between base_low and base_high
 };
 
 // `point_internode` maps each point to its internode (the node at its upper end), as produced
 // by reconstruct_skeleton. Slices without a trusted circle are reported with good = false.
-TrunkFit fit_trunk(std::span<const Eigen::Vector3f> points, const std::vector<int>& point_internode,
-                   const TreeGraph& tree, const TrunkOptions& options = {});
+TrunkFit fit_trunk(std::span<const Eigen::Vector3f> points, const std::vector<int>& point_internode, const TreeGraph& tree,
+                   const TrunkOptions& options = {});
 
 }  // namespace treelobes

@@ -7,7 +7,8 @@
 namespace treelobes {
 
 SkeletonGraph visible_reference(const SkeletonGraph& reference, std::span<const double> point_internode, std::size_t min_points) {
-    if (!reference.tree) throw Error::usage("the visible part of a reference needs a reference skeleton that is one tree rooted at vertex 0");
+    if (!reference.tree)
+        throw Error::usage("the visible part of a reference needs a reference skeleton that is one tree rooted at vertex 0");
     const TreeGraph& tree = *reference.tree;
     std::vector<std::size_t> hits(tree.size(), 0);
     for (double v : point_internode)
@@ -17,7 +18,8 @@ SkeletonGraph visible_reference(const SkeletonGraph& reference, std::span<const 
     for (std::size_t i = 1; i < tree.size(); ++i) {
         if (hits[i] < min_points) continue;
         any = true;
-        for (int v = static_cast<int>(i); v >= 0 && !keep[static_cast<std::size_t>(v)]; v = tree.nodes[v].parent) keep[static_cast<std::size_t>(v)] = true;
+        for (int v = static_cast<int>(i); v >= 0 && !keep[static_cast<std::size_t>(v)]; v = tree.nodes[v].parent)
+            keep[static_cast<std::size_t>(v)] = true;
     }
     if (!any) throw Error::input("visible reference", "no internode of the reference holds " + std::to_string(min_points) + " scan points");
 

@@ -48,8 +48,10 @@ PngParts split_png(const std::string& png) {
         const std::uint32_t length = get_u32(png, at);
         const std::string type = png.substr(at + 4, 4);
         const std::string data = png.substr(at + 8, length);
-        if (type == "IHDR") parts.header = data;
-        else if (type == "IDAT") parts.image_data += data;
+        if (type == "IHDR")
+            parts.header = data;
+        else if (type == "IDAT")
+            parts.image_data += data;
         at += 12 + length;
     }
     if (parts.header.size() != 13 || parts.image_data.empty()) throw Error(ExitCode::Internal, "APNG: the PNG encoder wrote no IHDR/IDAT");

@@ -9,7 +9,7 @@ namespace treelobes::render {
 Rgba ramp_colour(double t) {
     // Five stops of matplotlib's viridis (van der Walt and Smith 2015), linearly interpolated.
     static constexpr std::array<std::array<double, 3>, 5> stops = {
-        {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
+            {{68, 1, 84}, {59, 82, 139}, {33, 145, 140}, {94, 201, 98}, {253, 231, 37}}};
     t = std::isfinite(t) ? std::clamp(t, 0.0, 1.0) : 0.0;
     const double x = t * (stops.size() - 1);
     const std::size_t i = std::min(stops.size() - 2, static_cast<std::size_t>(x));
@@ -27,12 +27,24 @@ Rgba id_colour(long long id) {
     const double p = v * (1 - s), q = v * (1 - s * fraction), u = v * (1 - s * (1 - fraction));
     std::array<double, 3> rgb{};
     switch (static_cast<int>(hue) % 6) {
-        case 0: rgb = {v, u, p}; break;
-        case 1: rgb = {q, v, p}; break;
-        case 2: rgb = {p, v, u}; break;
-        case 3: rgb = {p, q, v}; break;
-        case 4: rgb = {u, p, v}; break;
-        default: rgb = {v, p, q}; break;
+        case 0:
+            rgb = {v, u, p};
+            break;
+        case 1:
+            rgb = {q, v, p};
+            break;
+        case 2:
+            rgb = {p, v, u};
+            break;
+        case 3:
+            rgb = {p, q, v};
+            break;
+        case 4:
+            rgb = {u, p, v};
+            break;
+        default:
+            rgb = {v, p, q};
+            break;
     }
     return {static_cast<std::uint8_t>(rgb[0] * 255), static_cast<std::uint8_t>(rgb[1] * 255), static_cast<std::uint8_t>(rgb[2] * 255), 255};
 }

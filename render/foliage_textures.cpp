@@ -83,8 +83,8 @@ Image downsample(const Image& image, int factor) {
     return out;
 }
 
-std::array<Image, 6> render_diagonal_textures(std::span<const FoliageLayer> layers, const Eigen::Vector3d& lo,
-                                              const Eigen::Vector3d& hi, int size, int supersample) {
+std::array<Image, 6> render_diagonal_textures(std::span<const FoliageLayer> layers, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                              int size, int supersample) {
     if (size < 1 || size > 8192) throw Error::usage("foliage textures: the texture size must be 1..8192 pixels");
     if (supersample < 1 || supersample > 16) throw Error::usage("foliage textures: supersampling must be 1..16");
     const auto planes = diagonal_planes(lo, hi);

@@ -25,10 +25,10 @@
 namespace treelobes::render {
 
 struct DiagonalPlane {
-    std::string name;                   // "z1" "z2" (contain the z axis), "y1" "y2", "x1" "x2"
+    std::string name;  // "z1" "z2" (contain the z axis), "y1" "y2", "x1" "x2"
     Eigen::Vector3d corner{0, 0, 0};
-    Eigen::Vector3d u{1, 0, 0};         // image columns
-    Eigen::Vector3d v{0, 0, 1};         // image rows, bottom to top
+    Eigen::Vector3d u{1, 0, 0};                                         // image columns
+    Eigen::Vector3d v{0, 0, 1};                                         // image rows, bottom to top
     Eigen::Vector3d normal() const { return u.cross(v).normalized(); }  // the viewer's side
 };
 
@@ -46,8 +46,8 @@ struct FoliageLayer {
 // Each is rendered at size * supersample pixels and box-filtered down (alpha = coverage, colour
 // averaged over the covered samples), so leaves smaller than a texel still show as soft foliage
 // instead of dropping out or aliasing into speckle.
-std::array<Image, 6> render_diagonal_textures(std::span<const FoliageLayer> layers, const Eigen::Vector3d& lo,
-                                              const Eigen::Vector3d& hi, int size = 128, int supersample = 4);
+std::array<Image, 6> render_diagonal_textures(std::span<const FoliageLayer> layers, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                              int size = 128, int supersample = 4);
 
 // Box-filters an image down by an integer factor (width and height must be multiples of it):
 // alpha is the mean alpha, colour the alpha-weighted mean colour.

@@ -19,7 +19,7 @@ struct Image {
     Image() = default;
     Image(int w, int h, Rgba background = {0, 0, 0, 0});
     Rgba at(int x, int y) const;
-    void set(int x, int y, Rgba colour);  // ignores pixels outside the image
+    void set(int x, int y, Rgba colour);                          // ignores pixels outside the image
     void fill_rect(int x0, int y0, int x1, int y1, Rgba colour);  // [x0, x1) x [y0, y1)
 };
 

@@ -26,8 +26,8 @@ Image leaf_texture(int size) {
     constexpr double blade_base = 0.12, stalk_half_width = 0.025;  // petiole below blade_base (image fractions)
     for (int y = 0; y < size; ++y)
         for (int x = 0; x < size; ++x) {
-            const double u = (x + 0.5) / size - 0.5;        // -0.5 .. 0.5 across
-            const double h = 1.0 - (y + 0.5) / size;         // 0 at the bottom row, 1 at the top
+            const double u = (x + 0.5) / size - 0.5;                  // -0.5 .. 0.5 across
+            const double h = 1.0 - (y + 0.5) / size;                  // 0 at the bottom row, 1 at the top
             const double t = (h - blade_base) / (0.98 - blade_base);  // along the blade
             const double half = blade_half_width(t);
             if (h < blade_base + 0.02 && std::abs(u) < stalk_half_width && h > 0.01) {

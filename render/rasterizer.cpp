@@ -64,8 +64,7 @@ double View::aspect() const {
 }
 
 Rasterizer::Rasterizer(int width, int height, const View& view, Rgba background)
-    : image_(width, height, background),
-      depth_(static_cast<std::size_t>(width) * height, std::numeric_limits<double>::infinity()) {
+        : image_(width, height, background), depth_(static_cast<std::size_t>(width) * height, std::numeric_limits<double>::infinity()) {
     const ImageAxes axes = image_axes(view);
     forward_ = axes.forward;
     up_ = axes.up;

@@ -27,8 +27,7 @@ struct View {
 
     // A view from the side at `azimuth_deg` around the vertical axis (0 = looking along +y)
     // and `elevation_deg` above the horizon.
-    static View side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azimuth_deg = 0,
-                     double elevation_deg = 10);
+    static View side(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double azimuth_deg = 0, double elevation_deg = 10);
 
     // Width over height of the box [lo, hi] as this view sees it: the image shape in which the
     // box fills the frame.

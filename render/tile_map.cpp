@@ -18,12 +18,23 @@ Rgba hsv(double hue, double saturation, double value) {
     const double f = h - sector, p = value * (1 - saturation), q = value * (1 - saturation * f), t = value * (1 - saturation * (1 - f));
     double r = value, g = t, b = p;
     switch (sector) {
-        case 1: r = q, g = value, b = p; break;
-        case 2: r = p, g = value, b = t; break;
-        case 3: r = p, g = q, b = value; break;
-        case 4: r = t, g = p, b = value; break;
-        case 5: r = value, g = p, b = q; break;
-        default: break;
+        case 1:
+            r = q, g = value, b = p;
+            break;
+        case 2:
+            r = p, g = value, b = t;
+            break;
+        case 3:
+            r = p, g = q, b = value;
+            break;
+        case 4:
+            r = t, g = p, b = value;
+            break;
+        case 5:
+            r = value, g = p, b = q;
+            break;
+        default:
+            break;
     }
     auto byte = [](double v) { return static_cast<std::uint8_t>(std::clamp(v, 0.0, 1.0) * 255.0 + 0.5); };
     return {byte(r), byte(g), byte(b), 255};

@@ -19,10 +19,10 @@ struct TileMapStem {
 };
 
 struct TileMapOptions {
-    int max_side_px = 1600;    // the longer side of the tile fills this many pixels...
-    double min_pixel_m = 0.05; // ...unless a pixel would be smaller than this (metres)
+    int max_side_px = 1600;     // the longer side of the tile fills this many pixels...
+    double min_pixel_m = 0.05;  // ...unless a pixel would be smaller than this (metres)
     int margin_px = 12;
-    bool labels = true;        // tree ids beside the stem marks
+    bool labels = true;  // tree ids beside the stem marks
 };
 
 // Colour of tree `id` (> 0): a fixed hue sequence, so neighbouring ids differ.

@@ -40,7 +40,8 @@ void check_options(const SegmentOptions& o) {
     positive(o.window_base, "window base");
     if (!(o.window_per_metre >= 0.0f) || !std::isfinite(o.window_per_metre)) throw Error::usage("segment: window per metre must be >= 0");
     positive(o.max_window, "max window");
-    if (!(o.min_top_prominence >= 0.0f) || !std::isfinite(o.min_top_prominence)) throw Error::usage("segment: min top prominence must be >= 0");
+    if (!(o.min_top_prominence >= 0.0f) || !std::isfinite(o.min_top_prominence))
+        throw Error::usage("segment: min top prominence must be >= 0");
     share(o.top_prominence_ratio, "top prominence ratio");
     share(o.merge_pass_ratio, "merge pass ratio");
     share(o.seed_ratio, "seed ratio");
@@ -73,8 +74,8 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0) {
 std::vector<std::uint8_t> vegetation_points(const PointCloud& cloud, const Terrain& terrain, float clearance) {
     std::vector<std::uint8_t> keep(cloud.size(), 0);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const bool noise = !cloud.classification.empty() &&
-                           (cloud.classification[i] == kLowNoiseClass || cloud.classification[i] == kHighNoiseClass);
+        const bool noise =
+                !cloud.classification.empty() && (cloud.classification[i] == kLowNoiseClass || cloud.classification[i] == kHighNoiseClass);
         keep[i] = !noise && !terrain.is_ground[i] && terrain.height_above_ground[i] >= clearance;
     }
     return keep;
@@ -287,7 +288,7 @@ float cell_distance(const Raster& chm, std::size_t a, std::size_t b) {
 // that remain.
 std::vector<std::size_t> prominent_tops(const Raster& chm, const std::vector<std::size_t>& tops, const SegmentOptions& options) {
     const std::vector<std::int32_t> basin =
-        flood_from_tops(chm, tops, [&](std::size_t cell, std::size_t) { return chm.values[cell] >= options.min_tree_height; });
+            flood_from_tops(chm, tops, [&](std::size_t cell, std::size_t) { return chm.values[cell] >= options.min_tree_height; });
     // Highest pass between every pair of touching basins.
     std::map<std::pair<std::int32_t, std::int32_t>, float> passes;
     for (int r = 0; r < chm.rows; ++r)
@@ -307,9 +308,8 @@ std::vector<std::size_t> prominent_tops(const Raster& chm, const std::vector<std
         }
     std::vector<std::tuple<float, std::int32_t, std::int32_t>> order;
     for (const auto& [key, pass] : passes) order.emplace_back(pass, key.first, key.second);
-    std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) {
-        return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : a < b;
-    });
+    std::sort(order.begin(), order.end(),
+              [](const auto& a, const auto& b) { return std::get<0>(a) != std::get<0>(b) ? std::get<0>(a) > std::get<0>(b) : a < b; });
     UnionFind groups(tops.size());
     std::vector<std::size_t> peak(tops.size());  // per group root: index into tops of its highest top
     for (std::size_t t = 0; t < tops.size(); ++t) peak[t] = t;
@@ -506,8 +506,9 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
     std::vector<int> near;
     std::vector<float> squared;
     const auto reaches_ground = [&](const Stem& stem) {
-        below_index.radius_search(Eigen::Vector3f(stem.centre.x(), stem.centre.y(), 0.0f), 1.5f * stem.radius + 2.0f * options.circle_tolerance,
-                                  near, squared, static_cast<std::size_t>(options.min_stem_points));
+        below_index.radius_search(Eigen::Vector3f(stem.centre.x(), stem.centre.y(), 0.0f),
+                                  1.5f * stem.radius + 2.0f * options.circle_tolerance, near, squared,
+                                  static_cast<std::size_t>(options.min_stem_points));
         return static_cast<int>(near.size()) >= options.min_stem_points;
     };
     std::vector<Stem> stems;
@@ -607,9 +608,12 @@ void segment_terrestrial(const PointCloud& cloud, const Terrain& terrain, const 
 
 const char* scan_mode_name(ScanMode mode) {
     switch (mode) {
-    case ScanMode::Automatic: return "auto";
-    case ScanMode::Airborne: return "als";
-    case ScanMode::Terrestrial: return "tls";
+        case ScanMode::Automatic:
+            return "auto";
+        case ScanMode::Airborne:
+            return "als";
+        case ScanMode::Terrestrial:
+            return "tls";
     }
     return "auto";
 }
@@ -625,8 +629,8 @@ TreeSegmentation segment_trees(const PointCloud& cloud, const Terrain& terrain, 
     check_options(options);
     if (terrain.height_above_ground.size() != cloud.size() || terrain.is_ground.size() != cloud.size())
         throw Error(ExitCode::Internal, "segment: the terrain was computed for another cloud (" +
-                                            std::to_string(terrain.height_above_ground.size()) + " heights for " +
-                                            std::to_string(cloud.size()) + " points)");
+                                                std::to_string(terrain.height_above_ground.size()) + " heights for " +
+                                                std::to_string(cloud.size()) + " points)");
     TreeSegmentation result;
     result.tree_id.assign(cloud.size(), 0);
     const std::vector<std::uint8_t> vegetation = vegetation_points(cloud, terrain, options.ground_clearance);
@@ -637,8 +641,10 @@ TreeSegmentation segment_trees(const PointCloud& cloud, const Terrain& terrain, 
         result.mode_reason = std::string("requested: ") + scan_mode_name(options.mode);
     }
     if (cloud.empty()) return result;
-    if (result.mode_used == ScanMode::Terrestrial) segment_terrestrial(cloud, terrain, vegetation, options, result);
-    else segment_airborne(cloud, terrain, vegetation, options, result);
+    if (result.mode_used == ScanMode::Terrestrial)
+        segment_terrestrial(cloud, terrain, vegetation, options, result);
+    else
+        segment_airborne(cloud, terrain, vegetation, options, result);
     return result;
 }
 

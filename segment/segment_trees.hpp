@@ -41,7 +41,7 @@ ScanMode parse_scan_mode(std::string_view text);
 
 struct SegmentOptions {
     ScanMode mode = ScanMode::Automatic;
-    float min_tree_height = 2.0f;        // trees whose top is lower are not trees (metres above ground)
+    float min_tree_height = 2.0f;  // trees whose top is lower are not trees (metres above ground)
     // Automatic choice: terrestrial when the non-ground points are at least this dense over the
     // tile's occupied footprint (points per square metre); airborne otherwise. Airborne surveys
     // give 1-100 per m^2 (dense drone surveys more: pass the mode then), terrestrial plots
@@ -49,24 +49,24 @@ struct SegmentOptions {
     float terrestrial_density = 200.0f;
 
     // Airborne (canopy height model and crowns).
-    float chm_cell = 0.5f;               // CHM cell edge (metres)
-    float point_radius = 0.15f;          // each point drawn as a disc of this radius (pit-free CHM)
-    float pit_depth = 1.0f;              // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
-    float chm_smoothing = 0.5f;          // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
-    float window_base = 2.0f;            // treetop window diameter at 0 m height (metres) ...
-    float window_per_metre = 0.1f;       // ... plus this much per metre of height (Popescu & Wynne 2004)
-    float max_window = 20.0f;            // cap of the treetop window diameter (metres)
+    float chm_cell = 0.5f;          // CHM cell edge (metres)
+    float point_radius = 0.15f;     // each point drawn as a disc of this radius (pit-free CHM)
+    float pit_depth = 1.0f;         // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
+    float chm_smoothing = 0.5f;     // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
+    float window_base = 2.0f;       // treetop window diameter at 0 m height (metres) ...
+    float window_per_metre = 0.1f;  // ... plus this much per metre of height (Popescu & Wynne 2004)
+    float max_window = 20.0f;       // cap of the treetop window diameter (metres)
     // A top is part of a higher neighbour's crown when it rises less than
     // max(min_top_prominence, top_prominence_ratio x its height) above the highest pass between
     // them (its dynamics, Grimaud 1992) and that pass is at least merge_pass_ratio x the higher top.
     // The defaults suit broad crowns (the synthetic species library); for dense conifer stands
     // such as lidR's MixedConifer set min_top_prominence = 0 and chm_smoothing = 0 (docs/segment.md).
-    float min_top_prominence = 3.0f;     // metres
+    float min_top_prominence = 3.0f;  // metres
     float top_prominence_ratio = 0.0f;
     float merge_pass_ratio = 0.5f;
-    float seed_ratio = 0.45f;            // a crown cell must be higher than this share of its top (Dalponte 2016: th_seed)
-    float crown_ratio = 0.55f;           // ... and higher than this share of the crown's mean height (th_cr)
-    float max_crown_radius = 15.0f;      // no crown cell farther than this from its top (metres)
+    float seed_ratio = 0.45f;        // a crown cell must be higher than this share of its top (Dalponte 2016: th_seed)
+    float crown_ratio = 0.55f;       // ... and higher than this share of the crown's mean height (th_cr)
+    float max_crown_radius = 15.0f;  // no crown cell farther than this from its top (metres)
 
     // Terrestrial (stems and plot-wide shortest paths).
     float stem_slice_low = 1.0f;         // stem slice, metres above ground: from ...
@@ -75,30 +75,30 @@ struct SegmentOptions {
     int min_stem_points = 15;            // smaller slice clusters are not stems
     float min_stem_radius = 0.025f;      // accepted circle radii (metres)
     float max_stem_radius = 0.8f;
-    float circle_tolerance = 0.03f;      // circle inlier band (metres)
-    float min_circle_inliers = 0.5f;     // share of the cluster's points on the circle
-    float min_arc_coverage = 0.2f;       // share of the circle's 10-degree sectors that hold inliers
-    float max_stem_lean = 30.0f;         // degrees from vertical between the lower and upper half of a stem's slice points
-    float graph_voxel = 0.1f;            // voxel edge of the thinned cloud the plot graph is built on (metres)
-    int graph_neighbours = 10;           // k of the kNN graph
-    float graph_beta = 2.0f;             // an edge costs length^beta: > 1 makes jumps across the sparse contact of two crowns dear
-    float max_gap = 0.5f;                // longest graph edge (metres): points beyond wider gaps stay 0
-    float ground_clearance = 0.3f;       // points lower than this above the DTM stay out of the graph (metres)
+    float circle_tolerance = 0.03f;   // circle inlier band (metres)
+    float min_circle_inliers = 0.5f;  // share of the cluster's points on the circle
+    float min_arc_coverage = 0.2f;    // share of the circle's 10-degree sectors that hold inliers
+    float max_stem_lean = 30.0f;      // degrees from vertical between the lower and upper half of a stem's slice points
+    float graph_voxel = 0.1f;         // voxel edge of the thinned cloud the plot graph is built on (metres)
+    int graph_neighbours = 10;        // k of the kNN graph
+    float graph_beta = 2.0f;          // an edge costs length^beta: > 1 makes jumps across the sparse contact of two crowns dear
+    float max_gap = 0.5f;             // longest graph edge (metres): points beyond wider gaps stay 0
+    float ground_clearance = 0.3f;    // points lower than this above the DTM stay out of the graph (metres)
 };
 
 struct SegmentedTree {
-    std::int32_t id = 0;                 // 1.. in the order the trees were found; the treeID of its points
-    Eigen::Vector3f base{0, 0, 0};       // local frame, on the DTM: stem centre (terrestrial) or below the top (airborne)
-    Eigen::Vector3f top{0, 0, 0};        // local frame: highest point of the tree
-    std::size_t points = 0;              // points with this id
-    float stem_radius = 0.0f;            // radius of the stem circle that seeded the tree (terrestrial); 0 for airborne
+    std::int32_t id = 0;            // 1.. in the order the trees were found; the treeID of its points
+    Eigen::Vector3f base{0, 0, 0};  // local frame, on the DTM: stem centre (terrestrial) or below the top (airborne)
+    Eigen::Vector3f top{0, 0, 0};   // local frame: highest point of the tree
+    std::size_t points = 0;         // points with this id
+    float stem_radius = 0.0f;       // radius of the stem circle that seeded the tree (terrestrial); 0 for airborne
 };
 
 struct TreeSegmentation {
-    std::vector<std::int32_t> tree_id;   // per point; 0 = no tree (ground, understory, unreachable)
-    std::vector<SegmentedTree> trees;    // trees[i].id == i + 1
+    std::vector<std::int32_t> tree_id;  // per point; 0 = no tree (ground, understory, unreachable)
+    std::vector<SegmentedTree> trees;   // trees[i].id == i + 1
     ScanMode mode_used = ScanMode::Airborne;
-    std::string mode_reason;             // why this mode ("requested", or the density that decided it)
+    std::string mode_reason;  // why this mode ("requested", or the density that decided it)
 };
 
 // Segments the tile into trees. `terrain` must come from analyse_terrain on the same cloud

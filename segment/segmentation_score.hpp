@@ -11,7 +11,7 @@
 namespace treelobes {
 
 struct HeightClassCounts {
-    std::string name;                // "5-10 m", "10-20 m", "20+ m"
+    std::string name;  // "5-10 m", "10-20 m", "20+ m"
     std::size_t reference = 0, found = 0, matched = 0;
 };
 

@@ -43,8 +43,9 @@ void check_options(const TerrainOptions& o) {
 void check_finite(const PointCloud& cloud) {
     for (std::size_t i = 0; i < cloud.size(); ++i)
         if (!cloud.positions[i].allFinite())
-            throw Error::input("", "point " + std::to_string(i) + " has a non-finite coordinate (NaN or infinity); "
-                                   "remove such points before terrain analysis");
+            throw Error::input("", "point " + std::to_string(i) +
+                                           " has a non-finite coordinate (NaN or infinity); "
+                                           "remove such points before terrain analysis");
 }
 
 bool is_noise(const PointCloud& cloud, std::size_t i) {
@@ -121,8 +122,8 @@ bool looks_normalised(const PointCloud& cloud, float cell_size, float tolerance)
 // weighted by inverse squared distance (exact on a slope, where plain inverse-distance
 // weighting flattens a hole towards its rim), kept within the neighbours' height range widened by
 // that range; inverse-distance weighting when the neighbours are collinear.
-float interpolate_from_neighbours(const Eigen::Vector2f& at, const std::vector<Eigen::Vector3f>& known,
-                                  const std::vector<float>& values, const std::vector<int>& near, const std::vector<float>& squared) {
+float interpolate_from_neighbours(const Eigen::Vector2f& at, const std::vector<Eigen::Vector3f>& known, const std::vector<float>& values,
+                                  const std::vector<int>& near, const std::vector<float>& squared) {
     Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
     Eigen::Vector3d right = Eigen::Vector3d::Zero();
     double idw_sum = 0, idw_weights = 0;
@@ -307,7 +308,8 @@ std::vector<std::uint8_t> filter_ground(const PointCloud& cloud, const DtmGrid& 
     drop_low_outliers(cloud, shape, lowest, 1.0f + options.terrain_slope * options.cell_size);
     DtmGrid first = shape;
     for (int cell : ground_cells_by_morphological_filter(cloud, lowest, options))
-        first.heights[static_cast<std::size_t>(cell)] = cloud.positions[static_cast<std::size_t>(lowest[static_cast<std::size_t>(cell)])].z();
+        first.heights[static_cast<std::size_t>(cell)] =
+                cloud.positions[static_cast<std::size_t>(lowest[static_cast<std::size_t>(cell)])].z();
     fill_empty_cells(first);
     const float band = options.ground_tolerance + 0.5f * options.terrain_slope * options.cell_size;
     const DtmGrid second = ground_height_grid(cloud, shape, points_near_surface(cloud, first, options.ground_tolerance, band));
@@ -359,9 +361,9 @@ Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options) 
     const DtmGrid shape = empty_grid(cloud, options.cell_size);
     std::vector<int> lowest = lowest_point_per_cell(cloud, shape);
 
-    const bool has_ground_class = options.use_classification && !cloud.classification.empty() &&
-                                  std::find(cloud.classification.begin(), cloud.classification.end(), kGroundClass) !=
-                                      cloud.classification.end();
+    const bool has_ground_class =
+            options.use_classification && !cloud.classification.empty() &&
+            std::find(cloud.classification.begin(), cloud.classification.end(), kGroundClass) != cloud.classification.end();
     if (looks_normalised(cloud, options.cell_size, options.normalised_tolerance)) {
         terrain.ground_source = "normalised";
         terrain.dtm = shape;
@@ -369,7 +371,8 @@ Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options) 
         terrain.is_ground.resize(cloud.size());
         for (std::size_t i = 0; i < cloud.size(); ++i)
             terrain.is_ground[i] = has_ground_class ? cloud.classification[i] == kGroundClass
-                                                    : !is_noise(cloud, i) && std::abs(cloud.origin.z() + cloud.positions[i].z()) <= options.ground_tolerance;
+                                                    : !is_noise(cloud, i) && std::abs(cloud.origin.z() + cloud.positions[i].z()) <=
+                                                                                     options.ground_tolerance;
     } else if (has_ground_class) {
         terrain.ground_source = "classified";
         terrain.is_ground.resize(cloud.size());
@@ -383,7 +386,7 @@ Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options) 
     terrain.ground_points = count_ground(terrain.is_ground);
     if (terrain.ground_points == 0 && terrain.ground_source != "normalised")
         throw Error::input("", "no ground points found (" + std::to_string(cloud.size()) +
-                                   " points); a tile needs some ground to measure heights from");
+                                       " points); a tile needs some ground to measure heights from");
     fill_heights_above_ground(cloud, terrain);
     return terrain;
 }
@@ -399,8 +402,10 @@ void write_ascii_grid(const DtmGrid& dtm, const Eigen::Vector3d& origin, const s
         for (int r = dtm.rows - 1; r >= 0; --r) {
             for (int c = 0; c < dtm.columns; ++c) {
                 const float h = dtm.at(c, r);
-                if (std::isfinite(h)) std::snprintf(line, sizeof line, "%s%.3f", c ? " " : "", origin.z() + h);
-                else std::snprintf(line, sizeof line, "%s-9999", c ? " " : "");
+                if (std::isfinite(h))
+                    std::snprintf(line, sizeof line, "%s%.3f", c ? " " : "", origin.z() + h);
+                else
+                    std::snprintf(line, sizeof line, "%s-9999", c ? " " : "");
                 out << line;
             }
             out << '\n';
@@ -423,14 +428,15 @@ void write_hillshade_png(const DtmGrid& dtm, const std::filesystem::path& path) 
             if (!std::isfinite(dtm.at(c, r))) continue;
             // Row index grows northwards; x east.
             const double dzdx = ((height(c + 1, r + 1) + 2 * height(c + 1, r) + height(c + 1, r - 1)) -
-                                 (height(c - 1, r + 1) + 2 * height(c - 1, r) + height(c - 1, r - 1))) / (8 * dtm.cell_size);
+                                 (height(c - 1, r + 1) + 2 * height(c - 1, r) + height(c - 1, r - 1))) /
+                                (8 * dtm.cell_size);
             const double dzdy = ((height(c - 1, r + 1) + 2 * height(c, r + 1) + height(c + 1, r + 1)) -
-                                 (height(c - 1, r - 1) + 2 * height(c, r - 1) + height(c + 1, r - 1))) / (8 * dtm.cell_size);
+                                 (height(c - 1, r - 1) + 2 * height(c, r - 1) + height(c + 1, r - 1))) /
+                                (8 * dtm.cell_size);
             const double slope = std::atan(std::hypot(dzdx, dzdy));
             // Aspect as the compass direction the slope faces (0 = north, clockwise).
             const double aspect = std::atan2(-dzdx, -dzdy);
-            const double light = std::cos(zenith) * std::cos(slope) +
-                                 std::sin(zenith) * std::sin(slope) * std::cos(azimuth - aspect);
+            const double light = std::cos(zenith) * std::cos(slope) + std::sin(zenith) * std::sin(slope) * std::cos(azimuth - aspect);
             const auto grey = static_cast<std::uint8_t>(std::clamp(std::lround(255.0 * light), 0L, 255L));
             image.set(c, dtm.rows - 1 - r, {grey, grey, grey, 255});
         }

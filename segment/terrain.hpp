@@ -26,17 +26,17 @@
 namespace treelobes {
 
 struct TerrainOptions {
-    float cell_size = 1.0f;             // DTM cell edge (metres)
+    float cell_size = 1.0f;  // DTM cell edge (metres)
     // Progressive morphological filter (Zhang et al. 2003, §2.2), used only for "filtered":
-    float max_window_size = 20.0f;      // largest opening window (metres): wider than the widest crown or building
-    float terrain_slope = 0.7f;         // steepest expected terrain (rise over run; 0.7 ~ 35 degrees)
-    float initial_distance = 0.3f;      // height tolerance of the smallest window (metres)
-    float max_distance = 3.0f;          // height tolerance cap of the largest windows (metres)
-    float ground_tolerance = 0.25f;     // points this close above (or below) the DTM surface are ground (metres)
+    float max_window_size = 20.0f;   // largest opening window (metres): wider than the widest crown or building
+    float terrain_slope = 0.7f;      // steepest expected terrain (rise over run; 0.7 ~ 35 degrees)
+    float initial_distance = 0.3f;   // height tolerance of the smallest window (metres)
+    float max_distance = 3.0f;       // height tolerance cap of the largest windows (metres)
+    float ground_tolerance = 0.25f;  // points this close above (or below) the DTM surface are ground (metres)
     // Detection of an already normalised tile: the lowest points of at least half of the
     // occupied 5 m cells must lie within this distance of global z = 0 (metres), without a slope.
     float normalised_tolerance = 0.5f;
-    bool use_classification = true;     // false: ignore an input class 2 and filter afresh
+    bool use_classification = true;  // false: ignore an input class 2 and filter afresh
 };
 
 // Regular grid of terrain heights in the cloud's local frame.
@@ -45,7 +45,7 @@ struct DtmGrid {
     float cell_size = 1.0f;
     int columns = 0;
     int rows = 0;
-    std::vector<float> heights;    // rows x columns, row-major (row = y index), local z; NaN = no data
+    std::vector<float> heights;  // rows x columns, row-major (row = y index), local z; NaN = no data
 
     bool empty() const { return heights.empty(); }
     float at(int column, int row) const { return heights[static_cast<std::size_t>(row) * columns + column]; }

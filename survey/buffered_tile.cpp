@@ -46,7 +46,8 @@ bool TileCore::holds(double x, double y) const {
 TileCore core_from_retile_name(const fs::path& tile, double size) {
     double x = 0, y = 0;
     if (!corner_of_name(tile.stem().string(), x, y))
-        throw Error::usage("--tile-size: " + tile.filename().string() + " is not named <prefix>_<x>_<y> by `treelobes retile`; "
+        throw Error::usage("--tile-size: " + tile.filename().string() +
+                           " is not named <prefix>_<x>_<y> by `treelobes retile`; "
                            "leave --tile-size out to take the tile's point bounds as its core");
     return {x, y, x + size, y + size, true, "retile name"};
 }
@@ -80,7 +81,8 @@ std::size_t estimate_buffer_points(const fs::path& input, const std::optional<Ti
             continue;
         }
         const Box3d box = buffered_box(*core, buffer);
-        const Eigen::Vector2d lo = bounds->min.head<2>().cwiseMax(box.min.head<2>()), hi = bounds->max.head<2>().cwiseMin(box.max.head<2>());
+        const Eigen::Vector2d lo = bounds->min.head<2>().cwiseMax(box.min.head<2>()),
+                              hi = bounds->max.head<2>().cwiseMin(box.max.head<2>());
         if ((lo.array() > hi.array()).any()) continue;
         const Eigen::Vector2d extent = bounds->max.head<2>() - bounds->min.head<2>();
         const double area = extent.x() * extent.y();
@@ -89,7 +91,8 @@ std::size_t estimate_buffer_points(const fs::path& input, const std::optional<Ti
     return static_cast<std::size_t>(std::ceil(points));
 }
 
-BufferedTile add_buffer(PointCloud tile, const fs::path& input, const TileCore& core, double buffer, const std::vector<fs::path>& candidates) {
+BufferedTile add_buffer(PointCloud tile, const fs::path& input, const TileCore& core, double buffer,
+                        const std::vector<fs::path>& candidates) {
     BufferedTile result;
     result.own_points = tile.size();
     const Box3d box = buffered_box(core, buffer);
@@ -108,7 +111,7 @@ BufferedTile add_buffer(PointCloud tile, const fs::path& input, const TileCore& 
             throw Error::input(neighbour.string(), "its CRS differs from that of the tile " + input.string() + ": a buffer needs one CRS");
         if (attribute_signature(points) != signature)
             throw Error::input(neighbour.string(), "its attributes (" + attribute_signature(points) + ") differ from those of the tile " +
-                                                       input.string() + " (" + signature + ")");
+                                                           input.string() + " (" + signature + ")");
         std::vector<std::size_t> outside_core;
         for (std::size_t i = 0; i < points.size(); ++i) {
             const Eigen::Vector3d g = points.global(i);

@@ -71,7 +71,8 @@ encode::TreeFileOptions forest_options(const json& summary, const std::string& c
 // Adds every number of `from` into `into`, recursing into objects (strings and the like are skipped).
 void add_counts(json& into, const json& from) {
     for (const auto& [key, value] : from.items()) {
-        if (value.is_number_integer()) into[key] = into.value(key, 0L) + value.get<long>();
+        if (value.is_number_integer())
+            into[key] = into.value(key, 0L) + value.get<long>();
         else if (value.is_object()) {
             json& child = into[key];
             if (!child.is_object()) child = json::object();
@@ -100,12 +101,15 @@ void add_csv(CsvRows& all, const fs::path& tile_dir) {
     std::getline(in, header);
     if (header.rfind(kGlobalIdColumn, 0) != 0)
         throw Error::input(path.string(), "no global_id column first (made by an older treelobes): run the tile again");
-    if (all.header.empty()) all.header = header;
-    else if (header != all.header) throw Error::input(path.string(), "its columns differ from the other tiles'");
+    if (all.header.empty())
+        all.header = header;
+    else if (header != all.header)
+        throw Error::input(path.string(), "its columns differ from the other tiles'");
     for (std::string line; std::getline(in, line);) {
         if (line.empty()) continue;
         const std::size_t first = line.find(','), second = line.find(',', first + 1);
-        if (first == std::string::npos || second == std::string::npos || first == 0) throw Error::input(path.string(), "a row without its ids");
+        if (first == std::string::npos || second == std::string::npos || first == 0)
+            throw Error::input(path.string(), "a row without its ids");
         const std::string global = line.substr(0, first), tree = line.substr(first + 1, second - first - 1);
         all.rows[{global, tile}] = global + "," + tile + line.substr(first) + "\n";
         all.global_of_tree[{tile, tree}] = global;
@@ -131,7 +135,8 @@ void add_features(std::map<TreeKey, json>& features, std::string& crs, const fs:
     const json collection = read_json(tile_dir / "trees.geojson");
     const std::string tile_crs = collection.value("crs_wkt", std::string());
     if (!tile_crs.empty()) {
-        if (!crs.empty() && crs != tile_crs) throw Error::input((tile_dir / "trees.geojson").string(), "its CRS differs from the other tiles'");
+        if (!crs.empty() && crs != tile_crs)
+            throw Error::input((tile_dir / "trees.geojson").string(), "its CRS differs from the other tiles'");
         crs = tile_crs;
     }
     for (json feature : collection.at("features")) {
@@ -180,7 +185,8 @@ TileFolders find_tile_folders(const std::vector<fs::path>& dirs) {
     std::map<std::string, fs::path> by_name;
     const auto add = [&](const fs::path& dir) {
         const auto [it, fresh] = by_name.emplace(tile_of(dir), dir);
-        if (!fresh) throw Error::input(dir.string(), "tile '" + it->first + "' is also in " + it->second.string() + ": merge each tile once");
+        if (!fresh)
+            throw Error::input(dir.string(), "tile '" + it->first + "' is also in " + it->second.string() + ": merge each tile once");
     };
     std::set<std::string> incomplete;
     for (const fs::path& dir : dirs) {
@@ -190,11 +196,14 @@ TileFolders find_tile_folders(const std::vector<fs::path>& dirs) {
             continue;
         }
         for (const auto& entry : fs::directory_iterator(dir)) {
-            if (entry.is_regular_file() && entry.path().filename().string().rfind("failures", 0) == 0 && entry.path().extension() == ".jsonl")
+            if (entry.is_regular_file() && entry.path().filename().string().rfind("failures", 0) == 0 &&
+                entry.path().extension() == ".jsonl")
                 found.failure_lists.push_back(entry.path());
             if (!entry.is_directory()) continue;
-            if (fs::is_regular_file(entry.path() / kCompletionMarker) && is_tile_folder(entry.path())) add(entry.path());
-            else incomplete.insert(tile_of(entry.path()));
+            if (fs::is_regular_file(entry.path() / kCompletionMarker) && is_tile_folder(entry.path()))
+                add(entry.path());
+            else
+                incomplete.insert(tile_of(entry.path()));
         }
     }
     for (const auto& [name, dir] : by_name) {
@@ -224,12 +233,15 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
             throw Error::input((dir / "summary.json").string(), "made with other DBF6 options (--resolution, --lods) than the other tiles");
         dbf6 = tile_dbf6;
         const json tile_options = shaping_options(summary.at("options"));
-        if (options.is_null()) options = tile_options;
-        else if (options != tile_options) log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
+        if (options.is_null())
+            options = tile_options;
+        else if (options != tile_options)
+            log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
         json tile_counts = summary.at("counts");
         tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
         add_counts(counts, tile_counts);
-        tiles.push_back({{"name", tile_of(dir)}, {"trees", tile_counts.value("trees", 0)}, {"trees_failed", tile_counts.value("trees_failed", 0)}});
+        tiles.push_back(
+                {{"name", tile_of(dir)}, {"trees", tile_counts.value("trees", 0)}, {"trees_failed", tile_counts.value("trees_failed", 0)}});
         add_csv(csv, dir);
         add_features(features, crs, dir);
         add_forest_trees(forest_trees, csv, dir);

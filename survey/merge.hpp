@@ -14,17 +14,17 @@ namespace treelobes::survey {
 // tile name. Throws Error(InvalidInput) when a folder is missing or two tiles share a name.
 struct TileFolders {
     std::vector<std::filesystem::path> complete;
-    std::vector<std::string> incomplete;        // names of batch tiles without a completion marker
+    std::vector<std::string> incomplete;               // names of batch tiles without a completion marker
     std::vector<std::filesystem::path> failure_lists;  // the batches' failures*.jsonl
 };
 TileFolders find_tile_folders(const std::vector<std::filesystem::path>& dirs);
 
 struct MergedSurvey {
-    std::string trees_csv;              // global_id,tile, then the tiles' columns
-    std::string trees_geojson;          // the tiles' features with global_id and tile properties
-    std::vector<std::uint8_t> forest;   // every tree, named by its global id
-    std::string summary_json;           // tiles, summed counts, CRS, options; no paths or timings
-    std::string failures_jsonl;         // the batches' tile failures, sorted; empty when none
+    std::string trees_csv;             // global_id,tile, then the tiles' columns
+    std::string trees_geojson;         // the tiles' features with global_id and tile properties
+    std::vector<std::uint8_t> forest;  // every tree, named by its global id
+    std::string summary_json;          // tiles, summed counts, CRS, options; no paths or timings
+    std::string failures_jsonl;        // the batches' tile failures, sorted; empty when none
     // Survey-wide ids found in more than one tile ("<id> in <tile>, <tile>"): one tree modelled
     // by two tiles, which happens when tiles are run without --buffer.
     std::vector<std::string> duplicated_ids;

@@ -36,8 +36,10 @@ PointCloud empty_tile_like(const PointCloud& first, const Eigen::Vector3d& corne
 
 std::string retiled_name(const std::string& prefix, double x, double y, double size) {
     char name[128];
-    if (size == std::floor(size)) std::snprintf(name, sizeof name, "%s_%.0f_%.0f", prefix.c_str(), x, y);
-    else std::snprintf(name, sizeof name, "%s_%.2f_%.2f", prefix.c_str(), x, y);
+    if (size == std::floor(size))
+        std::snprintf(name, sizeof name, "%s_%.0f_%.0f", prefix.c_str(), x, y);
+    else
+        std::snprintf(name, sizeof name, "%s_%.2f_%.2f", prefix.c_str(), x, y);
     return name;
 }
 
@@ -54,16 +56,18 @@ std::vector<RetiledTile> retile(const std::vector<fs::path>& inputs, const Retil
             first.source = cloud.source;
             signature = attribute_signature(cloud);
         } else if (cloud.georef.crs_wkt != first.georef.crs_wkt) {
-            throw Error::input(inputs[i].string(), "its CRS differs from that of " + inputs[0].string() + ": reproject the inputs to one CRS first");
+            throw Error::input(inputs[i].string(),
+                               "its CRS differs from that of " + inputs[0].string() + ": reproject the inputs to one CRS first");
         } else if (attribute_signature(cloud) != signature) {
             throw Error::input(inputs[i].string(), "its attributes (" + attribute_signature(cloud) + ") differ from those of " +
-                                                       inputs[0].string() + " (" + signature + ")");
+                                                           inputs[0].string() + " (" + signature + ")");
         }
         std::map<CellKey, std::vector<std::size_t>> members;
         for (std::size_t p = 0; p < cloud.size(); ++p) {
             const Eigen::Vector3d g = cloud.global(p);
-            members[{static_cast<std::int64_t>(std::floor(g.x() / options.size)), static_cast<std::int64_t>(std::floor(g.y() / options.size))}]
-                .push_back(p);
+            members[{static_cast<std::int64_t>(std::floor(g.x() / options.size)),
+                     static_cast<std::int64_t>(std::floor(g.y() / options.size))}]
+                    .push_back(p);
         }
         for (const auto& [key, indices] : members) {
             auto it = tiles.find(key);

@@ -20,7 +20,9 @@ constexpr std::int64_t kTenthsOfMillimetrePerCentimetre = 100;
 // floor(x / 1 cm) in whole centimetres, from x rounded to 0.1 mm.
 std::int64_t centimetre_cell(double metres) {
     const double tenths = std::round(metres * kTenthsOfMillimetrePerMetre);
-    if (!std::isfinite(tenths) || std::abs(tenths) > 9e15) throw Error::input("", "stem base coordinate " + std::to_string(metres) + " is out of range for a tree id (CRS units must be metres)");
+    if (!std::isfinite(tenths) || std::abs(tenths) > 9e15)
+        throw Error::input("",
+                           "stem base coordinate " + std::to_string(metres) + " is out of range for a tree id (CRS units must be metres)");
     const auto t = static_cast<std::int64_t>(tenths);
     const std::int64_t q = t / kTenthsOfMillimetrePerCentimetre;
     return (t % kTenthsOfMillimetrePerCentimetre < 0) ? q - 1 : q;

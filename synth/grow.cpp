@@ -19,14 +19,12 @@ using Vec3 = Eigen::Vector3d;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
-constexpr double kMinRadius = 0.0005;    // 1 mm twig tips: nothing real is thinner
+constexpr double kMinRadius = 0.0005;      // 1 mm twig tips: nothing real is thinner
 constexpr std::size_t kMaxStems = 300000;  // a runaway profile fails instead of eating memory
 constexpr std::size_t kMaxLeaves = 3000000;
 constexpr double kGroundClearance = 0.3;  // weeping and spreading branches end on the ground, not in it
 
-Vec3 rotate(const Vec3& v, const Vec3& axis, double degrees) {
-    return Eigen::AngleAxisd(degrees * kDeg, axis.normalized()) * v;
-}
+Vec3 rotate(const Vec3& v, const Vec3& axis, double degrees) { return Eigen::AngleAxisd(degrees * kDeg, axis.normalized()) * v; }
 
 Vec3 any_perpendicular(const Vec3& d) {
     const Vec3 helper = std::abs(d.z()) < 0.9 ? Vec3::UnitZ() : Vec3::UnitX();
@@ -45,29 +43,29 @@ Eigen::Vector3f to_float(const Vec3& v) { return v.cast<float>(); }
 // full stem so that taper, child density and curvature continue across forks.
 struct Stem {
     int level = 0;
-    int parent_node = 0;         // the node the stem grows from
+    int parent_node = 0;  // the node the stem grows from
     Vec3 start{0, 0, 0};
     Vec3 dir{0, 0, 1};
-    Vec3 side{1, 0, 0};          // bending axis: curve and down angle rotate about it
-    double length = 0;           // planned length of the full stem
-    double length_ratio = 1;     // length / maximum length at this level: scales children and leaves
-    double radius = 0;           // radius at offset 0 of the full stem
-    double radius_scale = 1;     // pipe-model reduction after forks
-    int first_segment = 0;       // > 0 for the parts after a fork
-    double child_begin = 0;      // offset where children start (trunk: the clear bole)
+    Vec3 side{1, 0, 0};               // bending axis: curve and down angle rotate about it
+    double length = 0;                // planned length of the full stem
+    double length_ratio = 1;          // length / maximum length at this level: scales children and leaves
+    double radius = 0;                // radius at offset 0 of the full stem
+    double radius_scale = 1;          // pipe-model reduction after forks
+    int first_segment = 0;            // > 0 for the parts after a fork
+    double child_begin = 0;           // offset where children start (trunk: the clear bole)
     std::uint64_t schedule_seed = 0;  // where the children and leaves sit along the stem
-    bool main = true;            // continues its parent node's stem (main child first)
-    bool dead = false;           // in the dead lower crown (growth.dead_crown), with its descendants
+    bool main = true;                 // continues its parent node's stem (main child first)
+    bool dead = false;                // in the dead lower crown (growth.dead_crown), with its descendants
 };
 
 // The chunk of a stem between its first segment and the next fork (or the tip).
 struct Chunk {
     double seg_length = 0;
-    double begin = 0, end = 0;   // offsets along the full stem
-    std::vector<Vec3> points;    // segment end points, points[0] = start
-    std::vector<Vec3> dirs;      // direction of each segment
+    double begin = 0, end = 0;  // offsets along the full stem
+    std::vector<Vec3> points;   // segment end points, points[0] = start
+    std::vector<Vec3> dirs;     // direction of each segment
     std::vector<Vec3> sides;
-    Vec3 end_dir, end_side;      // direction after the last bend (for forks)
+    Vec3 end_dir, end_side;  // direction after the last bend (for forks)
 
     std::size_t segment_at(double s) const {
         const double k = std::floor((s - begin) / seg_length);
@@ -79,10 +77,10 @@ struct Chunk {
     }
 };
 
-struct Placement {          // a child stem or leaf node along a stem
+struct Placement {  // a child stem or leaf node along a stem
     double offset = 0;
-    int index = 0;          // position in the schedule (phyllotaxis step)
-    int count = 1;          // stems in this whorl / leaves in this cluster
+    int index = 0;  // position in the schedule (phyllotaxis step)
+    int count = 1;  // stems in this whorl / leaves in this cluster
 };
 
 // Leaf count and size multipliers (see grow(): the species' LAI within a leaf budget).
@@ -93,10 +91,14 @@ struct LeafScaling {
 
 class Grower {
 public:
-    Grower(const SpeciesProfile& species, std::uint64_t seed, const GrowOptions& options, double height, double dbh,
-           LeafScaling leaves)
-        : growth_(species.growth), options_(options), seed_(seed), height_(height), dbh_(dbh), scaling_(leaves),
-          split_error_(growth_.levels.size(), 0.0) {
+    Grower(const SpeciesProfile& species, std::uint64_t seed, const GrowOptions& options, double height, double dbh, LeafScaling leaves)
+            : growth_(species.growth),
+              options_(options),
+              seed_(seed),
+              height_(height),
+              dbh_(dbh),
+              scaling_(leaves),
+              split_error_(growth_.levels.size(), 0.0) {
         tree_.species = species.entry.name;
         tree_.species_id = species.entry.id;
         tree_.seed = seed;
@@ -295,8 +297,10 @@ private:
         for (auto& c : children) {
             auto nearest = std::min_element(offsets.begin(), offsets.end(),
                                             [&](double a, double b) { return std::abs(a - c.offset) < std::abs(b - c.offset); });
-            if (std::abs(*nearest - c.offset) < snap) c.offset = *nearest;
-            else offsets.push_back(c.offset);
+            if (std::abs(*nearest - c.offset) < snap)
+                c.offset = *nearest;
+            else
+                offsets.push_back(c.offset);
         }
         std::sort(offsets.begin(), offsets.end());
         std::vector<double> refined;
@@ -519,8 +523,7 @@ Individual draw_individual(const VariationProfile& v, std::uint64_t seed, double
     Rng rng(stream_seed(seed, 0xA11CE));
     const auto lerp = [](const ValueRange& r, double t) { return r.min + (r.max - r.min) * std::clamp(t, 0.0, 1.0); };
     double u = rng.uniform();
-    if (forced_height > 0 && v.height_m.max > v.height_m.min)
-        u = (forced_height - v.height_m.min) / (v.height_m.max - v.height_m.min);
+    if (forced_height > 0 && v.height_m.max > v.height_m.min) u = (forced_height - v.height_m.min) / (v.height_m.max - v.height_m.min);
     const double age_t = u + 0.15 * rng.normal();
     const double dbh_t = 0.7 * u + 0.3 * std::clamp(age_t, 0.0, 1.0) + 0.1 * rng.normal();
     return {forced_height > 0 ? forced_height : lerp(v.height_m, u), lerp(v.age_years, age_t), lerp(v.dbh_m, dbh_t)};
@@ -558,8 +561,7 @@ SyntheticTree grow(const SpeciesProfile& species, std::uint64_t seed, const Grow
     if (!(options.leaf_density >= 0.001 && options.leaf_density <= 4))
         throw Error::usage("leaf density " + std::to_string(options.leaf_density) + " is outside [0.001, 4]");
     if (options.max_leaves < 1 || options.max_leaves > 20'000'000) throw Error::usage("leaf budget must be in [1, 20000000]");
-    if (!(options.max_internode_m >= 0.05))
-        throw Error::usage("max internode length must be at least 0.05 m");
+    if (!(options.max_internode_m >= 0.05)) throw Error::usage("max internode length must be at least 0.05 m");
     const Individual who = draw_individual(species.variation, seed, options.height_m);
     // A first growth with the profile's nominal leaves measures the tree. Crowns rise above the
     // trunk or end below it depending on the species, so the second growth (same random
@@ -568,7 +570,8 @@ SyntheticTree grow(const SpeciesProfile& species, std::uint64_t seed, const Grow
     SyntheticTree first = Grower(species, seed, options, who.height, who.dbh, {}).run();
     const double top = top_of(first);
     const double nominal = top > 0.1 ? who.height * who.height / top : who.height;
-    SyntheticTree tree = Grower(species, seed, options, nominal, who.dbh, leaf_scaling(species, first, nominal / who.height, options)).run();
+    SyntheticTree tree =
+            Grower(species, seed, options, nominal, who.dbh, leaf_scaling(species, first, nominal / who.height, options)).run();
     tree.age_years = who.age;
     return tree;
 }

@@ -20,14 +20,14 @@
 namespace treelobes::synth {
 
 struct GrowOptions {
-    double height_m = 0;          // 0: draw the height from the species' variation range
-    bool leaves = true;           // false: a leafless (winter) tree
+    double height_m = 0;  // 0: draw the height from the species' variation range
+    bool leaves = true;   // false: a leafless (winter) tree
     // Multiplies the number of leaves and divides their area by the same factor, so the total
     // leaf area (and how much a crown occludes) stays: 0.1 gives a tenth of the leaves, each
     // ~3x longer and wider. Tiles scanned from the air use this to fit in memory.
-    double leaf_density = 1.0;    // [0.001, 4]
+    double leaf_density = 1.0;        // [0.001, 4]
     std::size_t max_leaves = 250000;  // leaf budget per tree: beyond it leaves get fewer and larger
-    double max_internode_m = 1.0; // longer internodes are subdivided (finer labels and meshes)
+    double max_internode_m = 1.0;     // longer internodes are subdivided (finer labels and meshes)
 };
 
 // One leaf blade: a rhombus (broad, leaflet) or a thin strip (needle) from `base` along
@@ -42,10 +42,10 @@ struct Leaf {
 };
 
 struct SyntheticTree {
-    std::string species;       // canonical name
+    std::string species;  // canonical name
     int species_id = 0;
     std::uint64_t seed = 0;
-    TreeGraph skeleton;        // root (node 0) at the stem base, local (0,0,0); origin = placement
+    TreeGraph skeleton;  // root (node 0) at the stem base, local (0,0,0); origin = placement
     // Per node (index = node): the stem level of the internode ending there (0 trunk, 1 first-
     // order branch, ...) and its radius at the parent end (lateral branches start thinner than
     // the node they grow from). Root: level 0, its own radius.
@@ -55,7 +55,7 @@ struct SyntheticTree {
     std::vector<Leaf> leaves;
     float bark_reflectance = 0.45f;
     float leaf_reflectance = 0.55f;
-    double age_years = 0;      // drawn with the height; reported in truth tables
+    double age_years = 0;  // drawn with the height; reported in truth tables
 };
 
 SyntheticTree grow(const SpeciesProfile& species, std::uint64_t seed, const GrowOptions& options = {});

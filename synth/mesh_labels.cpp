@@ -39,7 +39,8 @@ std::optional<std::uint8_t> label_by_name(const FaceNames& names, const std::vec
 }
 
 double face_area(const TriangleMesh& mesh, const std::array<int, 3>& f) {
-    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>(), b = mesh.vertices[f[1]].cast<double>(), c = mesh.vertices[f[2]].cast<double>();
+    const Eigen::Vector3d a = mesh.vertices[f[0]].cast<double>(), b = mesh.vertices[f[1]].cast<double>(),
+                          c = mesh.vertices[f[2]].cast<double>();
     return 0.5 * (b - a).cross(c - a).norm();
 }
 
@@ -86,7 +87,8 @@ void label_by_geometry(const TriangleMesh& mesh, const std::vector<bool>& pendin
             part = static_cast<int>(shapes.size());
             shapes.emplace_back();
         }
-        shapes[part].add_face(mesh.vertices[face[0]].cast<double>(), mesh.vertices[face[1]].cast<double>(), mesh.vertices[face[2]].cast<double>());
+        shapes[part].add_face(mesh.vertices[face[0]].cast<double>(), mesh.vertices[face[1]].cast<double>(),
+                              mesh.vertices[face[2]].cast<double>());
     }
     double total_area = 0;
     for (const auto& face : mesh.faces) total_area += face_area(mesh, face);

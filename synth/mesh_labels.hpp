@@ -34,8 +34,8 @@ struct MeshLabelOptions {
 struct MeshLabelReport {
     std::size_t wood_by_name = 0, leaf_by_name = 0;
     std::size_t wood_by_geometry = 0, leaf_by_geometry = 0;
-    std::size_t parts = 0;        // connected parts of the faces labelled by geometry
-    std::size_t leaf_parts = 0;   // of which leaves
+    std::size_t parts = 0;                // connected parts of the faces labelled by geometry
+    std::size_t leaf_parts = 0;           // of which leaves
     double wood_area = 0, leaf_area = 0;  // m^2
 };
 

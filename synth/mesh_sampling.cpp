@@ -22,9 +22,7 @@ constexpr std::size_t kMaxSamples = 50'000'000;
 constexpr double kTlsHitFraction = 0.35;
 constexpr double kAlsReturnsPerPulse = 0.6;
 
-void add_wood_attribute(PointCloud& cloud) {
-    cloud.add_extra("wood", AttributeType::UInt8).description = "1 wood, 0 leaf";
-}
+void add_wood_attribute(PointCloud& cloud) { cloud.add_extra("wood", AttributeType::UInt8).description = "1 wood, 0 leaf"; }
 
 std::vector<double> cumulative_areas(const TriangleMesh& mesh) {
     std::vector<double> cumulative(mesh.faces.size());
@@ -139,9 +137,12 @@ SamplePattern parse_sample_pattern(const std::string& name) {
 
 const char* sample_pattern_name(SamplePattern pattern) {
     switch (pattern) {
-    case SamplePattern::Uniform: return "uniform";
-    case SamplePattern::Tls: return "tls";
-    case SamplePattern::Als: return "als";
+        case SamplePattern::Uniform:
+            return "uniform";
+        case SamplePattern::Tls:
+            return "tls";
+        case SamplePattern::Als:
+            return "als";
     }
     return "uniform";
 }
@@ -200,7 +201,8 @@ PointCloud sample_mesh(const TriangleMesh& mesh, const std::vector<std::uint8_t>
         const Scene scene = scene_of(mesh, wood);
         PointCloud scan = o.pattern == SamplePattern::Tls ? scan_tls_sized(scene, o, r) : scan_als_sized(scene, o, r);
         r.scanned_points = scan.size();
-        if (scan.empty()) throw Error::input("", std::string("the simulated ") + sample_pattern_name(o.pattern) + " scan saw nothing of the mesh");
+        if (scan.empty())
+            throw Error::input("", std::string("the simulated ") + sample_pattern_name(o.pattern) + " scan saw nothing of the mesh");
         cloud = relabelled_scan(thinned(scan, o.samples, o.seed));
     }
     for (double v : cloud.extra("wood")->values) ++(v > 0.5 ? r.wood_points : r.leaf_points);

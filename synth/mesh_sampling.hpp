@@ -39,12 +39,12 @@ struct MeshSamplingOptions {
 };
 
 struct MeshSamplingReport {
-    double surface_area = 0;       // m^2 of all faces
+    double surface_area = 0;  // m^2 of all faces
     std::size_t wood_points = 0, leaf_points = 0;
-    std::uint64_t pulses = 0;      // scans
+    std::uint64_t pulses = 0;        // scans
     std::size_t scanned_points = 0;  // scans, before thinning to `samples`
-    double angular_step_deg = 0;   // tls
-    double pulse_density = 0;      // als, per m^2
+    double angular_step_deg = 0;     // tls
+    double pulse_density = 0;        // als, per m^2
 };
 
 // `wood`: one label per face (1 wood, 0 leaf). Throws Error(InvalidInput) for a mesh without

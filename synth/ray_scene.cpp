@@ -52,7 +52,7 @@ struct RayScene::Impl {
     unsigned ground = RTC_INVALID_GEOMETRY_ID, understory = RTC_INVALID_GEOMETRY_ID, meshes = RTC_INVALID_GEOMETRY_ID;
     std::vector<Label> curve_labels, leaf_labels;
     std::vector<std::uint8_t> mesh_wood;  // per triangle of `meshes`
-    std::vector<float> bark, foliage;  // reflectance per tree
+    std::vector<float> bark, foliage;     // reflectance per tree
     std::size_t primitives = 0;
 
     ~Impl() {
@@ -193,8 +193,7 @@ RayScene::RayScene(const Scene& s) : impl_(std::make_unique<Impl>()) {
     for (std::size_t t = 0; t < s.trees.size(); ++t)
         sets.push_back({&s.trees[t].tree.leaves, s.trees[t].tree.leaf_shape, static_cast<int>(t), s.trees[t].position.cast<float>()});
     m.leaves = m.add_blades(sets, &m.leaf_labels);
-    if (!s.understory.empty())
-        m.understory = m.add_blades({{&s.understory, s.understory_shape, -1, Eigen::Vector3f::Zero()}}, nullptr);
+    if (!s.understory.empty()) m.understory = m.add_blades({{&s.understory, s.understory_shape, -1, Eigen::Vector3f::Zero()}}, nullptr);
     if (s.ground) m.add_ground(*s.ground);
     m.add_meshes(s);
 

@@ -16,11 +16,11 @@ namespace treelobes::synth {
 enum class Surface : std::uint8_t { Wood, Leaf, Ground, Understory };
 
 struct RayHit {
-    float t = 0;                       // distance along the (unit) ray direction
-    Eigen::Vector3f normal{0, 0, 1};   // unit geometric normal
+    float t = 0;                      // distance along the (unit) ray direction
+    Eigen::Vector3f normal{0, 0, 1};  // unit geometric normal
     Surface surface = Surface::Ground;
-    int tree = -1;                     // index into Scene::trees, -1 for ground and understory
-    int internode = -1;                // skeleton node whose internode was hit (leaves: their carrier)
+    int tree = -1;       // index into Scene::trees, -1 for ground and understory
+    int internode = -1;  // skeleton node whose internode was hit (leaves: their carrier)
     float reflectance = 0.3f;
 };
 

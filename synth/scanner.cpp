@@ -44,7 +44,7 @@ std::vector<BeamRay> beam_pattern(int sub_rays) {
 struct Sample {
     Eigen::Vector3f position;
     float energy;
-    std::int32_t tree;       // index into Scene::trees, -1 = none
+    std::int32_t tree;  // index into Scene::trees, -1 = none
     std::int32_t internode;
     std::uint8_t return_number, returns;
     Surface surface;
@@ -102,7 +102,8 @@ private:
             if (energy >= beam_.detection_threshold && energy > 0) {
                 const double range = weighted_t / energy + rng.normal(0.0, beam_.range_noise_m);
                 const RayHit& hit = hits_[strongest].hit;
-                out.push_back({(origin + dir * range).cast<float>(), static_cast<float>(energy), hit.tree, hit.internode, 0, 0, hit.surface});
+                out.push_back(
+                        {(origin + dir * range).cast<float>(), static_cast<float>(energy), hit.tree, hit.internode, 0, 0, hit.surface});
             }
             i = j;
         }
@@ -143,10 +144,13 @@ std::vector<Sample> run_lines(std::size_t lines, std::uint64_t seed, Line line) 
 
 std::uint8_t classification(Surface s) {
     switch (s) {
-    case Surface::Ground: return 2;
-    case Surface::Understory: return 3;
-    case Surface::Wood:
-    case Surface::Leaf: return 5;
+        case Surface::Ground:
+            return 2;
+        case Surface::Understory:
+            return 3;
+        case Surface::Wood:
+        case Surface::Leaf:
+            return 5;
     }
     return 1;
 }
@@ -215,15 +219,17 @@ Window tls_window(const Eigen::Vector3d& station, const Eigen::Vector3d& lo, con
         el0 = std::min(el0, el), el1 = std::max(el1, el);
     }
     Window w;
-    if (inside) w.az0 = -kPi, w.az1 = kPi;
-    else w.az0 = az_centre + daz0, w.az1 = az_centre + daz1;
+    if (inside)
+        w.az0 = -kPi, w.az1 = kPi;
+    else
+        w.az0 = az_centre + daz0, w.az1 = az_centre + daz1;
     w.el0 = std::max(inside ? -kPi / 2 : el0, o.min_elevation_deg * kDeg);
     w.el1 = std::min(inside ? kPi / 2 : el1, o.max_elevation_deg * kDeg);
     return w;
 }
 
-std::vector<Eigen::Vector3d> tls_stations(const Scene& scene, const TlsOptions& o, const Eigen::Vector3d& lo,
-                                          const Eigen::Vector3d& hi, std::uint64_t seed) {
+std::vector<Eigen::Vector3d> tls_stations(const Scene& scene, const TlsOptions& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                          std::uint64_t seed) {
     std::vector<Eigen::Vector2d> xy = o.station_xy;
     if (xy.empty()) {
         // Around the trees (not the ground patch), like an operator walking around a tree.
@@ -347,18 +353,18 @@ PointCloud scan_als(const Scene& scene, const AlsOptions& o, std::uint64_t seed,
     if (pulses > kMaxPulses)
         throw Error::usage("ALS scan would fire more than " + std::to_string(kMaxPulses) + " pulses; lower the pulse density");
 
-    std::vector<Sample> samples = run_lines(static_cast<std::size_t>(strips) * lines_per_strip, seed,
-                                            [&](std::size_t k, Rng& rng, std::vector<Sample>& out) {
-        PulseTracer tracer(rays, o.beam);
-        const double x = first_strip + static_cast<double>(k / lines_per_strip) * strip_step;
-        const double y = y0 + (static_cast<double>(k % lines_per_strip) + 0.5) * spacing;
-        for (std::size_t j = 0; j < per_line; ++j) {
-            const double angle = -o.max_scan_angle_deg * kDeg + (j + rng.vary(o.jitter)) * angle_step;
-            const double yj = y + rng.vary(o.jitter) * spacing;
-            const Eigen::Vector3d dir(std::sin(angle), 0.0, -std::cos(angle));
-            tracer.fire(Eigen::Vector3d(x, yj, flying), dir, 2.0 * (flying - lo.z()) + 10.0, rng, out);
-        }
-    });
+    std::vector<Sample> samples =
+            run_lines(static_cast<std::size_t>(strips) * lines_per_strip, seed, [&](std::size_t k, Rng& rng, std::vector<Sample>& out) {
+                PulseTracer tracer(rays, o.beam);
+                const double x = first_strip + static_cast<double>(k / lines_per_strip) * strip_step;
+                const double y = y0 + (static_cast<double>(k % lines_per_strip) + 0.5) * spacing;
+                for (std::size_t j = 0; j < per_line; ++j) {
+                    const double angle = -o.max_scan_angle_deg * kDeg + (j + rng.vary(o.jitter)) * angle_step;
+                    const double yj = y + rng.vary(o.jitter) * spacing;
+                    const Eigen::Vector3d dir(std::sin(angle), 0.0, -std::cos(angle));
+                    tracer.fire(Eigen::Vector3d(x, yj, flying), dir, 2.0 * (flying - lo.z()) + 10.0, rng, out);
+                }
+            });
     // Keep what falls on the scanned area: pulses from the margins reach over its edges.
     std::erase_if(samples, [&](const Sample& s) {
         return s.position.x() < area_lo.x() || s.position.x() > area_hi.x() || s.position.y() < area_lo.y() || s.position.y() > area_hi.y();

@@ -37,9 +37,9 @@ struct BeamOptions {
 // Terrestrial scanner on a tripod: stations around the scene centre, a raster of pulses with
 // equal angular steps in azimuth and elevation, limited to what faces the scene.
 struct TlsOptions {
-    int stations = 3;                    // 1..16, evenly around the scene centre
-    double station_distance_m = 0;       // 0: max(6, 0.6 x scene height)
-    double station_height_m = 1.5;       // above the ground
+    int stations = 3;               // 1..16, evenly around the scene centre
+    double station_distance_m = 0;  // 0: max(6, 0.6 x scene height)
+    double station_height_m = 1.5;  // above the ground
     double angular_step_deg = 0.06;
     double max_range_m = 100;
     double min_elevation_deg = -60;
@@ -50,11 +50,11 @@ struct TlsOptions {
 
 // Airborne scanner: parallel strips along y, a line-scanning mirror across track.
 struct AlsOptions {
-    double altitude_m = 500;             // above the highest point of the ground
-    double pulse_density = 10;           // pulses per m^2 on flat ground within one strip
-    double max_scan_angle_deg = 20;      // +- across track
-    double strip_overlap = 0.2;          // fraction of the swath shared by neighbouring strips
-    double jitter = 0.25;                // random pulse position jitter, fraction of the spacing
+    double altitude_m = 500;         // above the highest point of the ground
+    double pulse_density = 10;       // pulses per m^2 on flat ground within one strip
+    double max_scan_angle_deg = 20;  // +- across track
+    double strip_overlap = 0.2;      // fraction of the swath shared by neighbouring strips
+    double jitter = 0.25;            // random pulse position jitter, fraction of the spacing
     BeamOptions beam{0.5, 19, 0.03, 5, 1.5, 0.05};
 };
 

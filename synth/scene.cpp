@@ -78,7 +78,8 @@ std::vector<Leaf> make_understory(const Heightfield& ground, int count, double m
         const double centre_y = rng.uniform(ground.y0, y1);
         const double centre_x = rng.uniform(ground.x0, x1);
         Eigen::Vector2d centre(centre_x, centre_y);
-        const bool blocked = std::any_of(avoid.begin(), avoid.end(), [&](const Eigen::Vector2d& a) { return (a - centre).norm() < avoid_radius; });
+        const bool blocked =
+                std::any_of(avoid.begin(), avoid.end(), [&](const Eigen::Vector2d& a) { return (a - centre).norm() < avoid_radius; });
         if (blocked) continue;  // no bush inside a trunk
         const double height = rng.uniform(0.15, max_height_m);
         const double radius = rng.uniform(0.2, 0.4 + 0.6 * height);
@@ -92,8 +93,8 @@ std::vector<Leaf> make_understory(const Heightfield& ground, int count, double m
             leaf.base = Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y),
                                         static_cast<float>(ground.height(x, y) + rng.uniform(0.0, top)));
             const double tilt = rng.uniform(0.2, 1.3), az = rng.uniform(0, 2 * kPi);
-            leaf.direction = Eigen::Vector3f(static_cast<float>(std::sin(tilt) * std::cos(az)), static_cast<float>(std::sin(tilt) * std::sin(az)),
-                                             static_cast<float>(std::cos(tilt)));
+            leaf.direction = Eigen::Vector3f(static_cast<float>(std::sin(tilt) * std::cos(az)),
+                                             static_cast<float>(std::sin(tilt) * std::sin(az)), static_cast<float>(std::cos(tilt)));
             Eigen::Vector3f side = leaf.direction.cross(Eigen::Vector3f::UnitZ());
             if (side.norm() < 1e-4f) side = Eigen::Vector3f::UnitX();
             leaf.normal = side.cross(leaf.direction).normalized();

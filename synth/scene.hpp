@@ -44,12 +44,12 @@ struct SceneMesh {
 };
 
 struct Scene {
-    Eigen::Vector3d origin{0, 0, 0};     // added to every output position
+    Eigen::Vector3d origin{0, 0, 0};  // added to every output position
     std::vector<PlacedTree> trees;
-    std::optional<Heightfield> ground;   // class 2
-    std::vector<Leaf> understory;        // low vegetation blades in the scene frame (class 3)
+    std::optional<Heightfield> ground;  // class 2
+    std::vector<Leaf> understory;       // low vegetation blades in the scene frame (class 3)
     LeafShape understory_shape = LeafShape::Broad;
-    std::vector<SceneMesh> meshes;       // class 5 (tree), labelled wood/leaf per face, tree id 0
+    std::vector<SceneMesh> meshes;  // class 5 (tree), labelled wood/leaf per face, tree id 0
 
     // Bounding box of everything in the scene frame.
     std::pair<Eigen::Vector3d, Eigen::Vector3d> bounds() const;

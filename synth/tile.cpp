@@ -17,7 +17,8 @@ constexpr int kPlacementAttempts = 400;
 void check_options(const TileOptions& o) {
     if (o.trees < 0 || o.trees > 100000) throw Error::usage("tile trees must be in [0, 100000]");
     if (!(o.size_m >= 5 && o.size_m <= 2000)) throw Error::usage("tile size must be in [5, 2000] m");
-    if (!(o.understory_per_100m2 >= 0 && o.understory_per_100m2 <= 100)) throw Error::usage("understory density must be in [0, 100] clumps per 100 m^2");
+    if (!(o.understory_per_100m2 >= 0 && o.understory_per_100m2 <= 100))
+        throw Error::usage("understory density must be in [0, 100] clumps per 100 m^2");
     if (!(o.understory_height_m >= 0.2 && o.understory_height_m <= 5)) throw Error::usage("understory height must be in [0.2, 5] m");
     if (!(o.spacing >= 0 && o.spacing <= 2)) throw Error::usage("tile spacing factor must be in [0, 2]");
 }
@@ -76,8 +77,8 @@ std::string truth_csv(const std::vector<TreeTruth>& rows) {
     char line[512];
     for (const auto& r : rows) {
         std::snprintf(line, sizeof line, "%d,%s,%d,%llu,%.3f,%.3f,%.3f,%.2f,%.3f,%.2f,%.0f\n", r.tree_id, r.species.c_str(), r.species_id,
-                      static_cast<unsigned long long>(r.seed), r.base.x(), r.base.y(), r.base.z(), r.height_m, r.dbh_m,
-                      r.crown_diameter_m, r.age_years);
+                      static_cast<unsigned long long>(r.seed), r.base.x(), r.base.y(), r.base.z(), r.height_m, r.dbh_m, r.crown_diameter_m,
+                      r.age_years);
         csv += line;
     }
     return csv;
@@ -138,7 +139,8 @@ Tile make_tile(const std::vector<SpeciesProfile>& library, std::uint64_t seed, c
     const int clumps = static_cast<int>(std::lround(o.understory_per_100m2 * o.size_m * o.size_m / 100.0));
     double widest = 0;
     for (const auto& f : footprints) widest = std::max(widest, f.stem);
-    tile.scene.understory = make_understory(*tile.scene.ground, clumps, o.understory_height_m, stream_seed(seed, 0x0B5), stems, widest + 0.3);
+    tile.scene.understory =
+            make_understory(*tile.scene.ground, clumps, o.understory_height_m, stream_seed(seed, 0x0B5), stems, widest + 0.3);
     return tile;
 }
 

@@ -11,15 +11,15 @@ namespace treelobes::synth {
 
 struct TileOptions {
     int trees = 20;
-    double size_m = 50;                 // square tile side
-    std::vector<std::string> species;   // names to mix; empty = every species of the library
-    double slope_deg = 4;               // terrain slope; the downhill direction is drawn from the seed
-    double roughness_m = 0.25;          // amplitude of the terrain noise
-    double understory_per_100m2 = 3;    // bushes/grass clumps per 100 m^2 (0 = none)
+    double size_m = 50;                // square tile side
+    std::vector<std::string> species;  // names to mix; empty = every species of the library
+    double slope_deg = 4;              // terrain slope; the downhill direction is drawn from the seed
+    double roughness_m = 0.25;         // amplitude of the terrain noise
+    double understory_per_100m2 = 3;   // bushes/grass clumps per 100 m^2 (0 = none)
     double understory_height_m = 1.2;
-    double spacing = 0.4;               // stems at least spacing x (sum of crown radii) apart, relaxed when crowded
+    double spacing = 0.4;  // stems at least spacing x (sum of crown radii) apart, relaxed when crowded
     GrowOptions grow;
-    Eigen::Vector3d origin{0, 0, 0};    // added to output coordinates (e.g. a UTM corner)
+    Eigen::Vector3d origin{0, 0, 0};  // added to output coordinates (e.g. a UTM corner)
 };
 
 // One row of truth.csv.
@@ -28,13 +28,13 @@ struct TreeTruth {
     std::string species;
     int species_id = 0;
     std::uint64_t seed = 0;
-    Eigen::Vector3d base{0, 0, 0};      // stem base, output coordinates (origin added)
+    Eigen::Vector3d base{0, 0, 0};  // stem base, output coordinates (origin added)
     double height_m = 0, dbh_m = 0, crown_diameter_m = 0, age_years = 0;
 };
 
 struct Tile {
     Scene scene;
-    std::vector<TreeTruth> truth;       // same order as scene.trees
+    std::vector<TreeTruth> truth;  // same order as scene.trees
 };
 
 // Throws Error(Usage) for out-of-range options, unknown species, or when the trees cannot be

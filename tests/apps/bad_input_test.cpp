@@ -57,24 +57,24 @@ bool only_failure_records(const std::filesystem::path& folder) {
 }
 
 const BadInput kCorpus[] = {
-    {"truncated.las", "render {in} --out {out}.png", "truncated"},
-    {"wrong_magic.las", "render {in} --out {out}.png", "LASF"},
-    {"count_exceeds_file.las", "render {in} --out {out}.png", "declares 1000000 points"},
-    {"absurd_scale.las", "render {in} --out {out}.png", "x scale 1e+300 and offset 0 give coordinates beyond 1e30"},
-    {"empty_tile.las", "reconstruct {in} --out {out}", "too few points for a tree (0)"},
-    {"count_overflow.ply", "render {in} --out {out}.png", "element <name> <count>"},
-    {"negative_count.ply", "render {in} --out {out}.png", "element <name> <count>"},
-    {"nan.xyz", "render {in} --out {out}.png", "all 50 points have NaN/inf coordinates"},
-    {"inf.xyz", "render {in} --out {out}.png", "all 50 points have NaN/inf coordinates"},
-    {"two_points.xyz", "reconstruct {in} --out {out}", "too few points"},
-    {"identical_points.xyz", "reconstruct {in} --out {out}", "too few points left after removing duplicates"},
-    {"house.xyz", "reconstruct {in} --out {out} --reject-non-trees", "not a tree"},
-    {"skeleton_cycle.ply", "encode {in} --resolution 5 --out {out}.dbf6", "skeleton edges contain a cycle"},
-    {"skeleton_two_roots.ply", "encode {in} --resolution 5 --out {out}.dbf6", "needs 4 edges, found 3"},
-    {"truncated.dbf6", "decode {in} --out {out}.ply", "truncated"},
-    {"wrong_magic.dbf6", "decode {in} --out {out}.ply", "magic"},
-    {"absurd_count.forest", "decode {in} --out {out}", "tree count"},
-    {"absurd_size.tlobe", "synthesize {in} --out {out}.ply", "payload size"},
+        {"truncated.las", "render {in} --out {out}.png", "truncated"},
+        {"wrong_magic.las", "render {in} --out {out}.png", "LASF"},
+        {"count_exceeds_file.las", "render {in} --out {out}.png", "declares 1000000 points"},
+        {"absurd_scale.las", "render {in} --out {out}.png", "x scale 1e+300 and offset 0 give coordinates beyond 1e30"},
+        {"empty_tile.las", "reconstruct {in} --out {out}", "too few points for a tree (0)"},
+        {"count_overflow.ply", "render {in} --out {out}.png", "element <name> <count>"},
+        {"negative_count.ply", "render {in} --out {out}.png", "element <name> <count>"},
+        {"nan.xyz", "render {in} --out {out}.png", "all 50 points have NaN/inf coordinates"},
+        {"inf.xyz", "render {in} --out {out}.png", "all 50 points have NaN/inf coordinates"},
+        {"two_points.xyz", "reconstruct {in} --out {out}", "too few points"},
+        {"identical_points.xyz", "reconstruct {in} --out {out}", "too few points left after removing duplicates"},
+        {"house.xyz", "reconstruct {in} --out {out} --reject-non-trees", "not a tree"},
+        {"skeleton_cycle.ply", "encode {in} --resolution 5 --out {out}.dbf6", "skeleton edges contain a cycle"},
+        {"skeleton_two_roots.ply", "encode {in} --resolution 5 --out {out}.dbf6", "needs 4 edges, found 3"},
+        {"truncated.dbf6", "decode {in} --out {out}.ply", "truncated"},
+        {"wrong_magic.dbf6", "decode {in} --out {out}.ply", "magic"},
+        {"absurd_count.forest", "decode {in} --out {out}", "tree count"},
+        {"absurd_size.tlobe", "synthesize {in} --out {out}.ply", "payload size"},
 };
 
 class BadInputCorpus : public testing::TestWithParam<BadInput> {};
@@ -119,8 +119,8 @@ TEST(BadInputCorpus, UnbalancedForksInAChainCode) {
 // Valid but odd: a house reconstructs (exit 0) and the summary flags it as not a tree.
 TEST(BadInputCorpus, HouseIsFlaggedNotATree) {
     TempDir dir;
-    const auto r = test::run_cli("reconstruct " + quoted(bad_file("house.xyz")) + " --out " + quoted(dir / "out") +
-                                 " --json --log-level error");
+    const auto r =
+            test::run_cli("reconstruct " + quoted(bad_file("house.xyz")) + " --out " + quoted(dir / "out") + " --json --log-level error");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto summary = nlohmann::json::parse(r.out);
     const auto& quality = summary.at("trees").at(0).at("quality");

@@ -41,8 +41,7 @@ TEST(ConvertCli, LasToLasCopiesTheRecords) {
 TEST(ConvertCli, BoundsKeepOnlyThePointsInside) {
     TempDir dir;
     write_text(dir / "a.xyz", "0 0 0\n5 5 5\n10 10 10\n");
-    const auto r = run_cli("--json convert '" + (dir / "a.xyz").string() + "' --out '" + (dir / "b.xyz").string() +
-                           "' --bounds 1,1,9,9");
+    const auto r = run_cli("--json convert '" + (dir / "a.xyz").string() + "' --out '" + (dir / "b.xyz").string() + "' --bounds 1,1,9,9");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["points"], 1);
 }

@@ -26,9 +26,9 @@ std::vector<char> file_bytes(const std::filesystem::path& path) {
 
 TEST(ConvertReal, LazBecomesItsUncompressedTwin) {
     const std::pair<const char*, const char*> twins[] = {
-        {"laz/MixedConifer.laz", "lidr/MixedConifer.las"},   {"laz/pine.laz", "treels/pine.las"},
-        {"laz/pine_plot.laz", "treels/pine_plot.las"},       {"laz/laspy/simple.laz", "laz/laspy/simple.las"},
-        {"laz/laspy/extra.laz", "laz/laspy/extrabytes.las"}, {"laz/laspy/1_4_w_evlr.laz", "laz/laspy/1_4_w_evlr.las"}};
+            {"laz/MixedConifer.laz", "lidr/MixedConifer.las"},   {"laz/pine.laz", "treels/pine.las"},
+            {"laz/pine_plot.laz", "treels/pine_plot.las"},       {"laz/laspy/simple.laz", "laz/laspy/simple.las"},
+            {"laz/laspy/extra.laz", "laz/laspy/extrabytes.las"}, {"laz/laspy/1_4_w_evlr.laz", "laz/laspy/1_4_w_evlr.las"}};
     TempDir dir;
     for (const auto& [laz, las] : twins) {
         const auto out = dir / "out.las";
@@ -53,8 +53,8 @@ TEST(ConvertReal, LazBecomesItsUncompressedTwin) {
 
 TEST(ConvertReal, CopcToPlyKeepsEveryPoint) {
     TempDir dir;
-    const auto result = run_cli("--json convert '" + real_data("laz/laspy/simple.copc.laz").string() + "' --out '" +
-                                (dir / "c.ply").string() + "'");
+    const auto result =
+            run_cli("--json convert '" + real_data("laz/laspy/simple.copc.laz").string() + "' --out '" + (dir / "c.ply").string() + "'");
     ASSERT_EQ(result.exit_code, 0) << result.err;
     EXPECT_EQ(nlohmann::json::parse(result.out)["points"], 1065);
 }

@@ -55,8 +55,8 @@ private:
         fs::copy_file(in / "labels.csv", in / "clouds" / "labels.csv");
         run("classify features " + quoted(in / "clouds") + "/*.las --relative-to " + quoted(in / "clouds") + " --out " +
             quoted(in / "features.csv"));
-        run("classify train " + quoted(in / "features.csv") + " --labels " + quoted(in / "labels.csv") +
-            " --out " + quoted(in / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
+        run("classify train " + quoted(in / "features.csv") + " --labels " + quoted(in / "labels.csv") + " --out " +
+            quoted(in / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
         run("lobes " + quoted(data / "palm_1.las") + " --out " + quoted(in / "lobes"));
         run("encode " + quoted(data / "birch_3_skeleton.ply") + " --resolution 5 --lods 3 --out " + quoted(in / "birch.dbf6"));
         fs::create_directories(in / "skeletons");
@@ -72,29 +72,32 @@ private:
 };
 
 const Command kCommands[] = {
-    {"info", "info {data}/palm_1.las {data}/palm_1_skeleton.ply {data}/palm_1_mesh.ply --json"},
-    {"synth_tree", "synth tree --species palm --height 4 --seed 3 --out {out}"},
-    {"synth_tile", "synth tile --trees 2 --size 12 --seed 4 --no-leaves --out {out}"},
-    {"reconstruct", "reconstruct {data}/palm_1.las {data}/birch_3.las --out {out} --json"},
-    {"eval_skeleton", "eval skeleton --skeleton {data}/birch_3_skeleton.ply --reference {data}/palm_1_skeleton.ply --json"},
-    {"lobes", "lobes {data}/palm_1.las --out {out} --json"},
-    {"synthesize", "synthesize {in}/lobes/palm_1.tlobe --out {out}/palm.ply --json"},
-    {"classify_features", "classify features {in}/clouds/birch_3_1.las {in}/clouds/palm_1_1.las --relative-to {in}/clouds --out {out}/features.csv"},
-    {"classify_train", "classify train {in}/features.csv --labels {in}/labels.csv --out {out}/model.json --folds 2 --max-rounds 30 --no-scan-routing"},
-    {"classify_predict", "classify predict {in}/model.json {in}/features.csv --out {out}/predictions.csv"},
-    {"classify_evaluate", "classify evaluate {in}/clouds --features {in}/features.csv --splits 4 --max-rounds 20 --out {out}"},
-    {"encode", "encode {data}/birch_3_skeleton.ply --resolution 5 --lods 3 --out {out}/birch.dbf6 --json"},
-    {"encode_forest", "encode --forest {in}/skeletons --resolution 5 --lods 2 --out {out}/tile.forest --json"},
-    {"decode", "decode {in}/birch.dbf6 --lod 1 --out {out}/birch.ply --json"},
-    {"decode_forest", "decode {in}/tile.forest --out {out}/trees --json"},
-    {"lod", "lod --code 00080006000700087 --radii 9,8,4,6,3 --levels 3 --json"},
-    {"decode_code", "decode-code --code 00080006000700087 --radii 9,8,4,6,3 --resolution 5 --internode-length 0.1 --out {out}/code.ply --json"},
-    {"multires", "multires {src}/lsystem/examples/stochastic_bush.lsys --out {out} --all --json"},
-    {"render", "render {data}/palm_1.las {data}/palm_1_skeleton.ply --out {out}/preview.png"},
-    {"convert", "convert {data}/palm_1.las --out {out}/palm_1.ply --json"},
-    {"tile", "tile {data}/tile/tile.las --out {out}/tile --json --min-tree-points 30"},  // every segment modelled: exit 0
-    {"export_glb", "export {data}/birch_3_skeleton.ply --format glb --out {out}/birch.glb --json"},
-    {"export_qsm", "export {data}/birch_3_skeleton.ply --format qsm-csv --out {out}/birch.csv --json"},
+        {"info", "info {data}/palm_1.las {data}/palm_1_skeleton.ply {data}/palm_1_mesh.ply --json"},
+        {"synth_tree", "synth tree --species palm --height 4 --seed 3 --out {out}"},
+        {"synth_tile", "synth tile --trees 2 --size 12 --seed 4 --no-leaves --out {out}"},
+        {"reconstruct", "reconstruct {data}/palm_1.las {data}/birch_3.las --out {out} --json"},
+        {"eval_skeleton", "eval skeleton --skeleton {data}/birch_3_skeleton.ply --reference {data}/palm_1_skeleton.ply --json"},
+        {"lobes", "lobes {data}/palm_1.las --out {out} --json"},
+        {"synthesize", "synthesize {in}/lobes/palm_1.tlobe --out {out}/palm.ply --json"},
+        {"classify_features",
+         "classify features {in}/clouds/birch_3_1.las {in}/clouds/palm_1_1.las --relative-to {in}/clouds --out {out}/features.csv"},
+        {"classify_train",
+         "classify train {in}/features.csv --labels {in}/labels.csv --out {out}/model.json --folds 2 --max-rounds 30 --no-scan-routing"},
+        {"classify_predict", "classify predict {in}/model.json {in}/features.csv --out {out}/predictions.csv"},
+        {"classify_evaluate", "classify evaluate {in}/clouds --features {in}/features.csv --splits 4 --max-rounds 20 --out {out}"},
+        {"encode", "encode {data}/birch_3_skeleton.ply --resolution 5 --lods 3 --out {out}/birch.dbf6 --json"},
+        {"encode_forest", "encode --forest {in}/skeletons --resolution 5 --lods 2 --out {out}/tile.forest --json"},
+        {"decode", "decode {in}/birch.dbf6 --lod 1 --out {out}/birch.ply --json"},
+        {"decode_forest", "decode {in}/tile.forest --out {out}/trees --json"},
+        {"lod", "lod --code 00080006000700087 --radii 9,8,4,6,3 --levels 3 --json"},
+        {"decode_code",
+         "decode-code --code 00080006000700087 --radii 9,8,4,6,3 --resolution 5 --internode-length 0.1 --out {out}/code.ply --json"},
+        {"multires", "multires {src}/lsystem/examples/stochastic_bush.lsys --out {out} --all --json"},
+        {"render", "render {data}/palm_1.las {data}/palm_1_skeleton.ply --out {out}/preview.png"},
+        {"convert", "convert {data}/palm_1.las --out {out}/palm_1.ply --json"},
+        {"tile", "tile {data}/tile/tile.las --out {out}/tile --json --min-tree-points 30"},  // every segment modelled: exit 0
+        {"export_glb", "export {data}/birch_3_skeleton.ply --format glb --out {out}/birch.glb --json"},
+        {"export_qsm", "export {data}/birch_3_skeleton.ply --format qsm-csv --out {out}/birch.csv --json"},
 };
 
 std::string replaced(std::string text, const std::string& key, const std::string& value) {
@@ -180,7 +183,8 @@ class Determinism : public testing::TestWithParam<Command> {};
 class HeapLayout {
 public:
     explicit HeapLayout(bool perturbed) : perturbed_(perturbed) {
-        if (perturbed_) setenv("GLIBC_TUNABLES", "glibc.malloc.tcache_count=0:glibc.malloc.mmap_threshold=4096:glibc.malloc.top_pad=1000000", 1);
+        if (perturbed_)
+            setenv("GLIBC_TUNABLES", "glibc.malloc.tcache_count=0:glibc.malloc.mmap_threshold=4096:glibc.malloc.top_pad=1000000", 1);
     }
     ~HeapLayout() {
         if (perturbed_) unsetenv("GLIBC_TUNABLES");

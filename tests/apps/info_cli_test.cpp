@@ -58,8 +58,9 @@ TEST(Cli, InfoDescribesACloudAsJson) {
 TEST(Cli, BadInputGivesExitTwoAndOneLine) {
     TempDir dir;
     write_text(dir / "t.laz", "LASF whatever");
-    write_text(dir / "trunc.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
-                                  "property float y\nproperty float z\nend_header\nabc");
+    write_text(dir / "trunc.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\n"
+               "property float y\nproperty float z\nend_header\nabc");
     write_text(dir / "empty.xyz", "");
     for (const std::string name : {"t.laz", "trunc.ply", "empty.xyz", "missing.las"}) {
         const auto result = run_cli("info '" + (dir / name).string() + "'");

@@ -41,8 +41,7 @@ bool is_table(const std::filesystem::path& path) {
     std::ifstream in(path);
     std::string first_line;
     std::getline(in, first_line);
-    const bool has_letters =
-        std::any_of(first_line.begin(), first_line.end(), [](unsigned char c) { return std::isalpha(c); });
+    const bool has_letters = std::any_of(first_line.begin(), first_line.end(), [](unsigned char c) { return std::isalpha(c); });
     return has_letters && !(first_line.rfind("x", 0) == 0 || first_line.rfind("X", 0) == 0);
 }
 

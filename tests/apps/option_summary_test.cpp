@@ -34,52 +34,59 @@ struct Row {
 };
 
 const Row kRows[] = {
-    {"info", "--json info {data}/palm_1.las --bounds -50,-50,50,50", "", "/options", R"({"bounds": "-50,-50,50,50"})"},
-    {"convert", "--json convert {data}/palm_1.las --out {out}/palm_1.ply --bounds -50,-50,50,50", "", "/options",
-     R"({"bounds": "-50,-50,50,50"})"},
-    {"multires", "--json multires {src}/lsystem/examples/stochastic_bush.lsys --out {out} --all --texture-size 16", "", "/options",
-     R"({"all": true, "texture_size": 16, "lod": []})"},
-    {"reconstruct", "reconstruct {data}/palm_1.las --out {out} --geodesic-smoothing 2 --fit-axes false --mesh-sides 6 --species palm",
-     "palm_1_summary.json", "/options",
-     R"({"geodesic_smoothing": 2, "fit_axes": false, "mesh_sides": 6, "species": "palm", "overwrite": false})"},
-    {"eval skeleton", "--json eval skeleton --skeleton {data}/birch_3_skeleton.ply --reference {data}/palm_1_skeleton.ply --match-distance 0.2",
-     "", "/options", R"({"match_distance": 0.2})"},
-    {"encode", "--json encode {data}/birch_3_skeleton.ply --resolution 5 --lods 3 --out {out}/birch.dbf6", "", "/options",
-     R"({"resolution": 5, "lods": 3})"},
-    {"decode", "--json decode {in}/birch.dbf6 --lod 1 --out {out}/birch.ply", "", "/options", R"({"lod": 1})"},
-    {"lod", "--json lod --code 00080006000700087 --radii 9,8,4,6,3 --levels 3", "", "/options", R"({"levels": 3})"},
-    {"decode-code", "--json decode-code --code 00080006000700087 --radii 9,8,4,6,3 --resolution 5 --internode-length 0.1 --out {out}/code.ply",
-     "", "/options", R"({"internode_length": 0.1, "f6": false})"},
-    {"render", "--json render {data}/palm_1_skeleton.ply --out {out}/preview.png --size 100", "", "/options", R"({"size": 100})"},
-    {"synth tree", "--json synth tree --species palm --height 4 --seed 3 --max-leaves 2000 --out {out}", "", "/options",
-     R"({"height": 4, "seed": 3, "max_leaves": 2000})"},
-    {"synth dataset", "synth dataset --species palm --per-species 1 --seed 2 --max-leaves 2000 --angular-step 1 --out {out}",
-     "summary.json", "/options", R"({"per_species": 1, "species": ["palm"], "angular_step": 1})"},
-    {"synth tile", "--json synth tile --trees 2 --size 12 --seed 4 --no-leaves --out {out}", "", "/options",
-     R"({"trees": 2, "size": 12, "no_leaves": true})"},
-    {"classify features", "--json classify features {in}/clouds/birch_3_1.las --relative-to {in}/clouds --no-skeleton --out {out}/features.csv",
-     "", "/options", R"({"no_skeleton": true})"},
-    {"classify train",
-     "--json classify train {in}/features.csv --labels {in}/labels.csv --out {out}/model.json --folds 0 --max-rounds 20 --no-scan-routing",
-     "", "/options", R"({"folds": 0, "max_rounds": 20, "no_scan_routing": true, "no_calibration": false})"},
-    {"classify predict", "--json classify predict {in}/model.json {in}/features.csv --radius 3 --out {out}/predictions.csv", "", "/options",
-     R"({"radius": 3, "vote": false})"},
-    {"classify evaluate", "classify evaluate {in}/clouds --features {in}/features.csv --splits 4 --max-rounds 20 --no-xgboost --out {out}",
-     "summary.json", "/options", R"({"splits": 4, "max_rounds": 20, "no_xgboost": true})"},
-    {"lobes", "lobes {data}/palm_1.las --out {out} --face-budget 500 --beta 1.6", "palm_1_lobes.json", "/options",
-     R"({"face_budget": 500, "beta": 1.6})"},
-    {"synthesize", "synthesize {in}/lobes/palm_1.tlobe --out {out}/palm.ply --max-triangles 20000", "palm.json", "/options",
-     R"({"max_triangles": 20000})"},
-    {"export", "--json export {data}/birch_3_skeleton.ply --format glb --out {out}/birch.glb --sides 5 --no-leaves", "", "/options",
-     R"({"format": "glb", "sides": 5, "no_leaves": true})"},
-    {"rebuild",
-     "rebuild {in}/palm/palm_3_mesh.obj --out {out} --species palm --samples 20000 --compare-samples 2000 --max-triangles 20000 "
-     "--image-height 160",
-     "report.json", "/options", R"({"samples": 20000, "image_height": 160, "species": "palm"})"},
-    {"tile", "tile {data}/tile/tile.las --out {out} --map-size 300 --min-tree-points 30", "summary.json", "/options", R"({"map_size": 300, "mode": "auto", "min_tree_points": 30})"},
-    {"batch", "--json batch {in}/tiles --out {out} --max-memory 8G --map-size 300", "", "/options", R"({"max_memory": "8G"})"},
-    {"merge", "--json merge {in}/tile --out {out}", "", "/merge_options", "{}"},
-    {"retile", "--json retile {data}/palm_1.las --size 5 --prefix part --out {out}", "", "/options", R"({"size": 5, "prefix": "part"})"},
+        {"info", "--json info {data}/palm_1.las --bounds -50,-50,50,50", "", "/options", R"({"bounds": "-50,-50,50,50"})"},
+        {"convert", "--json convert {data}/palm_1.las --out {out}/palm_1.ply --bounds -50,-50,50,50", "", "/options",
+         R"({"bounds": "-50,-50,50,50"})"},
+        {"multires", "--json multires {src}/lsystem/examples/stochastic_bush.lsys --out {out} --all --texture-size 16", "", "/options",
+         R"({"all": true, "texture_size": 16, "lod": []})"},
+        {"reconstruct", "reconstruct {data}/palm_1.las --out {out} --geodesic-smoothing 2 --fit-axes false --mesh-sides 6 --species palm",
+         "palm_1_summary.json", "/options",
+         R"({"geodesic_smoothing": 2, "fit_axes": false, "mesh_sides": 6, "species": "palm", "overwrite": false})"},
+        {"eval skeleton",
+         "--json eval skeleton --skeleton {data}/birch_3_skeleton.ply --reference {data}/palm_1_skeleton.ply --match-distance 0.2", "",
+         "/options", R"({"match_distance": 0.2})"},
+        {"encode", "--json encode {data}/birch_3_skeleton.ply --resolution 5 --lods 3 --out {out}/birch.dbf6", "", "/options",
+         R"({"resolution": 5, "lods": 3})"},
+        {"decode", "--json decode {in}/birch.dbf6 --lod 1 --out {out}/birch.ply", "", "/options", R"({"lod": 1})"},
+        {"lod", "--json lod --code 00080006000700087 --radii 9,8,4,6,3 --levels 3", "", "/options", R"({"levels": 3})"},
+        {"decode-code",
+         "--json decode-code --code 00080006000700087 --radii 9,8,4,6,3 --resolution 5 --internode-length 0.1 --out {out}/code.ply", "",
+         "/options", R"({"internode_length": 0.1, "f6": false})"},
+        {"render", "--json render {data}/palm_1_skeleton.ply --out {out}/preview.png --size 100", "", "/options", R"({"size": 100})"},
+        {"synth tree", "--json synth tree --species palm --height 4 --seed 3 --max-leaves 2000 --out {out}", "", "/options",
+         R"({"height": 4, "seed": 3, "max_leaves": 2000})"},
+        {"synth dataset", "synth dataset --species palm --per-species 1 --seed 2 --max-leaves 2000 --angular-step 1 --out {out}",
+         "summary.json", "/options", R"({"per_species": 1, "species": ["palm"], "angular_step": 1})"},
+        {"synth tile", "--json synth tile --trees 2 --size 12 --seed 4 --no-leaves --out {out}", "", "/options",
+         R"({"trees": 2, "size": 12, "no_leaves": true})"},
+        {"classify features",
+         "--json classify features {in}/clouds/birch_3_1.las --relative-to {in}/clouds --no-skeleton --out {out}/features.csv", "",
+         "/options", R"({"no_skeleton": true})"},
+        {"classify train",
+         "--json classify train {in}/features.csv --labels {in}/labels.csv --out {out}/model.json --folds 0 --max-rounds 20 "
+         "--no-scan-routing",
+         "", "/options", R"({"folds": 0, "max_rounds": 20, "no_scan_routing": true, "no_calibration": false})"},
+        {"classify predict", "--json classify predict {in}/model.json {in}/features.csv --radius 3 --out {out}/predictions.csv", "",
+         "/options", R"({"radius": 3, "vote": false})"},
+        {"classify evaluate",
+         "classify evaluate {in}/clouds --features {in}/features.csv --splits 4 --max-rounds 20 --no-xgboost --out {out}", "summary.json",
+         "/options", R"({"splits": 4, "max_rounds": 20, "no_xgboost": true})"},
+        {"lobes", "lobes {data}/palm_1.las --out {out} --face-budget 500 --beta 1.6", "palm_1_lobes.json", "/options",
+         R"({"face_budget": 500, "beta": 1.6})"},
+        {"synthesize", "synthesize {in}/lobes/palm_1.tlobe --out {out}/palm.ply --max-triangles 20000", "palm.json", "/options",
+         R"({"max_triangles": 20000})"},
+        {"export", "--json export {data}/birch_3_skeleton.ply --format glb --out {out}/birch.glb --sides 5 --no-leaves", "", "/options",
+         R"({"format": "glb", "sides": 5, "no_leaves": true})"},
+        {"rebuild",
+         "rebuild {in}/palm/palm_3_mesh.obj --out {out} --species palm --samples 20000 --compare-samples 2000 --max-triangles 20000 "
+         "--image-height 160",
+         "report.json", "/options", R"({"samples": 20000, "image_height": 160, "species": "palm"})"},
+        {"tile", "tile {data}/tile/tile.las --out {out} --map-size 300 --min-tree-points 30", "summary.json", "/options",
+         R"({"map_size": 300, "mode": "auto", "min_tree_points": 30})"},
+        {"batch", "--json batch {in}/tiles --out {out} --max-memory 8G --map-size 300", "", "/options", R"({"max_memory": "8G"})"},
+        {"merge", "--json merge {in}/tile --out {out}", "", "/merge_options", "{}"},
+        {"retile", "--json retile {data}/palm_1.las --size 5 --prefix part --out {out}", "", "/options",
+         R"({"size": 5, "prefix": "part"})"},
 };
 
 std::string replaced(std::string text, const std::string& key, const std::string& value) {
@@ -96,14 +103,16 @@ public:
         static Inputs inputs;
         const auto wants = [&](const std::string& name) { return arguments.find("{in}/" + name) != std::string::npos; };
         if (wants("clouds") || wants("features.csv") || wants("labels.csv") || wants("model.json")) inputs.make_clouds();
-        if (wants("features.csv") || wants("model.json")) inputs.run("classify features " + quoted(inputs.in() / "clouds") + "/*.las --relative-to " +
-                                                                     quoted(inputs.in() / "clouds") + " --no-skeleton --out " + quoted(inputs.in() / "features.csv"));
+        if (wants("features.csv") || wants("model.json"))
+            inputs.run("classify features " + quoted(inputs.in() / "clouds") + "/*.las --relative-to " + quoted(inputs.in() / "clouds") +
+                       " --no-skeleton --out " + quoted(inputs.in() / "features.csv"));
         if (wants("model.json"))
-            inputs.run("classify train " + quoted(inputs.in() / "features.csv") + " --labels " + quoted(inputs.in() / "labels.csv") + " --out " +
-                       quoted(inputs.in() / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
+            inputs.run("classify train " + quoted(inputs.in() / "features.csv") + " --labels " + quoted(inputs.in() / "labels.csv") +
+                       " --out " + quoted(inputs.in() / "model.json") + " --folds 0 --max-rounds 20 --no-scan-routing");
         if (wants("lobes")) inputs.run("lobes " + quoted(inputs.data() / "palm_1.las") + " --out " + quoted(inputs.in() / "lobes"));
         if (wants("birch.dbf6"))
-            inputs.run("encode " + quoted(inputs.data() / "birch_3_skeleton.ply") + " --resolution 5 --lods 3 --out " + quoted(inputs.in() / "birch.dbf6"));
+            inputs.run("encode " + quoted(inputs.data() / "birch_3_skeleton.ply") + " --resolution 5 --lods 3 --out " +
+                       quoted(inputs.in() / "birch.dbf6"));
         if (wants("palm/"))
             inputs.run("synth tree --species palm --seed 3 --height 6 --max-leaves 4000 --angular-step 0.5 --mesh-format obj --out " +
                        quoted(inputs.in() / "palm"));
@@ -111,7 +120,8 @@ public:
             fs::create_directories(inputs.in() / "tiles");
             fs::copy_file(inputs.data() / "tile/tile.las", inputs.in() / "tiles" / "tile.las");
         }
-        if (wants("tile ")) inputs.run("tile " + quoted(inputs.data() / "tile/tile.las") + " --min-tree-points 30 --out " + quoted(inputs.in() / "tile"));
+        if (wants("tile "))
+            inputs.run("tile " + quoted(inputs.data() / "tile/tile.las") + " --min-tree-points 30 --out " + quoted(inputs.in() / "tile"));
         return inputs.in();
     }
 
@@ -240,7 +250,8 @@ TEST_P(OptionSummary, EveryDeclaredFlagAppearsWithItsResolvedValue) {
     ASSERT_NE(command, nullptr);
     const std::set<std::string> declared = declared_keys(*command);
     EXPECT_FALSE(declared.empty());
-    for (const std::string& key : declared) EXPECT_TRUE(options.contains(key)) << "the summary's options lack \"" << key << "\", a declared flag";
+    for (const std::string& key : declared)
+        EXPECT_TRUE(options.contains(key)) << "the summary's options lack \"" << key << "\", a declared flag";
     const nlohmann::json expected = nlohmann::json::parse(row.expected);
     for (const auto& item : expected.items()) {
         EXPECT_TRUE(declared.count(item.key())) << item.key() << " is no flag of " << row.command;

@@ -87,12 +87,14 @@ TEST(RebuildCli, SameInputSameOutputs) {
 TEST(RebuildCli, BrokenMeshesExitTwoWithOneLine) {
     TempDir dir, out;
     const std::pair<const char*, const char*> cases[] = {
-        {"truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2"},
-        {"nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"},
-        {"no_triangles.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"},
-        {"empty.obj", ""},
-        {"flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"},
-        {"points.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"},
+            {"truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2"},
+            {"nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"},
+            {"no_triangles.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"},
+            {"empty.obj", ""},
+            {"flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"},
+            {"points.ply",
+             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n1 0 0\n0 1 "
+             "0\n"},
     };
     for (const auto& [name, text] : cases) {
         test::write_text(dir / name, text);

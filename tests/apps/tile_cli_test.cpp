@@ -45,8 +45,10 @@ const std::string kWkt = "PROJCS[\"WGS 84 / UTM zone 32N\",AUTHORITY[\"EPSG\",\"
 const fs::path& small_tile() {
     static TempDir dir;
     static const fs::path tile = [] {
-        const auto r = run_cli("--log-level warn synth tile --trees 5 --size 20 --seed 11 --pulse-density 20 --max-leaves 2000 "
-                               "--species pine birch --origin 500000 5400000 300 --out " + quoted(dir / "synth"));
+        const auto r =
+                run_cli("--log-level warn synth tile --trees 5 --size 20 --seed 11 --pulse-density 20 --max-leaves 2000 "
+                        "--species pine birch --origin 500000 5400000 300 --out " +
+                        quoted(dir / "synth"));
         EXPECT_EQ(r.exit_code, 0) << r.err;
         PointCloud cloud = read_point_cloud(dir / "synth" / "tile.las");
         cloud.georef.crs_wkt = kWkt;
@@ -70,7 +72,8 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
     EXPECT_EQ(summary, nlohmann::json::parse(slurp(dir / "out" / "summary.json")));
     const int trees = summary["counts"]["trees"].get<int>();
     EXPECT_EQ(trees, 5);
-    for (const char* key : {"read", "terrain", "segmentation", "trees", "outputs", "total"}) EXPECT_TRUE(summary["seconds"].contains(key)) << key;
+    for (const char* key : {"read", "terrain", "segmentation", "trees", "outputs", "total"})
+        EXPECT_TRUE(summary["seconds"].contains(key)) << key;
     EXPECT_GT(summary["peak_memory_mb"].get<double>(), 0.0);
     EXPECT_EQ(summary["options"]["mode_used"], "input");
     EXPECT_FALSE(fs::exists(dir / "out" / "failures.jsonl"));
@@ -227,7 +230,8 @@ TEST(TileCliBadTiles, AllGroundGivesTheDocumentedEmptyResult) {
     TempDir dir;
     std::string text;
     for (int x = 0; x < 60; ++x)
-        for (int y = 0; y < 60; ++y) text += std::to_string(x * 0.5) + " " + std::to_string(y * 0.5) + " " + std::to_string(0.1 * x * 0.5) + "\n";
+        for (int y = 0; y < 60; ++y)
+            text += std::to_string(x * 0.5) + " " + std::to_string(y * 0.5) + " " + std::to_string(0.1 * x * 0.5) + "\n";
     std::ofstream(dir / "ground.xyz") << text;
     const auto r = run_cli("--json tile " + quoted(dir / "ground.xyz") + " --out " + quoted(dir / "o"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -242,9 +246,13 @@ TEST(TileCliBadTiles, AllGroundGivesTheDocumentedEmptyResult) {
 
 TEST(TileCliBadTiles, ASingleTree) {
     TempDir dir;
-    ASSERT_EQ(run_cli("--log-level warn synth tile --trees 1 --size 12 --seed 5 --pulse-density 20 --max-leaves 2000 --species pine --out " +
-                      quoted(dir / "synth")).exit_code, 0);
-    const auto r = run_cli("--json tile " + quoted(dir / "synth" / "tile.las") + " --out " + quoted(dir / "o") + " --use-input-segmentation");
+    ASSERT_EQ(
+            run_cli("--log-level warn synth tile --trees 1 --size 12 --seed 5 --pulse-density 20 --max-leaves 2000 --species pine --out " +
+                    quoted(dir / "synth"))
+                    .exit_code,
+            0);
+    const auto r =
+            run_cli("--json tile " + quoted(dir / "synth" / "tile.las") + " --out " + quoted(dir / "o") + " --use-input-segmentation");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(nlohmann::json::parse(r.out)["counts"]["trees"], 1);
     EXPECT_EQ(lines_of(slurp(dir / "o" / "trees.csv")).size(), 2u);
@@ -253,7 +261,7 @@ TEST(TileCliBadTiles, ASingleTree) {
 TEST(TileCliBuffer, OptionsAreCheckedAndMemoryIsRefusedBeforeReading) {
     TempDir dir;
     EXPECT_EQ(run_cli(run_tile(dir / "a", "--neighbours " + quoted(dir.path()))).exit_code, 1);  // --neighbours needs --buffer
-    EXPECT_EQ(run_cli(run_tile(dir / "b", "--buffer 5 --tile-size 20")).exit_code, 1);          // tile.las is not a retile name
+    EXPECT_EQ(run_cli(run_tile(dir / "b", "--buffer 5 --tile-size 20")).exit_code, 1);           // tile.las is not a retile name
     EXPECT_EQ(run_cli(run_tile(dir / "c", "--buffer -1")).exit_code, 1);
     EXPECT_EQ(run_cli(run_tile(dir / "d", "--max-memory lots")).exit_code, 1);
     const auto refused = run_cli(run_tile(dir / "e", "--max-memory 100K"));

@@ -34,14 +34,16 @@ protected:
     // One dataset and its feature table for the whole suite (the expensive part).
     static void SetUpTestSuite() {
         dir_ = new TempDir;
-        const auto r = run_cli("--log-level warn synth dataset --per-species 4 --species palm pine oak --seed 3 --angular-step 0.5 "
-                               "--max-leaves 3000 --out " + quoted(dataset()));
+        const auto r =
+                run_cli("--log-level warn synth dataset --per-species 4 --species palm pine oak --seed 3 --angular-step 0.5 "
+                        "--max-leaves 3000 --out " +
+                        quoted(dataset()));
         ASSERT_EQ(r.exit_code, 0) << r.err;
         std::string files;
         for (const auto& line : lines_of(read_file(dataset() / "labels.csv")))
             if (line.rfind("file,", 0) != 0) (files += ' ') += quoted(dataset() / line.substr(0, line.find(',')));
         features_run_ = new test::CommandResult(
-            run_cli("classify features" + files + " --relative-to " + quoted(dataset()) + " --out " + quoted(features()) + " --json"));
+                run_cli("classify features" + files + " --relative-to " + quoted(dataset()) + " --out " + quoted(features()) + " --json"));
     }
     static void TearDownTestSuite() {
         delete features_run_;
@@ -75,8 +77,8 @@ TEST_F(ClassifyCli, FeaturesWritesOneRowPerTreeWithLabelIds) {
     std::string files;
     for (const auto& line : lines_of(read_file(labels())))
         if (line.rfind("file,", 0) != 0) (files += ' ') += quoted(dataset() / line.substr(0, line.find(',')));
-    const auto again = run_cli("--threads 1 classify features" + files + " --relative-to " + quoted(dataset()) + " --out " +
-                               quoted(other / "f.csv"));
+    const auto again =
+            run_cli("--threads 1 classify features" + files + " --relative-to " + quoted(dataset()) + " --out " + quoted(other / "f.csv"));
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_EQ(read_file(other / "f.csv"), read_file(features()));
 }
@@ -140,8 +142,8 @@ TEST_F(ClassifyCli, EvaluateWritesTheReport) {
     // From 2 training trees per species JointBoost is well above chance (1/3); measured 65 % over
     // 20 splits (oak 100 %, palm 72 %, pine 22 %: coarse scans of tall pines).
     EXPECT_GE(summary["classifiers"]["JointBoost"]["random_splits"]["average_recognition_rate"].get<double>(), 0.5);
-    for (const char* name : {"summary.json", "per_species.csv", "report.md", "confusion_JointBoost.csv", "confusion_JointBoost.png",
-                             "confusion_XGBoost.png"})
+    for (const char* name :
+         {"summary.json", "per_species.csv", "report.md", "confusion_JointBoost.csv", "confusion_JointBoost.png", "confusion_XGBoost.png"})
         EXPECT_TRUE(std::filesystem::exists(dir / "report" / name)) << name;
     const auto species = lines_of(read_file(dir / "report" / "per_species.csv"));
     EXPECT_EQ(species.size(), 4u);
@@ -184,7 +186,9 @@ TEST_F(ClassifyCli, EvaluateTrainsOnOneFolderAndTestsOnAnother) {
     EXPECT_EQ(lines_of(read_file(dir / "report" / "crowns.csv")).size(), 1u + 2 * 12u);
     EXPECT_EQ(run_cli("classify evaluate --train " + quoted(dataset()) + " --out " + quoted(dir / "r2")).exit_code, 1);
     EXPECT_EQ(run_cli("classify evaluate " + quoted(dataset()) + " --features " + quoted(features()) + " --groups nosuch --out " +
-                      quoted(dir / "r3")).exit_code, 1);
+                      quoted(dir / "r3"))
+                      .exit_code,
+              1);
 }
 
 TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
@@ -202,7 +206,9 @@ TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
     test::write_text(dir / "small.csv", "id,height\na,1\nb,2\n");
     test::write_text(dir / "small_labels.csv", "id,species\na,x\nb,y\n");
     ASSERT_EQ(run_cli("classify train " + quoted(dir / "small.csv") + " --labels " + quoted(dir / "small_labels.csv") + " --out " +
-                      quoted(dir / "small.jb") + " --folds 0 --max-rounds 2").exit_code, 0);
+                      quoted(dir / "small.jb") + " --folds 0 --max-rounds 2")
+                      .exit_code,
+              0);
     test::write_text(dir / "other.csv", "id,width\na,1\n");
     r = run_cli("classify predict " + quoted(dir / "small.jb") + " " + quoted(dir / "other.csv"));
     EXPECT_EQ(r.exit_code, 2);

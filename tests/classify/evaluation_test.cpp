@@ -153,15 +153,16 @@ TEST(ClassifyEvaluation, ParallelSplitsGiveTheSameReportAsOneThread) {
     jb.max_rounds = 60;
     const NamedClassifier jointboost = {"JointBoost", [jb](const FeatureTable& train, const std::vector<int>& y, int classes,
                                                            const FeatureTable& test, std::uint64_t seed) {
-        JointBoostOptions o = jb;
-        o.seed = seed;
-        std::vector<std::string> names;
-        for (int c = 0; c < classes; ++c) names.push_back(std::to_string(c));
-        const auto model = train_jointboost(train, y, names, o);
-        ClassifierRun run;
-        for (std::size_t r = 0; r < test.rows(); ++r) run.probabilities.push_back(model.probabilities(test.row(r)));
-        return run;
-    }};
+                                            JointBoostOptions o = jb;
+                                            o.seed = seed;
+                                            std::vector<std::string> names;
+                                            for (int c = 0; c < classes; ++c) names.push_back(std::to_string(c));
+                                            const auto model = train_jointboost(train, y, names, o);
+                                            ClassifierRun run;
+                                            for (std::size_t r = 0; r < test.rows(); ++r)
+                                                run.probabilities.push_back(model.probabilities(test.row(r)));
+                                            return run;
+                                        }};
     const auto many = evaluate(set, {jointboost}, options).classifiers[0].random_splits;
     Scores one;
     {
@@ -232,7 +233,7 @@ TEST(ClassifyVoting, UnconfidentTreesTakeTheMostProbableNeighbourSpecies) {
     // Tree 0 is unsure (B 0.40 > A 0.35 > C 0.25); its confident neighbours are A and C, so it
     // becomes A. Tree 3 is unsure but alone beyond the radius and keeps its own best guess.
     const std::vector<std::vector<double>> p = {
-        {0.35, 0.40, 0.25}, {0.9, 0.05, 0.05}, {0.1, 0.1, 0.8}, {0.32, 0.45, 0.23}, {0.2, 0.7, 0.1}};
+            {0.35, 0.40, 0.25}, {0.9, 0.05, 0.05}, {0.1, 0.1, 0.8}, {0.32, 0.45, 0.23}, {0.2, 0.7, 0.1}};
     const std::vector<Eigen::Vector2d> xy = {{0, 0}, {10, 0}, {0, 20}, {100, 0}, {0, 26}};
     VotingOptions options;  // 1.5, 25 m
     const auto r = spatial_vote(p, xy, options);
@@ -360,7 +361,8 @@ TEST(ClassifyBaseline, XGBoostSeesTheSameTablesAndSeparatesClusters) {
     int correct = 0;
     for (std::size_t r = 0; r < set.labels.size(); ++r) {
         EXPECT_NEAR(run.probabilities[r][0] + run.probabilities[r][1] + run.probabilities[r][2], 1.0, 1e-5);
-        correct += std::max_element(run.probabilities[r].begin(), run.probabilities[r].end()) - run.probabilities[r].begin() == set.labels[r];
+        correct +=
+                std::max_element(run.probabilities[r].begin(), run.probabilities[r].end()) - run.probabilities[r].begin() == set.labels[r];
     }
     EXPECT_EQ(correct, static_cast<int>(set.labels.size()));
     EXPECT_GT(run.rounds, 0);
@@ -401,8 +403,8 @@ TEST(ClassifyEvaluation, MacroF1KappaAndGenusLevel) {
     EXPECT_NEAR(s.kappa, 0.0, 1e-12);
     ASSERT_TRUE(s.genus_level);
     EXPECT_EQ(s.genera, (std::vector<std::string>{"Acer", "Quercus"}));
-    EXPECT_NEAR(s.genus_tree_accuracy, 2.0 / 3, 1e-12);      // both oaks count as right at genus level
-    EXPECT_NEAR(s.genus_average_rate, 0.5, 1e-12);           // Quercus 100 %, Acer 0 %
+    EXPECT_NEAR(s.genus_tree_accuracy, 2.0 / 3, 1e-12);  // both oaks count as right at genus level
+    EXPECT_NEAR(s.genus_average_rate, 0.5, 1e-12);       // Quercus 100 %, Acer 0 %
     // A perfect classifier: kappa 1, macro-F1 1.
     const auto perfect = evaluate(set, {nearest_mean()}, options).classifiers[0].random_splits;
     EXPECT_NEAR(perfect.kappa, 1.0, 1e-12);

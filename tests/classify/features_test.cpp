@@ -66,7 +66,8 @@ const PointCloud& tree(const std::string& species, std::uint64_t seed = 1) {
 
 // The scan moved and turned, with its attributes (classes, returns, intensity).
 PointCloud transformed(const PointCloud& cloud, double heading_deg, const Eigen::Vector3f& shift) {
-    const Eigen::Matrix3f turn = Eigen::AngleAxisf(static_cast<float>(heading_deg * M_PI / 180), Eigen::Vector3f::UnitZ()).toRotationMatrix();
+    const Eigen::Matrix3f turn =
+            Eigen::AngleAxisf(static_cast<float>(heading_deg * M_PI / 180), Eigen::Vector3f::UnitZ()).toRotationMatrix();
     PointCloud out = cloud;
     for (auto& p : out.positions) p = turn * p + shift;
     return out;
@@ -104,8 +105,10 @@ std::vector<double> feature_scales(const std::vector<std::vector<double>>& vecto
 double scaled_distance(const std::vector<double>& a, const std::vector<double>& b, const std::vector<double>& scale) {
     double sum = 0;
     for (std::size_t f = 0; f < a.size(); ++f) {
-        if (std::isnan(a[f]) || std::isnan(b[f])) sum += std::isnan(a[f]) && std::isnan(b[f]) ? 0.0 : 1.0;  // missing in one only: as far as it gets
-        else sum += std::min(1.0, std::abs(a[f] - b[f]) / scale[f]);
+        if (std::isnan(a[f]) || std::isnan(b[f]))
+            sum += std::isnan(a[f]) && std::isnan(b[f]) ? 0.0 : 1.0;  // missing in one only: as far as it gets
+        else
+            sum += std::min(1.0, std::abs(a[f] - b[f]) / scale[f]);
     }
     return sum / static_cast<double>(a.size());
 }
@@ -136,11 +139,27 @@ TEST(ClassifyFeatures, CatalogueHasMoreThan200DocumentedUniqueFeatures) {
         EXPECT_EQ(f.name.find(','), std::string::npos) << "a CSV column name cannot hold a comma: " << f.name;
     }
     // The paper's list (Livny et al. 2011, §6.1) and the skeleton features from a first reconstruction are all there.
-    for (const char* required :
-         {"trunk_diameter", "height", "crown_width_major", "crown_width_minor", "width_height_ratio", "normal_elevation_00",
-          "normal_axis_angle_00", "z_moment2", "z_moment3", "z_moment4", "z_decile_05", "count_cv_20", "stems_at_05",
-          "skel_angle_o1_mean", "skel_length_o2_mean", "skel_radius_o1_mean", "skel_whorl_spacing_mean", "skel_tip_offset_ratio",
-          "alpha_hull_ratio_20", "boxcount_dimension", "skel_boxcount_dimension"})
+    for (const char* required : {"trunk_diameter",
+                                 "height",
+                                 "crown_width_major",
+                                 "crown_width_minor",
+                                 "width_height_ratio",
+                                 "normal_elevation_00",
+                                 "normal_axis_angle_00",
+                                 "z_moment2",
+                                 "z_moment3",
+                                 "z_moment4",
+                                 "z_decile_05",
+                                 "count_cv_20",
+                                 "stems_at_05",
+                                 "skel_angle_o1_mean",
+                                 "skel_length_o2_mean",
+                                 "skel_radius_o1_mean",
+                                 "skel_whorl_spacing_mean",
+                                 "skel_tip_offset_ratio",
+                                 "alpha_hull_ratio_20",
+                                 "boxcount_dimension",
+                                 "skel_boxcount_dimension"})
         EXPECT_TRUE(names.count(required)) << "missing feature " << required;
     EXPECT_EQ(feature_names().size(), catalogue.size());
 }
@@ -149,7 +168,7 @@ TEST(ClassifyFeatures, CommittedDocumentationMatchesTheCatalogue) {
     const auto path = test::source_dir() / "docs" / "features.md";
     ASSERT_TRUE(std::filesystem::exists(path)) << path << " is missing: treelobes classify features --list > docs/features.md";
     EXPECT_EQ(read_file(path), features_markdown())
-        << "docs/features.md is out of date: regenerate it with treelobes classify features --list > docs/features.md";
+            << "docs/features.md is out of date: regenerate it with treelobes classify features --list > docs/features.md";
 }
 
 double feature(const std::vector<double>& v, const std::string& name) {
@@ -207,7 +226,8 @@ TEST(ClassifyFeatures, ScanDensityHalvesWithHalfThePointsAndIgnoresPose) {
         SCOPED_TRACE(kSpecies[s]);
         const double full = feature(vectors[s], kScanDensityFeature);
         const auto cloud = tree(kSpecies[s]);
-        const double per_disc = static_cast<double>(extract_crown(cloud).crown.size()) / (3.14159265358979 * std::pow(feature(vectors[s], "crown_radius"), 2));
+        const double per_disc = static_cast<double>(extract_crown(cloud).crown.size()) /
+                                (3.14159265358979 * std::pow(feature(vectors[s], "crown_radius"), 2));
         EXPECT_NEAR(full, per_disc, 1e-6 * per_disc);
         EXPECT_GT(full, 1000.0) << "a terrestrial scan";
         const auto turned = compute_features(transformed(cloud, 37, {120.0f, -80.0f, 15.0f}));
@@ -271,7 +291,8 @@ TEST(ClassifyFeatures, RejectsCloudsThatAreNotTrees) {
     PointCloud flat;
     Rng rng(2);
     for (int i = 0; i < 2000; ++i)
-        flat.positions.emplace_back(static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.normal(0, 0.02)));
+        flat.positions.emplace_back(static_cast<float>(rng.uniform(0, 10)), static_cast<float>(rng.uniform(0, 10)),
+                                    static_cast<float>(rng.normal(0, 0.02)));
     try {
         compute_features(flat, {}, "lawn.xyz");
         FAIL() << "a flat patch gave features";
@@ -314,8 +335,10 @@ TEST(ClassifyFeatures, AirborneGroupInvariantToPositionHeadingAndDensity) {
     for (std::size_t s = 0; s < 2; ++s) {
         SCOPED_TRACE(kSpecies[s]);
         PointCloud moved = scans[s], turned = scans[s];
-        const Eigen::Matrix3f turn37 = Eigen::AngleAxisf(37.0f * static_cast<float>(M_PI) / 180, Eigen::Vector3f::UnitZ()).toRotationMatrix();
-        const Eigen::Matrix3f turn200 = Eigen::AngleAxisf(200.0f * static_cast<float>(M_PI) / 180, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+        const Eigen::Matrix3f turn37 =
+                Eigen::AngleAxisf(37.0f * static_cast<float>(M_PI) / 180, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+        const Eigen::Matrix3f turn200 =
+                Eigen::AngleAxisf(200.0f * static_cast<float>(M_PI) / 180, Eigen::Vector3f::UnitZ()).toRotationMatrix();
         for (auto& p : moved.positions) p = turn37 * p + Eigen::Vector3f(120.0f, -80.0f, 15.0f);
         for (auto& p : turned.positions) p = turn200 * p;
         std::vector<bool> keep(scans[s].size());

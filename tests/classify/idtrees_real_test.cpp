@@ -25,7 +25,9 @@ TEST(ClassifyIdtreesReal, EveryCrownGetsFeaturesWithItsHeightAboveGround) {
     EXPECT_TRUE(batch.failures.empty()) << batch.failures.front().id << ": " << batch.failures.front().reason;
     ASSERT_EQ(batch.table.rows(), labels.size());
     const auto names = batch.table.feature_names;
-    const auto column = [&](const char* name) { return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin()); };
+    const auto column = [&](const char* name) {
+        return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
+    };
     std::size_t small = 0, noise = 0, ground = 0, ground_clips = 0;
     for (std::size_t r = 0; r < batch.table.rows(); ++r) {
         const double height = batch.table.at(r, column("als_height"));

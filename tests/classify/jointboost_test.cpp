@@ -86,8 +86,8 @@ struct NaiveStump {
 
 // Fits a, b, k for (f, theta, S) and returns the weighted squared error, summed over samples
 // and classes directly.
-NaiveStump naive_fit(const FeatureTable& t, const std::vector<int>& y, const std::vector<std::vector<double>>& w,
-                     int f, double theta, const std::vector<int>& set) {
+NaiveStump naive_fit(const FeatureTable& t, const std::vector<int>& y, const std::vector<std::vector<double>>& w, int f, double theta,
+                     const std::vector<int>& set) {
     const int classes = static_cast<int>(w.size());
     NaiveStump s;
     s.feature = f, s.threshold = theta, s.sharing = set;
@@ -95,8 +95,10 @@ NaiveStump naive_fit(const FeatureTable& t, const std::vector<int>& y, const std
     for (int c : set)
         for (std::size_t i = 0; i < t.rows(); ++i) {
             const double z = y[i] == c ? 1 : -1;
-            if (t.at(i, f) > theta) wa += w[c][i], za += w[c][i] * z;
-            else wb += w[c][i], zb += w[c][i] * z;
+            if (t.at(i, f) > theta)
+                wa += w[c][i], za += w[c][i] * z;
+            else
+                wb += w[c][i], zb += w[c][i] * z;
         }
     s.a = za / wa, s.b = zb / wb;
     s.k.assign(classes, 0);
@@ -192,8 +194,7 @@ void expect_rounds_match_naive(const FeatureTable& t, const std::vector<int>& y,
         for (int c = 0; c < classes; ++c) EXPECT_NEAR(s.k[c], ref.k[c], 1e-9);
         // Update the reference weights with the reference stump: w <- w exp(-z h).
         for (int c = 0; c < classes; ++c)
-            for (std::size_t i = 0; i < t.rows(); ++i)
-                w[c][i] *= std::exp(-(y[i] == c ? 1.0 : -1.0) * ref.h(c, t.at(i, ref.feature)));
+            for (std::size_t i = 0; i < t.rows(); ++i) w[c][i] *= std::exp(-(y[i] == c ? 1.0 : -1.0) * ref.h(c, t.at(i, ref.feature)));
     }
 }
 
@@ -227,12 +228,12 @@ TEST(JointBoost, ManyRoundsOverManyFeaturesMatchNaiveReference) {
         row[0] = rng.normal() + 0.6 * c;
         row[1] = std::floor(rng.uniform(0, 5)) + (c == 3 ? 2 : 0);
         row[2] = rng.normal() - (c <= 1 ? 1.2 : 0.0);
-        row[3] = rng.normal();                        // noise
-        row[4] = row[2];                              // duplicate of feature 2: exact ties
+        row[3] = rng.normal();  // noise
+        row[4] = row[2];        // duplicate of feature 2: exact ties
         row[5] = rng.normal() + (c == 4 ? 1.5 : 0.0);
-        row[6] = std::floor(rng.uniform(0, 3));       // few distinct values
+        row[6] = std::floor(rng.uniform(0, 3));  // few distinct values
         row[7] = rng.normal() * (1.0 + 0.3 * c);
-        row[8] = row[0];                              // duplicate of feature 0
+        row[8] = row[0];  // duplicate of feature 0
         t.add_row(test::numbered("t", static_cast<std::size_t>(i)), row);
         y.push_back(c);
     }
@@ -260,8 +261,8 @@ TEST(JointBoost, ClassesWithACommonFeatureShareTheFirstStump) {
     const Stump& first = model.stumps.front();
     EXPECT_EQ(first.feature, 0);
     EXPECT_EQ(first.sharing, (std::vector<int>{0, 1}));
-    EXPECT_NEAR(first.a, 0.0, 1e-9);   // above: half positives of class 0, half of class 1
-    EXPECT_NEAR(first.b, -1.0, 1e-9);  // below: only negatives for both
+    EXPECT_NEAR(first.a, 0.0, 1e-9);      // above: half positives of class 0, half of class 1
+    EXPECT_NEAR(first.b, -1.0, 1e-9);     // below: only negatives for both
     EXPECT_NEAR(first.k[2], -0.6, 1e-9);  // k_c: (n - 4n) / 5n
     EXPECT_GE(accuracy(model, t, y), 0.8);
 }
@@ -384,9 +385,10 @@ TEST(JointBoost, ModelFileRoundTripsAndRejectsBadFiles) {
     test::write_text(dir / "bad_index.jb", std::string(text).replace(text.find("\"feature\": "), 12, "\"feature\": 9"));
     EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad_index.jb"); }), ExitCode::InvalidInput);
     // Wrong types, truncation and other files: always a one-line input error, never a crash.
-    for (const std::string& bad : {std::string("{\"format\": 3, \"version\": 1}"), std::string("{\"format\": \"treelobes-jointboost\", \"version\": \"1\"}"),
-                                   std::string("[1, 2]"), std::string(""), text.substr(0, text.size() / 2),
-                                   std::string(text).replace(text.find("\"k\": ["), 6, "\"k\": [\"x\", ")}) {
+    for (const std::string& bad :
+         {std::string("{\"format\": 3, \"version\": 1}"), std::string("{\"format\": \"treelobes-jointboost\", \"version\": \"1\"}"),
+          std::string("[1, 2]"), std::string(""), text.substr(0, text.size() / 2),
+          std::string(text).replace(text.find("\"k\": ["), 6, "\"k\": [\"x\", ")}) {
         test::write_text(dir / "bad.jb", bad);
         EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad.jb"); }), ExitCode::InvalidInput) << bad.substr(0, 80);
     }
@@ -431,7 +433,8 @@ void two_scan_kinds(int per_class_and_kind, std::uint64_t seed, FeatureTable& ta
     for (int i = 0; i < per_class_and_kind; ++i)
         for (int kind = 0; kind < 2; ++kind)
             for (int c = 0; c < 3; ++c) {
-                double row[4] = {rng.normal(), rng.normal(), rng.normal(), kind == 0 ? 40.0 + 100.0 * rng.uniform() : 900.0 + 9000.0 * rng.uniform()};
+                double row[4] = {rng.normal(), rng.normal(), rng.normal(),
+                                 kind == 0 ? 40.0 + 100.0 * rng.uniform() : 900.0 + 9000.0 * rng.uniform()};
                 row[kind] += (kind == 0 ? 4.0 : -4.0) * (c - 1);
                 table.add_row(test::numbered("t", table.rows()), row);
                 y.push_back(c);
@@ -534,9 +537,9 @@ TEST(JointBoost, RoutedModelFileRoundTripsWithTwoSubModels) {
     const auto part_class = text.find("\"class1\"", text.find("\"models\""));
     ASSERT_NE(part_class, std::string::npos);
     for (const auto& [at, from, to] : std::vector<std::tuple<std::size_t, std::string, std::string>>{
-             {text.find("\"feature\": \"scan_point_density\""), "\"feature\": \"scan_point_density\"", "\"feature\": \"nope\""},
-             {part_class, "\"class1\"", "\"class7\""},
-             {text.find("\"version\": 3"), "\"version\": 3", "\"version\": 2"}}) {
+                 {text.find("\"feature\": \"scan_point_density\""), "\"feature\": \"scan_point_density\"", "\"feature\": \"nope\""},
+                 {part_class, "\"class1\"", "\"class7\""},
+                 {text.find("\"version\": 3"), "\"version\": 3", "\"version\": 2"}}) {
         ASSERT_NE(at, std::string::npos) << from;
         test::write_text(dir / "bad.jb", std::string(text).replace(at, from.size(), to));
         EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad.jb"); }), ExitCode::InvalidInput) << to;
@@ -646,7 +649,8 @@ TEST(JointBoost, BalancedClassWeightsFavourTheRareClass) {
     gaussian_clusters(3, 2, 10, 4, even, even_y);
     JointBoostOptions even_plain = plain, even_balanced = balanced;
     even_plain.max_rounds = even_balanced.max_rounds = 20;
-    const auto a = train_jointboost(even, even_y, class_names(3), even_plain), b = train_jointboost(even, even_y, class_names(3), even_balanced);
+    const auto a = train_jointboost(even, even_y, class_names(3), even_plain),
+               b = train_jointboost(even, even_y, class_names(3), even_balanced);
     ASSERT_EQ(a.stumps.size(), b.stumps.size());
     for (std::size_t k = 0; k < a.stumps.size(); ++k) EXPECT_EQ(a.stumps[k].threshold, b.stumps[k].threshold);
 }

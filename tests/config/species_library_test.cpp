@@ -42,11 +42,16 @@ TEST(SpeciesLibrary, ShipsTwelveSpeciesWithTableOneParameters) {
     const auto entries = load_species_entries(shipped());
     ASSERT_EQ(entries.size(), 12u);
     // Livny et al. 2011, Table 1, verbatim.
-    const std::map<std::string, std::array<double, 3>> table1 = {
-        {"mahogany", {1.7, 1.3, 0.975}},   {"bischofia_polycarpa", {1.8, 1.5, 0.986}}, {"delonix", {1.7, 1.5, 0.982}},
-        {"lagerstroemia", {1.6, 1.5, 0.976}}, {"ailanthus_altissima", {1.5, 1.9, 0.980}}, {"palm", {1.8, 1.3, 0.800}},
-        {"terminalia", {1.5, 1.5, 0.970}}, {"pine", {1.3, 1.2, 0.980}},             {"willow", {1.5, 1.9, 0.980}},
-        {"ficus_virens", {2.0, 1.6, 0.975}}};
+    const std::map<std::string, std::array<double, 3>> table1 = {{"mahogany", {1.7, 1.3, 0.975}},
+                                                                 {"bischofia_polycarpa", {1.8, 1.5, 0.986}},
+                                                                 {"delonix", {1.7, 1.5, 0.982}},
+                                                                 {"lagerstroemia", {1.6, 1.5, 0.976}},
+                                                                 {"ailanthus_altissima", {1.5, 1.9, 0.980}},
+                                                                 {"palm", {1.8, 1.3, 0.800}},
+                                                                 {"terminalia", {1.5, 1.5, 0.970}},
+                                                                 {"pine", {1.3, 1.2, 0.980}},
+                                                                 {"willow", {1.5, 1.9, 0.980}},
+                                                                 {"ficus_virens", {2.0, 1.6, 0.975}}};
     std::set<int> ids;
     for (const auto& e : entries) {
         ids.insert(e.id);
@@ -97,10 +102,10 @@ TEST(SpeciesLibrary, GrowthProfilesAreDistinct) {
     const auto& willow = find_species_profile(profiles, "willow").growth;
     const auto& pine = find_species_profile(profiles, "pine").growth;
     const auto& palm = find_species_profile(profiles, "palm").growth;
-    EXPECT_LT(willow.levels.back().tropism, -1.0);   // weeping branchlets
-    EXPECT_GT(pine.levels[1].whorl, 1);              // whorls
-    EXPECT_EQ(pine.levels[0].seg_splits, 0.0);       // apical dominance
-    EXPECT_EQ(palm.levels.size(), 2u);               // unbranched trunk + fronds
+    EXPECT_LT(willow.levels.back().tropism, -1.0);  // weeping branchlets
+    EXPECT_GT(pine.levels[1].whorl, 1);             // whorls
+    EXPECT_EQ(pine.levels[0].seg_splits, 0.0);      // apical dominance
+    EXPECT_EQ(palm.levels.size(), 2u);              // unbranched trunk + fronds
     EXPECT_EQ(pine.leaves.shape, LeafShape::Needle);
     for (const auto& p : profiles) {
         EXPECT_GE(p.growth.levels.size(), 2u) << p.entry.name;

@@ -20,8 +20,8 @@
 #include <vector>
 
 using namespace treelobes;
-using treelobes::test::TempDir;
 using treelobes::test::error_code_of;
+using treelobes::test::TempDir;
 
 namespace {
 
@@ -85,8 +85,7 @@ PointCloud cloud_of_format(int format, std::size_t n = 50) {
         cloud.return_number.push_back(static_cast<std::uint8_t>(1 + i % static_cast<std::size_t>(count)));
         cloud.classification.push_back(static_cast<std::uint8_t>(format >= 6 ? (i * 7) % 256 : (i * 3) % 32));
         if (format_has_gps(format)) cloud.gps_time.push_back(3.1e8 + 0.25 * static_cast<double>(i));
-        if (format_has_rgb(format))
-            cloud.rgb.push_back({static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(65535 - i), 1234});
+        if (format_has_rgb(format)) cloud.rgb.push_back({static_cast<std::uint16_t>(i), static_cast<std::uint16_t>(65535 - i), 1234});
     }
     return cloud;
 }
@@ -251,20 +250,30 @@ TEST(LasExtras, EveryDataTypeRoundTripsAndSaturates) {
     PointCloud cloud;
     cloud.positions = {{0, 0, 0}, {1, 1, 1}, {2, 2, 2}};
     const std::vector<std::pair<AttributeType, std::vector<double>>> cases = {
-        {AttributeType::UInt8, {0, 255, 300}},        {AttributeType::Int8, {-128, 127, -1000}},
-        {AttributeType::UInt16, {0, 65535, -5}},      {AttributeType::Int16, {-32768, 32767, 1.6}},
-        {AttributeType::UInt32, {0, 4294967295.0, 7}}, {AttributeType::Int32, {-2147483648.0, 2147483647.0, -2.4}},
-        {AttributeType::UInt64, {0, 9007199254740992.0, 1e30}},
-        {AttributeType::Int64, {-9007199254740992.0, 9007199254740992.0, -1e30}},
-        {AttributeType::Float32, {0.5f, -3.25e10f, 1e300}}, {AttributeType::Float64, {0.1, -1e-300, 1e300}},
+            {AttributeType::UInt8, {0, 255, 300}},
+            {AttributeType::Int8, {-128, 127, -1000}},
+            {AttributeType::UInt16, {0, 65535, -5}},
+            {AttributeType::Int16, {-32768, 32767, 1.6}},
+            {AttributeType::UInt32, {0, 4294967295.0, 7}},
+            {AttributeType::Int32, {-2147483648.0, 2147483647.0, -2.4}},
+            {AttributeType::UInt64, {0, 9007199254740992.0, 1e30}},
+            {AttributeType::Int64, {-9007199254740992.0, 9007199254740992.0, -1e30}},
+            {AttributeType::Float32, {0.5f, -3.25e10f, 1e300}},
+            {AttributeType::Float64, {0.1, -1e-300, 1e300}},
     };
     for (const auto& [type, values] : cases) cloud.add_extra(attribute_type_name(type), type).values = values;
     const PointCloud back = write_then_read(cloud, dir);
     const std::vector<std::vector<double>> expected = {
-        {0, 255, 255},   {-128, 127, -128}, {0, 65535, 0},  {-32768, 32767, 2}, {0, 4294967295.0, 7},
-        {-2147483648.0, 2147483647.0, -2},  {0, 9007199254740992.0, 18446744073709551615.0},
-        {-9007199254740992.0, 9007199254740992.0, -9223372036854775808.0},
-        {0.5, -3.25e10f, std::numeric_limits<double>::infinity()}, {0.1, -1e-300, 1e300},
+            {0, 255, 255},
+            {-128, 127, -128},
+            {0, 65535, 0},
+            {-32768, 32767, 2},
+            {0, 4294967295.0, 7},
+            {-2147483648.0, 2147483647.0, -2},
+            {0, 9007199254740992.0, 18446744073709551615.0},
+            {-9007199254740992.0, 9007199254740992.0, -9223372036854775808.0},
+            {0.5, -3.25e10f, std::numeric_limits<double>::infinity()},
+            {0.1, -1e-300, 1e300},
     };
     ASSERT_EQ(back.extras.size(), cases.size());
     for (std::size_t k = 0; k < cases.size(); ++k) {

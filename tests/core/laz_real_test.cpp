@@ -53,16 +53,14 @@ void expect_twins(const std::string& laz, const std::string& las) {
 }  // namespace
 
 TEST(LazReal, PointFormats0To3DecodeToTheirTwins) {
-    expect_twins("laz/MixedConifer.laz", "lidr/MixedConifer.las");  // format 1, treeID extra bytes
-    expect_twins("laz/pine.laz", "treels/pine.las");                // format 0
-    expect_twins("laz/pine_plot.laz", "treels/pine_plot.las");      // format 0, several chunks
-    expect_twins("laz/laspy/simple.laz", "laz/laspy/simple.las");   // format 3
-    expect_twins("laz/laspy/extra.laz", "laz/laspy/extrabytes.las"); // LAS 1.4 format 3 + extra bytes
+    expect_twins("laz/MixedConifer.laz", "lidr/MixedConifer.las");    // format 1, treeID extra bytes
+    expect_twins("laz/pine.laz", "treels/pine.las");                  // format 0
+    expect_twins("laz/pine_plot.laz", "treels/pine_plot.las");        // format 0, several chunks
+    expect_twins("laz/laspy/simple.laz", "laz/laspy/simple.las");     // format 3
+    expect_twins("laz/laspy/extra.laz", "laz/laspy/extrabytes.las");  // LAS 1.4 format 3 + extra bytes
 }
 
-TEST(LazReal, LayeredFormat6DecodesToItsTwin) {
-    expect_twins("laz/laspy/1_4_w_evlr.laz", "laz/laspy/1_4_w_evlr.las");
-}
+TEST(LazReal, LayeredFormat6DecodesToItsTwin) { expect_twins("laz/laspy/1_4_w_evlr.laz", "laz/laspy/1_4_w_evlr.las"); }
 
 namespace {
 
@@ -81,8 +79,8 @@ PointKey key_of(const std::uint8_t* r, int format, const Bytes& header) {
     const bool extended = format >= 6;
     const std::size_t gps = extended ? 22 : 20, rgb = extended ? 30 : 28;
     auto millimetres = [&](int k) {
-        const double value = load<std::int32_t>(r + 4 * k) * load<double>(header.data() + 131 + 8 * k) +
-                             load<double>(header.data() + 155 + 8 * k);
+        const double value =
+                load<std::int32_t>(r + 4 * k) * load<double>(header.data() + 131 + 8 * k) + load<double>(header.data() + 155 + 8 * k);
         return std::llround(value * 1000);
     };
     return {millimetres(0),
@@ -192,7 +190,7 @@ TEST(LazReal, CopcBoundsQueryReadsOnlyTheNodesItNeeds) {
         Eigen::Vector3d p;
         for (int k = 0; k < 3; ++k)
             p[k] = load<std::int32_t>(records.points.data() + i * records.record_length + 4 * k) *
-                       load<double>(records.header.data() + 131 + 8 * k) +
+                           load<double>(records.header.data() + 131 + 8 * k) +
                    load<double>(records.header.data() + 155 + 8 * k);
         expected += box.contains(p) ? 1 : 0;
     }

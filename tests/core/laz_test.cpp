@@ -152,25 +152,28 @@ TEST(LaszipVlr, AcceptsTheItemsOfItsPointFormat) {
     const LaszipVlr vlr = parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10, kGps, kRgb, {ItemType::Byte, 3, 2}}), 3, 37, "f.laz");
     EXPECT_EQ(vlr.chunk_size, 50000u);
     EXPECT_EQ(vlr.items.size(), 4u);
-    const LaszipVlr layered = parse_laszip_vlr(
-        laszip_vlr(3, kVariableChunkSize, {{ItemType::Point14, 30, 3}, {ItemType::Rgb14, 6, 3}}), 7, 36, "f.laz");
+    const LaszipVlr layered =
+            parse_laszip_vlr(laszip_vlr(3, kVariableChunkSize, {{ItemType::Point14, 30, 3}, {ItemType::Rgb14, 6, 3}}), 7, 36, "f.laz");
     EXPECT_TRUE(layered.variable_chunks());
 }
 
 TEST(LaszipVlr, RejectsItemsThatContradictTheHeader) {
     // RGB items for point format 1 (GPS time, no colour).
-    EXPECT_NE(message_of([] { parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10, kRgb}), 1, 26, "f.laz"); })
-                  .find("do not match point format 1"),
+    EXPECT_NE(message_of([] {
+                  parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10, kRgb}), 1, 26, "f.laz");
+              }).find("do not match point format 1"),
               std::string::npos);
     // Items summing to 28 bytes for a 30-byte record.
-    EXPECT_NE(message_of([] { parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10, kGps}), 1, 30, "f.laz"); })
-                  .find("point record length is 30"),
+    EXPECT_NE(message_of([] {
+                  parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10, kGps}), 1, 30, "f.laz");
+              }).find("point record length is 30"),
               std::string::npos);
     // Point-wise items for a LAS 1.4 format.
     EXPECT_EQ(error_code_of([] { parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10}), 6, 20, "f.laz"); }), ExitCode::InvalidInput);
     // LASzip 1.x item versions.
-    EXPECT_NE(message_of([] { parse_laszip_vlr(laszip_vlr(2, 50000, {{ItemType::Point10, 20, 1}}), 0, 20, "f.laz"); })
-                  .find("only version 2"),
+    EXPECT_NE(message_of([] {
+                  parse_laszip_vlr(laszip_vlr(2, 50000, {{ItemType::Point10, 20, 1}}), 0, 20, "f.laz");
+              }).find("only version 2"),
               std::string::npos);
     // Truncated VLR payloads.
     Bytes cut = laszip_vlr(2, 50000, {kPoint10, kGps});
@@ -195,8 +198,7 @@ TEST(LazChunk, TooFewBytesForItsPointsIsAnError) {
     const LaszipVlr vlr = parse_laszip_vlr(laszip_vlr(2, 50000, {kPoint10, kGps}), 1, 28, "f.laz");
     Bytes chunk(28 + 6, 0x5A);  // a raw point and six bytes of stream for 10,000 points
     Bytes out(28 * 10000);
-    const std::string message =
-        message_of([&] { decode_chunk(vlr, 28, chunk, 10000, out.data(), LayerSelection::all(), "f.laz", 3); });
+    const std::string message = message_of([&] { decode_chunk(vlr, 28, chunk, 10000, out.data(), LayerSelection::all(), "f.laz", 3); });
     EXPECT_NE(message.find("f.laz: LAZ chunk 3"), std::string::npos) << message;
     // Shorter than the raw first point.
     EXPECT_EQ(error_code_of([&] { decode_chunk(vlr, 28, Bytes(10, 0), 2, out.data(), LayerSelection::all(), "f.laz", 0); }),

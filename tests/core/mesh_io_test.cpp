@@ -15,17 +15,17 @@ using test::write_text;
 namespace {
 
 const char* kPartsObj =
-    "# two parts\n"
-    "o Tree\n"
-    "g Trunk\n"
-    "usemtl Bark\n"
-    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
-    "vn 0 0 1\n"
-    "f 1 2 3 4\n"        // a quad: two triangles
-    "usemtl Leaf\n"
-    "v 0 0 1\nv 1 0 1\nv 0.5 1 1\n"
-    "f -3/1/1 -2/1/1 -1/1/1\n"
-    "f 5 5 6\n";         // degenerate: dropped
+        "# two parts\n"
+        "o Tree\n"
+        "g Trunk\n"
+        "usemtl Bark\n"
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+        "vn 0 0 1\n"
+        "f 1 2 3 4\n"  // a quad: two triangles
+        "usemtl Leaf\n"
+        "v 0 0 1\nv 1 0 1\nv 0.5 1 1\n"
+        "f -3/1/1 -2/1/1 -1/1/1\n"
+        "f 5 5 6\n";  // degenerate: dropped
 
 }  // namespace
 
@@ -59,7 +59,8 @@ TEST(MeshIo, ObjWithoutNamesHasNoFaceNames) {
 
 TEST(MeshIo, UtmCoordinatesKeepMillimetres) {
     TempDir dir;
-    write_text(dir / "utm.obj", "v 500123.456 5600000.789 300.5\nv 500124.457 5600000.789 300.5\nv 500123.456 5600001.790 301.5\nf 1 2 3\n");
+    write_text(dir / "utm.obj",
+               "v 500123.456 5600000.789 300.5\nv 500124.457 5600000.789 300.5\nv 500123.456 5600001.790 301.5\nf 1 2 3\n");
     const TriangleMesh m = read_mesh(dir / "utm.obj");
     EXPECT_EQ(m.origin, Eigen::Vector3d(500000, 5600000, 0));
     const Eigen::Vector3d second = m.origin + m.vertices[1].cast<double>();
@@ -70,12 +71,12 @@ TEST(MeshIo, UtmCoordinatesKeepMillimetres) {
 TEST(MeshIo, BrokenObjFilesAreRejectedWithTheLine) {
     TempDir dir;
     const std::pair<const char*, const char*> cases[] = {
-        {"truncated_face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2"},
-        {"truncated_vertex.obj", "v 0 0 0\nv 1 0"},
-        {"missing_vertex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"},
-        {"nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"},
-        {"garbage.obj", "v 0 0 0\n\x01\x02\x03 binary\n"},
-        {"no_vertices.obj", "# nothing\n"},
+            {"truncated_face.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2"},
+            {"truncated_vertex.obj", "v 0 0 0\nv 1 0"},
+            {"missing_vertex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n"},
+            {"nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n"},
+            {"garbage.obj", "v 0 0 0\n\x01\x02\x03 binary\n"},
+            {"no_vertices.obj", "# nothing\n"},
     };
     for (const auto& [name, text] : cases) {
         write_text(dir / name, text);
@@ -117,7 +118,6 @@ TEST(MeshIo, NamedObjRoundTrip) {
     ASSERT_EQ(back.face_names.size(), m.face_names.size());
     for (std::size_t f = 0; f < m.mesh.faces.size(); ++f) {
         EXPECT_EQ(back.names[back.face_names[f]], m.names[m.face_names[f]]);
-        for (int c = 0; c < 3; ++c)
-            EXPECT_EQ(back.mesh.vertices[back.mesh.faces[f][c]], m.mesh.vertices[m.mesh.faces[f][c]]);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(back.mesh.vertices[back.mesh.faces[f][c]], m.mesh.vertices[m.mesh.faces[f][c]]);
     }
 }

@@ -14,8 +14,8 @@
 #include <fstream>
 
 using namespace treelobes;
-using treelobes::test::TempDir;
 using treelobes::test::error_code_of;
+using treelobes::test::TempDir;
 using treelobes::test::write_text;
 
 namespace {
@@ -71,7 +71,8 @@ TEST(PlyCloud, ReadsAnyPropertyOrderAndBigEndian) {
     EXPECT_FLOAT_EQ(cloud.positions[1].z(), 6);
     EXPECT_DOUBLE_EQ(cloud.extra("w")->values[0], 9);
 
-    std::string be = "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    std::string be =
+            "ply\nformat binary_big_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
     for (float v : {1.0f, 2.0f, 3.0f}) {
         std::uint32_t bits;
         std::memcpy(&bits, &v, 4);
@@ -88,15 +89,19 @@ TEST(PlyCloud, TruncatedOrLyingHeadersAreRejected) {
     write_text(dir / "truncated.ply", bytes.substr(0, bytes.size() - 5));
     EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "truncated.ply"); }), ExitCode::InvalidInput);
 
-    write_text(dir / "huge.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\nproperty float x\n"
-                                 "property float y\nproperty float z\nend_header\n");
+    write_text(dir / "huge.ply",
+               "ply\nformat binary_little_endian 1.0\nelement vertex 4000000000000\nproperty float x\n"
+               "property float y\nproperty float z\nend_header\n");
     EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "huge.ply"); }), ExitCode::InvalidInput);
     write_text(dir / "noend.ply", "ply\nformat ascii 1.0\nelement vertex 1\n");
     EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "noend.ply"); }), ExitCode::InvalidInput);
-    write_text(dir / "garbage.ply", "\x7f" "ELF\x02\x01 binary garbage");
+    write_text(dir / "garbage.ply",
+               "\x7f"
+               "ELF\x02\x01 binary garbage");
     EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "garbage.ply"); }), ExitCode::InvalidInput);
-    write_text(dir / "nan.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
-                                "end_header\nnan 0 0\n1 2 3\n");
+    write_text(dir / "nan.ply",
+               "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\n"
+               "end_header\nnan 0 0\n1 2 3\n");
     const PointCloud kept = read_point_cloud(dir / "nan.ply");
     EXPECT_EQ(kept.size(), 1u);
     EXPECT_EQ(kept.source.dropped_non_finite, 1u);
@@ -132,7 +137,7 @@ TEST(SkeletonPly, RoundTripKeepsTopologyRadiiAndChildOrder) {
     tree.add_node({0, 0, 1}, 0.25f, 0);
     tree.add_node({0.5f, 0, 1.5f}, 0.1f, 1);  // lateral listed first on purpose
     tree.add_node({0, 0, 2}, 0.2f, 1);
-    tree.nodes[1].children = {3, 2};          // main child first
+    tree.nodes[1].children = {3, 2};  // main child first
     write_skeleton_ply(tree, dir / "s.ply");
     const TreeGraph back = read_skeleton_ply(dir / "s.ply");
     ASSERT_EQ(back.size(), 4u);
@@ -144,8 +149,9 @@ TEST(SkeletonPly, RoundTripKeepsTopologyRadiiAndChildOrder) {
 
 TEST(SkeletonPly, AcceptsUnorientedEdgesAndRejectsCyclesAndForests) {
     TempDir dir;
-    const std::string header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-                               "element edge 2\nproperty int vertex1\nproperty int vertex2\nend_header\n0 0 0\n0 0 1\n0 0 2\n";
+    const std::string header =
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+            "element edge 2\nproperty int vertex1\nproperty int vertex2\nend_header\n0 0 0\n0 0 1\n0 0 2\n";
     write_text(dir / "unoriented.ply", header + "1 0\n2 1\n");
     const TreeGraph tree = read_skeleton_ply(dir / "unoriented.ply");
     EXPECT_EQ(tree.nodes[2].parent, 1);
@@ -192,8 +198,9 @@ TEST(PcdIo, RoundTripWithIntensityAndExtras) {
     EXPECT_FLOAT_EQ(back.positions[1].z(), 6);
     EXPECT_EQ(back.intensity, cloud.intensity);
     ASSERT_NE(back.extra("label"), nullptr);
-    write_text(dir / "bad.pcd", "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
-                                "WIDTH 100\nHEIGHT 1\nPOINTS 100\nDATA binary\nabc");
+    write_text(dir / "bad.pcd",
+               "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+               "WIDTH 100\nHEIGHT 1\nPOINTS 100\nDATA binary\nabc");
     EXPECT_EQ(error_code_of([&] { read_point_cloud(dir / "bad.pcd"); }), ExitCode::InvalidInput);
 }
 
@@ -201,10 +208,11 @@ TEST(PcdIo, RoundTripWithIntensityAndExtras) {
 // ASan: PCL's reader crashing on an empty file). Attributes clamp, NaN is "no value" (0).
 TEST(PlyCloud, NanAndOutOfRangeIntegerAttributesClamp) {
     TempDir dir;
-    write_text(dir / "a.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
-                              "property float z\nproperty float intensity\nproperty float classification\n"
-                              "property float red\nproperty float green\nproperty float blue\nend_header\n"
-                              "0 0 0 nan 300 -5 nan 70000\n1 1 1 12.7 2 1 2 3\n");
+    write_text(dir / "a.ply",
+               "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+               "property float z\nproperty float intensity\nproperty float classification\n"
+               "property float red\nproperty float green\nproperty float blue\nend_header\n"
+               "0 0 0 nan 300 -5 nan 70000\n1 1 1 12.7 2 1 2 3\n");
     const PointCloud cloud = read_ply_cloud(dir / "a.ply");
     ASSERT_EQ(cloud.size(), 2u);
     EXPECT_EQ(cloud.intensity, (std::vector<std::uint16_t>{0, 12}));
@@ -223,8 +231,9 @@ TEST(Pcd, EmptyFileIsBadInputNotACrash) {
 // PLY reader never returned on a header without end_header.
 TEST(Pcd, HeaderWithoutFieldsIsBadInputNotACrash) {
     TempDir dir;
-    write_text(dir / "nofields.pcd", "# .PCD v0.7\nVERSION 0.7\nFIEL S x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
-                                     "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    write_text(dir / "nofields.pcd",
+               "# .PCD v0.7\nVERSION 0.7\nFIEL S x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+               "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
     EXPECT_EQ(error_code_of([&] { read_pcd(dir / "nofields.pcd"); }), ExitCode::InvalidInput);
 }
 

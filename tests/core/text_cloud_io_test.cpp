@@ -129,9 +129,10 @@ TEST(CloudIo, DamagedLazAndUnknownFormatsAreRejectedClearly) {
 // "no value" and becomes 0; out-of-range values clamp.
 TEST(TextCloud, NanAndOutOfRangeAttributesBecomeValidIntegers) {
     TempDir dir;
-    write_text(dir / "a.xyz", "x y z intensity classification red green blue\n"
-                              "1 2 3 nan nan nan nan nan\n"
-                              "4 5 6 70000 -3 1e300 -1e300 12\n");
+    write_text(dir / "a.xyz",
+               "x y z intensity classification red green blue\n"
+               "1 2 3 nan nan nan nan nan\n"
+               "4 5 6 70000 -3 1e300 -1e300 12\n");
     const PointCloud cloud = read_text_cloud(dir / "a.xyz");
     ASSERT_EQ(cloud.size(), 2u);
     EXPECT_EQ(cloud.intensity, (std::vector<std::uint16_t>{0, 65535}));

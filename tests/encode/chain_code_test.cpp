@@ -39,9 +39,7 @@ CodeGeometry geometry_of(double voxel_size, int root_radius = 0) {
 struct Builder {
     TreeGraph tree;
     Builder() { tree.add_node({0, 0, 0}, 0.010f, -1); }
-    int add(int parent, float x, float y, float z, float radius_mm) {
-        return tree.add_node({x, y, z}, radius_mm * 0.001f, parent);
-    }
+    int add(int parent, float x, float y, float z, float radius_mm) { return tree.add_node({x, y, z}, radius_mm * 0.001f, parent); }
 };
 
 }  // namespace

@@ -96,8 +96,8 @@ TEST(CorruptCode, RandomCodesNeverCrash) {
         const std::size_t length = engine() % 40;
         std::string symbols;
         for (std::size_t i = 0; i < length; ++i) symbols += alphabet[engine() % alphabet.size()];
-        const auto terminators = static_cast<std::size_t>(std::count_if(
-            symbols.begin(), symbols.end(), [](char c) { return c == '6' || c == '7' || c == '8'; }));
+        const auto terminators = static_cast<std::size_t>(
+                std::count_if(symbols.begin(), symbols.end(), [](char c) { return c == '6' || c == '7' || c == '8'; }));
         // Mostly the right number of radii, sometimes one off.
         const std::size_t count = engine() % 4 == 0 ? terminators + 1 : terminators;
         std::vector<int> radii(count);
@@ -123,9 +123,8 @@ TEST(CorruptCode, MutatedPaperCodesAreDecodedOrRejected) {
     const std::vector<int> radii{10, 9, 6, 3, 4, 3, 2, 1};
     for (std::size_t i = 0; i < base.size(); ++i) {
         for (char replacement = '0'; replacement <= '9'; ++replacement) {
-            for (const std::string& mutated :
-                 {base.substr(0, i) + replacement + base.substr(i + 1), base.substr(0, i) + base.substr(i + 1),
-                  base.substr(0, i) + replacement + base.substr(i)}) {
+            for (const std::string& mutated : {base.substr(0, i) + replacement + base.substr(i + 1), base.substr(0, i) + base.substr(i + 1),
+                                               base.substr(0, i) + replacement + base.substr(i)}) {
                 try {
                     const TreeGraph tree = decode_tree(ChainCode{CodeKind::DBF6, mutated, radii}, unit_geometry());
                     tree.validate("decoded");
@@ -185,8 +184,7 @@ TEST(CorruptCode, InternodeFormDecodesAndRejectsLikeTheText) {
         std::optional<TreeGraph> from_text;
         try {
             from_text = decode_tree(code, unit_geometry());
-        } catch (const Error&) {
-        }
+        } catch (const Error&) {}
         try {
             const TreeGraph from_internodes = decode_internodes(internode_form(code), unit_geometry());
             ASSERT_TRUE(from_text) << symbols << ": accepted only in internode form";

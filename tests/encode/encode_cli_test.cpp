@@ -69,9 +69,9 @@ TEST(EncodeCli, LodPrintsTheReducedCodeAndRadii) {
 
 TEST(EncodeCli, DecodeCodeWritesASkeletonThatEncodesToTheSameCode) {
     TempDir dir;
-    const auto decoded = run_cli(std::string("decode-code --code ") + treelobes::test::kFig4F6 +
-                                 " --radii 10,9,6,3,4,3,2,1 --f6 --resolution 3 --internode-length 1 --root-radius 12 --out " +
-                                 quoted(dir / "out.ply"));
+    const auto decoded =
+            run_cli(std::string("decode-code --code ") + treelobes::test::kFig4F6 +
+                    " --radii 10,9,6,3,4,3,2,1 --f6 --resolution 3 --internode-length 1 --root-radius 12 --out " + quoted(dir / "out.ply"));
     ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
     const treelobes::TreeGraph tree = treelobes::read_skeleton_ply(dir / "out.ply");
     EXPECT_EQ(tree.size(), 9u);
@@ -88,13 +88,13 @@ TEST(EncodeCli, CorruptCodesExitWithTwoAndOneLine) {
         std::string args;
         std::string message;
     } cases[] = {
-        {"decode-code --code 111917 --radii 1,2" + out, "unknown chain code symbol '9' at character 4"},
-        {"decode-code --code 1118111 --radii 1,2" + out, "without the final branch tip 7"},
-        {"decode-code --code 1118118117 --radii 1,2" + out, "radius list has 2 values but the DBF6 code has 3 internodes"},
-        {"decode-code --code 11161117 --radii 1,2" + out, "fork(s) 6 without a lateral branch"},
-        {"decode-code --code 1117 --radii 1x" + out, "--radii: value 1 ('1x') is not a non-negative integer"},
-        {"lod --code 11161117 --radii 1,2 --threshold 2", "fork(s) 6 without a lateral branch"},
-        {"encode " + quoted(dir / "missing.ply") + " --resolution 3", "missing.ply"},
+            {"decode-code --code 111917 --radii 1,2" + out, "unknown chain code symbol '9' at character 4"},
+            {"decode-code --code 1118111 --radii 1,2" + out, "without the final branch tip 7"},
+            {"decode-code --code 1118118117 --radii 1,2" + out, "radius list has 2 values but the DBF6 code has 3 internodes"},
+            {"decode-code --code 11161117 --radii 1,2" + out, "fork(s) 6 without a lateral branch"},
+            {"decode-code --code 1117 --radii 1x" + out, "--radii: value 1 ('1x') is not a non-negative integer"},
+            {"lod --code 11161117 --radii 1,2 --threshold 2", "fork(s) 6 without a lateral branch"},
+            {"encode " + quoted(dir / "missing.ply") + " --resolution 3", "missing.ply"},
     };
     for (const auto& c : cases) {
         const auto result = run_cli(c.args);

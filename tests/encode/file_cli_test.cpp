@@ -28,9 +28,7 @@ treelobes::TreeGraph cli_tree(std::uint32_t seed) {
 
 std::string read_bytes(const std::filesystem::path& path) { return treelobes::read_file(path); }
 
-void write_bytes(const std::filesystem::path& path, const std::string& bytes) {
-    std::ofstream(path, std::ios::binary) << bytes;
-}
+void write_bytes(const std::filesystem::path& path, const std::string& bytes) { std::ofstream(path, std::ios::binary) << bytes; }
 
 }  // namespace
 
@@ -55,8 +53,8 @@ TEST(FileCli, EncodeDecodeDbf6WithLodsAndStats) {
 
         for (int lod : {0, 2}) {
             const auto out = dir / (treelobes::test::numbered("d", static_cast<std::size_t>(lod)) + ".ply");
-            const auto decoded = run_cli("--json decode " + quoted(dir / ("t_" + coder + ".dbf6")) + " --lod " +
-                                         std::to_string(lod) + " --out " + quoted(out));
+            const auto decoded = run_cli("--json decode " + quoted(dir / ("t_" + coder + ".dbf6")) + " --lod " + std::to_string(lod) +
+                                         " --out " + quoted(out));
             ASSERT_EQ(decoded.exit_code, 0) << decoded.err;
             const auto d = nlohmann::json::parse(decoded.out);
             EXPECT_EQ(d["internodes"], json["lods"][lod]["internodes"]);
@@ -70,7 +68,7 @@ TEST(FileCli, EncodeDecodeDbf6WithLodsAndStats) {
     // Same input, same bytes.
     ASSERT_EQ(run_cli("encode " + quoted(dir / "t.ply") + " --resolution 5 --internode-length 0.1 --lods 3 --coder best --out " +
                       quoted(dir / "again.dbf6"))
-                  .exit_code,
+                      .exit_code,
               0);
     EXPECT_EQ(read_bytes(dir / "again.dbf6"), read_bytes(dir / "t_best.dbf6"));
 }
@@ -83,8 +81,8 @@ TEST(FileCli, ForestFromAListWithRandomAccess) {
         list += "tree" + std::to_string(i) + ".ply " + std::to_string(10 * i) + " 5 0" + (i == 2 ? " 90" : "") + "\n";
     }
     write_bytes(dir / "trees.txt", list);
-    const auto encoded = run_cli("--json encode --forest " + quoted(dir / "trees.txt") +
-                                 " --resolution 5 --lods 2 --out " + quoted(dir / "plot.forest"));
+    const auto encoded = run_cli("--json encode --forest " + quoted(dir / "trees.txt") + " --resolution 5 --lods 2 --out " +
+                                 quoted(dir / "plot.forest"));
     ASSERT_EQ(encoded.exit_code, 0) << encoded.err;
     EXPECT_EQ(nlohmann::json::parse(encoded.out)["trees"], 3);
 
@@ -123,12 +121,12 @@ TEST(FileCli, DamagedFilesExitWithTwoAndOneLine) {
     const struct {
         std::string name, bytes, message;
     } cases[] = {
-        {"cut.dbf6", dbf6.substr(0, dbf6.size() - 7), "checksum mismatch"},
-        {"flip.dbf6", flipped, "checksum mismatch"},
-        {"short.dbf6", dbf6.substr(0, 3), "not a .dbf6 file"},
-        {"cut.forest", forest.substr(0, forest.size() - 5), "truncated"},
-        {"flip.forest", forest_flipped, "checksum mismatch in tree 0"},
-        {"empty.forest", "DBFF", "truncated"},
+            {"cut.dbf6", dbf6.substr(0, dbf6.size() - 7), "checksum mismatch"},
+            {"flip.dbf6", flipped, "checksum mismatch"},
+            {"short.dbf6", dbf6.substr(0, 3), "not a .dbf6 file"},
+            {"cut.forest", forest.substr(0, forest.size() - 5), "truncated"},
+            {"flip.forest", forest_flipped, "checksum mismatch in tree 0"},
+            {"empty.forest", "DBFF", "truncated"},
     };
     for (const auto& c : cases) {
         write_bytes(dir / c.name, c.bytes);
@@ -151,8 +149,8 @@ TEST(FileCli, BadOptionsExitWithOne) {
     const std::string file = quoted(dir / "t.ply");
     EXPECT_EQ(run_cli("encode " + file + " --resolution 5 --out x.dbf6 --coder zip").exit_code, 1);
     EXPECT_EQ(run_cli("encode " + file + " --resolution 5 --out x.dbf6 --lods 0").exit_code, 1);
-    EXPECT_EQ(run_cli("encode " + file + " --resolution 5 --lods 3").exit_code, 1);  // --lods needs --out
-    EXPECT_EQ(run_cli("encode --resolution 5 --out x.dbf6").exit_code, 1);           // no input
+    EXPECT_EQ(run_cli("encode " + file + " --resolution 5 --lods 3").exit_code, 1);                // --lods needs --out
+    EXPECT_EQ(run_cli("encode --resolution 5 --out x.dbf6").exit_code, 1);                         // no input
     EXPECT_EQ(run_cli("encode --forest " + quoted(dir.path()) + " --resolution 5").exit_code, 1);  // forest without --out
     ASSERT_EQ(run_cli("encode " + file + " --resolution 5 --lods 2 --out " + quoted(dir / "t.dbf6")).exit_code, 0);
     EXPECT_EQ(run_cli("decode " + quoted(dir / "t.dbf6") + " --lod 2 --out " + quoted(dir / "x.ply")).exit_code, 1);

@@ -247,7 +247,7 @@ TEST(ForestFile, ModelPriorIsStoredWhenItPaysAndDecodesExactly) {
         }
         independent += write_tree_record(expected).size() + 4;
     }
-    EXPECT_GT(reader.index_bytes(), 1000u);                   // the prior is in the index (40 entries take ~800)
+    EXPECT_GT(reader.index_bytes(), 1000u);                       // the prior is in the index (40 entries take ~800)
     EXPECT_LT(bytes.size() - reader.index_bytes(), independent);  // and the records are smaller for it
     // A record coded with the prior cannot be read without it.
     const ForestEntry& e = reader.entry(0);

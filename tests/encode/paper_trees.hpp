@@ -44,8 +44,9 @@ inline TreeGraph fig4_tree() {
     tree.nodes.resize(v.size());
     for (std::size_t k = 0; k < v.size(); ++k) {
         // Offsets of up to 0.35 voxels so that Eq. 1 has to round, never on a voxel border.
-        const Eigen::Vector3d offset = k == 0 ? Eigen::Vector3d::Zero()
-                                              : Eigen::Vector3d(0.35 * std::sin(3.0 * k), 0.35 * std::cos(5.0 * k), 0.3 * std::sin(k + 1.0));
+        const Eigen::Vector3d offset =
+                k == 0 ? Eigen::Vector3d::Zero()
+                       : Eigen::Vector3d(0.35 * std::sin(3.0 * k), 0.35 * std::cos(5.0 * k), 0.3 * std::sin(k + 1.0));
         const Eigen::Vector3d p = root + d * (Eigen::Vector3d(v[k].x, v[k].y, 0) + offset);
         TreeNode& node = tree.nodes[v[k].index];
         node.position = p.cast<float>();

@@ -26,18 +26,18 @@ namespace treelobes::test {
 struct RandomTreeProfile {
     std::string name = "random";
     int max_nodes = 300;
-    double internode_length = 0.1;    // nominal l (metres)
-    double length_jitter = 0.3;       // keep < 0.4: edges then span > 1.8 voxels at r >= 3
-    double wiggle_degrees = 5.0;      // random turn per internode (0 = straight branches)
-    double fork_probability = 0.25;   // chance that an internode with a continuation forks
-    int max_laterals = 1;             // laterals per fork; > 1 gives multi-way forks
+    double internode_length = 0.1;   // nominal l (metres)
+    double length_jitter = 0.3;      // keep < 0.4: edges then span > 1.8 voxels at r >= 3
+    double wiggle_degrees = 5.0;     // random turn per internode (0 = straight branches)
+    double fork_probability = 0.25;  // chance that an internode with a continuation forks
+    int max_laterals = 1;            // laterals per fork; > 1 gives multi-way forks
     double branch_angle_degrees = 45.0;
     int trunk_internodes = 20;
     double lateral_length_ratio = 0.6;  // lateral length relative to the parent's remaining length
     int max_order = 4;
-    int root_stems = 1;               // children of the root (> 1: multi-stemmed)
-    double tip_radius = 0.002;        // metres; the pipe model gives the rest
-    bool shuffle = true;              // random node numbering and child order
+    int root_stems = 1;         // children of the root (> 1: multi-stemmed)
+    double tip_radius = 0.002;  // metres; the pipe model gives the rest
+    bool shuffle = true;        // random node numbering and child order
 };
 
 class TreeRandom {

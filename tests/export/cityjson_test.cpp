@@ -138,7 +138,8 @@ TEST(CityJson, InstancesOneTemplatePerSpeciesScaledToEachTree) {
     const auto translate = doc["transform"]["translate"];
     const auto reference_point = [&](const nlohmann::json& instance) {
         const auto& v = doc["vertices"][instance["boundaries"][0].get<std::size_t>()];
-        return Eigen::Vector3d(translate[0].get<double>() + 0.001 * v[0].get<double>(), translate[1].get<double>() + 0.001 * v[1].get<double>(),
+        return Eigen::Vector3d(translate[0].get<double>() + 0.001 * v[0].get<double>(),
+                               translate[1].get<double>() + 0.001 * v[1].get<double>(),
                                translate[2].get<double>() + 0.001 * v[2].get<double>());
     };
     const auto instance_of = [&](const std::string& name) {
@@ -171,7 +172,8 @@ TEST(CityJson, InstancesOneTemplatePerSpeciesScaledToEachTree) {
     bad_reference["CityObjects"]["oak"]["geometry"][1]["boundaries"][0] = doc["vertices"].size();
     EXPECT_FALSE(check_cityjson(bad_reference.dump()).empty());
     auto bad_template_vertex = doc;
-    bad_template_vertex["geometry-templates"]["templates"][0]["boundaries"][0][0][0] = doc["geometry-templates"]["vertices-templates"].size();
+    bad_template_vertex["geometry-templates"]["templates"][0]["boundaries"][0][0][0] =
+            doc["geometry-templates"]["vertices-templates"].size();
     EXPECT_FALSE(check_cityjson(bad_template_vertex.dump()).empty());
     // The schema catches a matrix of 15 numbers.
     auto short_matrix = doc;

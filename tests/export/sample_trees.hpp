@@ -17,10 +17,10 @@ inline TreeGraph sample_tree(const Eigen::Vector3d& origin = {500000.0, 5400000.
     t.add_node({0.02f, 0, 1.5f}, 0.09f, 1);
     t.add_node({0.02f, 0.01f, 2.25f}, 0.07f, 2);
     t.add_node({0.03f, 0.01f, 3.0f}, 0.04f, 3);
-    t.add_node({0.5f, 0, 1.9f}, 0.04f, 2);    // 5: first lateral
+    t.add_node({0.5f, 0, 1.9f}, 0.04f, 2);  // 5: first lateral
     t.add_node({1.0f, 0.1f, 2.2f}, 0.03f, 5);
     t.add_node({1.4f, 0.1f, 2.6f}, 0.015f, 6);
-    t.add_node({1.1f, 0.5f, 2.5f}, 0.01f, 6);  // 8: sub-lateral
+    t.add_node({1.1f, 0.5f, 2.5f}, 0.01f, 6);   // 8: sub-lateral
     t.add_node({-0.4f, 0.2f, 2.5f}, 0.03f, 3);  // 9: second lateral
     t.add_node({-0.8f, 0.3f, 2.9f}, 0.02f, 9);
     return t;

@@ -106,8 +106,7 @@ TEST(BranchMesh, ParallelTransportFramesDoNotTwist) {
         const float twist = std::acos(std::clamp(carried.dot(n1), -1.0f, 1.0f));
         EXPECT_LT(twist, 0.02f) << "ring " << i;
         // Corresponding vertices stay close: no ring is rotated against its neighbour.
-        for (int j = 0; j < 6; ++j)
-            EXPECT_LT((mesh.vertices[i * 6 + j] - mesh.vertices[(i + 1) * 6 + j]).norm(), (c1 - c0).norm() + 0.02f);
+        for (int j = 0; j < 6; ++j) EXPECT_LT((mesh.vertices[i * 6 + j] - mesh.vertices[(i + 1) * 6 + j]).norm(), (c1 - c0).norm() + 0.02f);
     }
 }
 

@@ -56,10 +56,10 @@ TEST(NeighbourGraph, PiecesAreJoinedByTheShortestBridges) {
     // Three lines of 100 points (larger than the exact-search limit for small pieces) and a
     // 3-point clump; gaps of 0.5 m, 0.3 m and 0.2 m.
     std::vector<Eigen::Vector3f> p;
-    add_line(p, {0, 0, 0}, {0, 0, 1}, 0.01f);          // A
-    add_line(p, {0, 0, 1.5f}, {0, 0, 2.5f}, 0.01f);    // B: 0.5 m above A
+    add_line(p, {0, 0, 0}, {0, 0, 1}, 0.01f);              // A
+    add_line(p, {0, 0, 1.5f}, {0, 0, 2.5f}, 0.01f);        // B: 0.5 m above A
     add_line(p, {0.3f, 0, 1.5f}, {1.3f, 0, 1.5f}, 0.01f);  // C: 0.3 m beside B's foot
-    p.push_back({0, 0, 2.7f});                         // D: 0.2 m above B
+    p.push_back({0, 0, 2.7f});                             // D: 0.2 m above B
     p.push_back({0, 0.01f, 2.71f});
     p.push_back({0, -0.01f, 2.71f});
     NeighbourGraphOptions options;
@@ -84,11 +84,11 @@ TEST(NeighbourGraph, ElongatedPieceJoinsAlongItsOwnAxis) {
     // continuation (C) beyond a 0.4 m occlusion gap. C's nearest foreign points lie 0.3 m
     // sideways on the stem; its own axis leads down to B's top, which is where it belongs.
     std::vector<Eigen::Vector3f> p;
-    add_line(p, {0, 0, 0}, {0, 0, 3}, 0.01f);                 // A
-    add_line(p, {0, 0, 1}, {0.3f, 0, 1.3f}, 0.01f);           // B, joined to A
+    add_line(p, {0, 0, 0}, {0, 0, 3}, 0.01f);        // A
+    add_line(p, {0, 0, 1}, {0.3f, 0, 1.3f}, 0.01f);  // B, joined to A
     add_line(p, {0.3f, 0, 1.31f}, {0.3f, 0, 1.6f}, 0.01f);
     const int c_first = static_cast<int>(p.size());
-    add_line(p, {0.3f, 0, 2.0f}, {0.3f, 0, 3.0f}, 0.01f);     // C
+    add_line(p, {0.3f, 0, 2.0f}, {0.3f, 0, 3.0f}, 0.01f);  // C
     auto bridge_of_c = [&](float weight) {
         NeighbourGraphOptions options;
         options.neighbours = 4;

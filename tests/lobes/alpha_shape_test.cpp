@@ -89,8 +89,10 @@ TEST(ClosedMesh, TwoTetrahedraSharingAnEdgeAreSplitIntoAManifold) {
         // Orient each face outward: its normal points away from the fourth vertex.
         auto add = [&](int x, int y, int z, int w) {
             const Eigen::Vector3f n = (m.vertices[y] - m.vertices[x]).cross(m.vertices[z] - m.vertices[x]);
-            if (n.dot(m.vertices[w] - m.vertices[x]) > 0) m.faces.push_back({x, z, y});
-            else m.faces.push_back({x, y, z});
+            if (n.dot(m.vertices[w] - m.vertices[x]) > 0)
+                m.faces.push_back({x, z, y});
+            else
+                m.faces.push_back({x, y, z});
         };
         add(a, b, c, d);
         add(a, b, d, c);

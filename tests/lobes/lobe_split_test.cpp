@@ -28,8 +28,8 @@ TEST(EdgeConfidence, AverageDistanceToTheEdgeAgainstMidEdgeDiameter) {
     const TreeGraph tree = chain_tree();
     const std::vector<float> d_prime{0.2f, 0.16f, 0.1f, 0.04f, 0.04f};
     // Edge 1 (0..1 m): points 5 cm off the axis; edge 2 (1..2 m): 10 and 30 cm; edge 4: on the axis.
-    const std::vector<Eigen::Vector3f> points{{0.05f, 0, 0.5f}, {0, -0.05f, 0.2f}, {0.1f, 0, 1.5f}, {0, 0.3f, 1.5f},
-                                              {0.5f, 0, 1.0f}, {0, 0, -1.0f}};
+    const std::vector<Eigen::Vector3f> points{{0.05f, 0, 0.5f}, {0, -0.05f, 0.2f}, {0.1f, 0, 1.5f},
+                                              {0, 0.3f, 1.5f},  {0.5f, 0, 1.0f},   {0, 0, -1.0f}};
     const std::vector<int> internode{1, 1, 2, 2, 4, -1};
     const EdgeConfidence c = edge_confidence(tree, points, internode, d_prime);
     EXPECT_NEAR(c.mean_distance[1], 0.05f, 1e-6f);
@@ -48,10 +48,8 @@ TEST(EdgeConfidence, AverageDistanceToTheEdgeAgainstMidEdgeDiameter) {
 TEST(EdgeConfidence, RejectsMismatchedSizes) {
     const TreeGraph tree = chain_tree();
     const std::vector<Eigen::Vector3f> points{{0, 0, 0}};
-    EXPECT_EQ(error_code_of([&] { edge_confidence(tree, points, std::vector<int>{}, std::vector<float>(5, 0.1f)); }),
-              ExitCode::Usage);
-    EXPECT_EQ(error_code_of([&] { edge_confidence(tree, points, std::vector<int>{1}, std::vector<float>(2, 0.1f)); }),
-              ExitCode::Usage);
+    EXPECT_EQ(error_code_of([&] { edge_confidence(tree, points, std::vector<int>{}, std::vector<float>(5, 0.1f)); }), ExitCode::Usage);
+    EXPECT_EQ(error_code_of([&] { edge_confidence(tree, points, std::vector<int>{1}, std::vector<float>(2, 0.1f)); }), ExitCode::Usage);
 }
 
 TEST(SplitAtLowConfidence, ClusterTakesTheWholeSubtreeAboveTheFirstLowEdge) {

@@ -54,7 +54,7 @@ TEST(LobeTree, CrownBecomesClosedLobesSeededOnTheTrunk) {
     const Built b = build(cloud, 1.0);
     ASSERT_GE(b.tree.lobes.size(), 1u);
     EXPECT_GE(b.report.lobe_points, crown / 2);  // most of the crown is in lobes
-    EXPECT_GE(b.tree.skeleton.size(), 2u);      // the trunk stays explicit
+    EXPECT_GE(b.tree.skeleton.size(), 2u);       // the trunk stays explicit
     double lobe_volume = 0;
     for (const Lobe& lobe : b.tree.lobes) {
         EXPECT_TRUE(check_closed(lobe.mesh).closed());

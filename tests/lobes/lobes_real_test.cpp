@@ -73,13 +73,15 @@ TEST(LobesReal, CliWritesTlobeMeshesAndSummary) {
     EXPECT_GT(f["patch_instances"].get<std::size_t>(), summary["lobe_count"].get<std::size_t>());
     EXPECT_LT(f["fidelity"]["median_point_to_mesh"].get<double>(), 0.4);  // covers the scan (measured 0.18 m)
     EXPECT_TRUE(std::filesystem::exists(dir / "full.png"));
-    const auto lod = test::run_cli("synthesize " + tlobe + " --out " + (dir / "lod.ply").string() + " --lod 0.25 --species lagerstroemia --max-triangles 1000000");
+    const auto lod = test::run_cli("synthesize " + tlobe + " --out " + (dir / "lod.ply").string() +
+                                   " --lod 0.25 --species lagerstroemia --max-triangles 1000000");
     ASSERT_EQ(lod.exit_code, 0) << lod.err;
     const auto l = nlohmann::json::parse(read_file(dir / "lod.json"));
     EXPECT_LT(l["triangles"].get<std::size_t>(), f["triangles"].get<std::size_t>() / 2);
     EXPECT_TRUE(l["seconds"].contains("lod_extraction"));
     // The same seed gives the same mesh.
-    const auto again = test::run_cli("synthesize " + tlobe + " --out " + (dir / "again.ply").string() + " --lod 0.25 --species lagerstroemia --max-triangles 1000000");
+    const auto again = test::run_cli("synthesize " + tlobe + " --out " + (dir / "again.ply").string() +
+                                     " --lod 0.25 --species lagerstroemia --max-triangles 1000000");
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_TRUE(read_file(dir / "again.ply") == read_file(dir / "lod.ply"));
 }

@@ -285,7 +285,8 @@ TEST(Synthesis, TriangleBudgetIsAHardBound) {
             std::size_t counted = 0, smallest = SIZE_MAX;
             for (const auto& inst : lobe.instances)
                 counted += patch_triangles(textured.library.patches[inst.patch], o.twig_sides, textured.leaf_share);
-            for (const auto& p : textured.library.patches) smallest = std::min(smallest, patch_triangles(p, o.twig_sides, textured.leaf_share));
+            for (const auto& p : textured.library.patches)
+                smallest = std::min(smallest, patch_triangles(p, o.twig_sides, textured.leaf_share));
             EXPECT_EQ(lobe.triangles, counted);
             EXPECT_EQ(mesh.triangles(), lobe.triangles + (o.max_triangles - textured.patch_budget)) << name;
             if (lobe.budget_spent) {

@@ -19,8 +19,8 @@ namespace {
 // A closed octahedron around `c` with half-size `r`, outward.
 TriangleMesh octahedron(const Eigen::Vector3f& c, float r) {
     TriangleMesh m;
-    m.vertices = {c + Eigen::Vector3f(r, 0, 0), c + Eigen::Vector3f(-r, 0, 0), c + Eigen::Vector3f(0, r, 0),
-                  c + Eigen::Vector3f(0, -r, 0), c + Eigen::Vector3f(0, 0, r), c + Eigen::Vector3f(0, 0, -r)};
+    m.vertices = {c + Eigen::Vector3f(r, 0, 0),  c + Eigen::Vector3f(-r, 0, 0), c + Eigen::Vector3f(0, r, 0),
+                  c + Eigen::Vector3f(0, -r, 0), c + Eigen::Vector3f(0, 0, r),  c + Eigen::Vector3f(0, 0, -r)};
     m.faces = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
     return m;
 }

@@ -57,7 +57,7 @@ TEST(Foliage, LeafOutlineFollowsTheTurtleFrame) {
     EXPECT_TRUE(outline[3].isApprox(Eigen::Vector3f(1, 2, 5)));        // tip: base + size * H
     EXPECT_TRUE(outline[2].isApprox(Eigen::Vector3f(1, 2.5f, 3.8f)));  // widest at 40 %: half width 0.5
     EXPECT_TRUE(outline[4].isApprox(Eigen::Vector3f(1, 1.5f, 3.8f)));
-    for (const auto& p : outline) EXPECT_FLOAT_EQ(p.x(), 1.0f);        // flat, normal U
+    for (const auto& p : outline) EXPECT_FLOAT_EQ(p.x(), 1.0f);  // flat, normal U
     const TriangleMesh mesh = foliage_mesh(std::vector<LeafPlacement>{leaf, leaf});
     EXPECT_EQ(mesh.vertex_count(), 12u);
     EXPECT_EQ(mesh.face_count(), 8u);
@@ -190,9 +190,8 @@ TEST(Foliage, CombinedLodAccountsForEveryLeaf) {
         for (std::size_t k = 0; k < chain.lod_count(); ++k) {
             const TurtleResult lod = extract_lod(chain, k, tree.turtle);
             const FoliageLod f = foliage_for_prefix(chain.tadt, h, visited_nodes(chain, chain.lod_end(k)));
-            EXPECT_EQ(lod.leaves.size() + f.attached_leaves.size() + f.leaves_in_textures + f.leaves_in_small_boxes,
-                      drawn.leaves.size())
-                << k;
+            EXPECT_EQ(lod.leaves.size() + f.attached_leaves.size() + f.leaves_in_textures + f.leaves_in_small_boxes, drawn.leaves.size())
+                    << k;
             if (threshold == 0.0) {
                 EXPECT_TRUE(f.small_boxes.empty());
             }
@@ -272,10 +271,10 @@ TEST(FoliageTextures, LeafLandsOnItsTexel) {
     const render::Image& z1 = textures[0];
     ASSERT_EQ(z1.width, 128);
     ASSERT_EQ(z1.height, 128);
-    EXPECT_EQ(z1.at(64, 25)[3], 255);      // the blade (heights 0.73 .. 0.88) covers t = 0.8
+    EXPECT_EQ(z1.at(64, 25)[3], 255);               // the blade (heights 0.73 .. 0.88) covers t = 0.8
     EXPECT_GT(z1.at(64, 25)[1], z1.at(64, 25)[0]);  // green
-    EXPECT_EQ(z1.at(64, 5)[3], 0);         // above the tip: transparent
-    EXPECT_EQ(z1.at(10, 25)[3], 0);        // beside it: transparent
+    EXPECT_EQ(z1.at(64, 5)[3], 0);                  // above the tip: transparent
+    EXPECT_EQ(z1.at(10, 25)[3], 0);                 // beside it: transparent
     std::size_t opaque = 0;
     for (int y = 0; y < 128; ++y)
         for (int x = 0; x < 128; ++x) opaque += z1.at(x, y)[3] == 255;

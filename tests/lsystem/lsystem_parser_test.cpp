@@ -76,8 +76,8 @@ TEST(ModuleStringParse, ErrorsGiveLineAndColumn) {
 TEST(Expressions, PrecedenceAndFunctions) {
     EXPECT_EQ(value_of("1+2*3"), 7);
     EXPECT_EQ(value_of("(1+2)*3"), 9);
-    EXPECT_EQ(value_of("-2^2"), -4);       // power binds tighter than unary minus
-    EXPECT_EQ(value_of("2^3^2"), 512);     // right-associative
+    EXPECT_EQ(value_of("-2^2"), -4);    // power binds tighter than unary minus
+    EXPECT_EQ(value_of("2^3^2"), 512);  // right-associative
     EXPECT_EQ(value_of("2^-1"), 0.5);
     EXPECT_EQ(value_of("7 % 4"), 3);
     EXPECT_EQ(value_of("10/4"), 2.5);
@@ -128,7 +128,7 @@ this line is after endlsystem and ignored
     EXPECT_EQ(s.axiom.to_string(), "A(1)B");
     ASSERT_EQ(s.productions.size(), 4u);
     EXPECT_TRUE(s.productions[0].condition.has_value());
-    EXPECT_EQ(s.productions[0].successor.size(), 6u);  // F [ + A ] A
+    EXPECT_EQ(s.productions[0].successor.size(), 6u);      // F [ + A ] A
     EXPECT_FALSE(s.productions[1].condition.has_value());  // `*`
     EXPECT_EQ(s.productions[1].probability, 0.5);
     EXPECT_EQ(s.productions[2].probability, 1.5);
@@ -141,8 +141,7 @@ this line is after endlsystem and ignored
 TEST(LSystemParse, ContextsAndDefineOverrides) {
     ParseOptions options;
     options.defines["k"] = 7;
-    const LSystem s = parse_lsystem("#define k 2\naxiom: A\nB(x) C < A(y) > D(z) : x + y + z > k -> E(x, y, z)\n", "t",
-                                    options);
+    const LSystem s = parse_lsystem("#define k 2\naxiom: A\nB(x) C < A(y) > D(z) : x + y + z > k -> E(x, y, z)\n", "t", options);
     ASSERT_EQ(s.productions.size(), 1u);
     const Rule& r = s.productions[0];
     EXPECT_EQ(r.left_context.size(), 2u);
@@ -166,20 +165,16 @@ TEST(LSystemParse, ErrorsNameLineAndColumn) {
               "steps or pi)");
     EXPECT_EQ(parse_error("axiom: A\nA B\n"),
               "test.lsys: line 2, column 1: expected a rule 'predecessor -> successor', a header such as 'axiom:' or a #define");
-    EXPECT_EQ(parse_error("axiom: A\n  A(l+1) -> B\n"),
-              "test.lsys: line 2, column 6: expected ',' or ')' after a parameter of A");
+    EXPECT_EQ(parse_error("axiom: A\n  A(l+1) -> B\n"), "test.lsys: line 2, column 6: expected ',' or ')' after a parameter of A");
     EXPECT_EQ(parse_error("axiom: A\nA B -> C\n"),
               "test.lsys: line 2, column 1: the predecessor must be one module; write contexts as 'left < A > right'");
-    EXPECT_EQ(parse_error("axiom: A\nA -> B : 0\n"),
-              "test.lsys: line 2, column 10: a rule probability must be greater than 0");
+    EXPECT_EQ(parse_error("axiom: A\nA -> B : 0\n"), "test.lsys: line 2, column 10: a rule probability must be greater than 0");
     EXPECT_EQ(parse_error("axiom: A\nA -> B(foo(1))\n"), "test.lsys: line 2, column 8: unknown function 'foo'");
-    EXPECT_EQ(parse_error("axiom: A\nA -> B(sqrt(1, 2))\n"),
-              "test.lsys: line 2, column 8: sqrt() takes 1 argument, got 2");
+    EXPECT_EQ(parse_error("axiom: A\nA -> B(sqrt(1, 2))\n"), "test.lsys: line 2, column 8: sqrt() takes 1 argument, got 2");
     EXPECT_EQ(parse_error("derivation length: 2.5\naxiom: A\n"),
               "test.lsys: line 1, column 20: derivation length must be a whole number from 0 to 100000");
     EXPECT_EQ(parse_error("#define a 1\n#define a 2\naxiom: A\n"), "test.lsys: line 2, column 9: constant 'a' is defined twice");
-    EXPECT_EQ(parse_error("#define step 1\naxiom: A\n"),
-              "test.lsys: line 1, column 9: 'step' is a built-in name and cannot be #defined");
+    EXPECT_EQ(parse_error("#define step 1\naxiom: A\n"), "test.lsys: line 1, column 9: 'step' is a built-in name and cannot be #defined");
     EXPECT_EQ(parse_error("axiom: A\n/* open\n"), "test.lsys: line 2: '/*' comment is never closed");
     EXPECT_EQ(parse_error("derivation length: 3\n"), "test.lsys: no 'axiom:' line");
     EXPECT_EQ(parse_error("axiom: A(1/0)\n"), "test.lsys: line 1, column 10: parameter is not a finite number (division by zero?)");
@@ -189,8 +184,10 @@ TEST(LSystemParse, ErrorsNameLineAndColumn) {
     EXPECT_EQ(parse_error("tropism: 0 0 -1\naxiom: A\n"),
               "test.lsys: line 1, column 12: tropism needs three components separated by commas: x, y, z");
     EXPECT_EQ(parse_error("axiom: A\nA -> [B\n"), "");  // unbalanced successors are legal until interpretation
-    EXPECT_EQ(parse_error("axiom: A\nA < [B] -> C\n"), "test.lsys: line 2, column 5: brackets are not supported in predecessors or contexts");
-    EXPECT_EQ(parse_error("axiom: A\nA -> B(" + std::string(200, '(') + "\n"), "test.lsys: line 2, column 40: expression nested too deeply");
+    EXPECT_EQ(parse_error("axiom: A\nA < [B] -> C\n"),
+              "test.lsys: line 2, column 5: brackets are not supported in predecessors or contexts");
+    EXPECT_EQ(parse_error("axiom: A\nA -> B(" + std::string(200, '(') + "\n"),
+              "test.lsys: line 2, column 40: expression nested too deeply");
     EXPECT_EQ(parse_error("axiom: A(" + std::string(100, '(') + "1" + std::string(100, ')') + ")\n"),
               "test.lsys: line 1, column 42: expression nested too deeply");
 }

@@ -12,9 +12,7 @@
 
 namespace treelobes::lsystem::test_util {
 
-inline std::string example(const std::string& name) {
-    return (treelobes::test::source_dir() / "lsystem" / "examples" / name).string();
-}
+inline std::string example(const std::string& name) { return (treelobes::test::source_dir() / "lsystem" / "examples" / name).string(); }
 
 // Every internode as (parent position, position, radius), sorted: two trees with the same edges
 // compare equal whatever their node numbering.
@@ -33,8 +31,8 @@ inline std::vector<Edge> edges(const TreeGraph& tree) {
 inline std::vector<std::array<float, 10>> leaves(const TurtleResult& r) {
     std::vector<std::array<float, 10>> out;
     for (const auto& l : r.leaves)
-        out.push_back({l.position.x(), l.position.y(), l.position.z(), l.heading.x(), l.heading.y(), l.heading.z(),
-                       l.up.x(), l.up.y(), l.up.z(), l.size});
+        out.push_back({l.position.x(), l.position.y(), l.position.z(), l.heading.x(), l.heading.y(), l.heading.z(), l.up.x(), l.up.y(),
+                       l.up.z(), l.size});
     std::sort(out.begin(), out.end());
     return out;
 }

@@ -15,8 +15,8 @@ using namespace treelobes::lsystem::test_util;
 
 namespace {
 
-const std::vector<ChainMetric> kMetrics = {ChainMetric::branching_length, ChainMetric::children,
-                                           ChainMetric::descendants, ChainMetric::longest_path};
+const std::vector<ChainMetric> kMetrics = {ChainMetric::branching_length, ChainMetric::children, ChainMetric::descendants,
+                                           ChainMetric::longest_path};
 
 MultiresChain chain_of(const std::string& text, ChainMetric metric, ChainOrder order, TadtOptions tadt = {}) {
     MultiresOptions options;
@@ -60,7 +60,7 @@ TEST(Tadt, ContinuationAfterBracketIsANewNode) {
     EXPECT_TRUE(t.nodes[1].lateral);
     EXPECT_FALSE(t.nodes[2].lateral);  // F(3) continues the axis after the branch
     EXPECT_EQ(t.nodes[2].parent, 0);
-    EXPECT_EQ(t.nodes[3].parent, 2);   // the branch F(4) grows from F(3)
+    EXPECT_EQ(t.nodes[3].parent, 2);  // the branch F(4) grows from F(3)
     EXPECT_EQ(t.nodes[0].length, 1.0);
     EXPECT_EQ(t.nodes[0].subtree_length, 10.0);
     EXPECT_THROW(build_tadt(parse_module_string("F]")), Error);
@@ -85,7 +85,7 @@ TEST(MultiresChain, SeedExampleExactChain) {
         for (ChainMetric metric : kMetrics) {
             const MultiresChain c = chain_of(kSeedExample, metric, order, seed_lengths());
             EXPECT_EQ(format_chain(c), "C1 SAVE(C1) C2 SAVE(C2) C3 RESTORE(C2) C4 RESTORE(C1) C5")
-                << to_string(metric) << ", " << to_string(order);
+                    << to_string(metric) << ", " << to_string(order);
             EXPECT_EQ(c.lod_count(), 3u);
             EXPECT_EQ(format_chain(c, ChainLabels::node_id), "C1 SAVE(n0) C2 SAVE(n1) C3 RESTORE(n1) C4 RESTORE(n0) C5");
         }

@@ -49,8 +49,8 @@ TEST(MultiresCli, LSystemFileWritesChainLodsAndSummary) {
 
 TEST(MultiresCli, StringInputGivesTheSeedChain) {
     TempDir dir;
-    const auto r = run_cli("multires --string 'C1[C2[C3][C4]][C5]' --length-modules C1,C2,C3,C4,C5 --all --out '" +
-                           (dir / "out").string() + "' --json");
+    const auto r = run_cli("multires --string 'C1[C2[C3][C4]][C5]' --length-modules C1,C2,C3,C4,C5 --all --out '" + (dir / "out").string() +
+                           "' --json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto summary = nlohmann::json::parse(r.out);
     EXPECT_EQ(summary["lod_count"], 3);
@@ -59,7 +59,7 @@ TEST(MultiresCli, StringInputGivesTheSeedChain) {
     EXPECT_NE(chain.find("node 0 root C1\nSAVE 0\nnode 1 lateral C2\nSAVE 1\nnode 2 lateral C3\nRESTORE 1\nnode 3 lateral "
                          "C4\nRESTORE 0\nnode 4 lateral C5\n"),
               std::string::npos)
-        << chain;
+            << chain;
 }
 
 TEST(MultiresCli, SkeletonPlyInput) {
@@ -83,7 +83,7 @@ TEST(MultiresCli, SkeletonPlyInput) {
     const TreeGraph full = read_skeleton_ply(dir / "out" / "lod_2.ply");
     ASSERT_EQ(full.size(), tree.size());
     EXPECT_NEAR(full.total_length(), tree.total_length(), 1e-4);
-    EXPECT_EQ(full.origin, tree.origin);  // georeferenced input keeps its origin
+    EXPECT_EQ(full.origin, tree.origin);                                 // georeferenced input keeps its origin
     EXPECT_EQ(read_skeleton_ply(dir / "out" / "lod_0.ply").size(), 4u);  // root -> 1 -> 3 -> one tip
 }
 
@@ -104,8 +104,7 @@ TEST(MultiresCli, BadInputAndUsageErrors) {
     r = run_cli("multires '" + example("honda_monopodial.lsys") + "' --define nope=1 --out '" + (dir / "o").string() + "'");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.err.find("--define nope"), std::string::npos) << r.err;
-    r = run_cli("multires '" + example("honda_monopodial.lsys") + "' --steps 30 --max-modules 100000 --out '" +
-                (dir / "o").string() + "'");
+    r = run_cli("multires '" + example("honda_monopodial.lsys") + "' --steps 30 --max-modules 100000 --out '" + (dir / "o").string() + "'");
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("more than 100000 modules"), std::string::npos) << r.err;
     r = run_cli("multires --out '" + (dir / "o").string() + "'");
@@ -114,17 +113,16 @@ TEST(MultiresCli, BadInputAndUsageErrors) {
 
 TEST(MultiresCli, OverridesStepsSeedAndDefines) {
     TempDir dir;
-    const auto r = run_cli("multires '" + example("honda_monopodial.lsys") + "' --steps 4 -D r1=0.5 --out '" +
-                           (dir / "o").string() + "' --json");
+    const auto r =
+            run_cli("multires '" + example("honda_monopodial.lsys") + "' --steps 4 -D r1=0.5 --out '" + (dir / "o").string() + "' --json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto summary = nlohmann::json::parse(r.out);
     EXPECT_EQ(summary["internodes"], 15);
     EXPECT_EQ(summary["lods"][1]["skeleton"], "lod_15.ply");  // 16 levels: two digits
     // The trunk ends at 1 + 0.5 + 0.25 + 0.125 (r1 = 0.5 instead of 0.9).
     const TreeGraph full = read_skeleton_ply(dir / "o" / "lod_15.ply");
-    const bool trunk_top = std::any_of(full.nodes.begin(), full.nodes.end(), [](const TreeNode& n) {
-        return (n.position - Eigen::Vector3f(0, 0, 1.875f)).norm() < 1e-5f;
-    });
+    const bool trunk_top = std::any_of(full.nodes.begin(), full.nodes.end(),
+                                       [](const TreeNode& n) { return (n.position - Eigen::Vector3f(0, 0, 1.875f)).norm() < 1e-5f; });
     EXPECT_TRUE(trunk_top);
     const auto a = run_cli("multires '" + example("stochastic_bush.lsys") + "' --seed 5 --out '" + (dir / "a").string() + "'");
     const auto b = run_cli("multires '" + example("stochastic_bush.lsys") + "' --seed 5 --out '" + (dir / "b").string() + "'");
@@ -138,7 +136,8 @@ TEST(MultiresCli, OverridesStepsSeedAndDefines) {
 
 TEST(MultiresCli, FoliageHierarchyTexturesAndAtlas) {
     TempDir dir;
-    const std::string args = "multires '" + example("leafy_ternary.lsys") + "' --steps 3 --all --texture-threshold 0.05 --texture-planes --out '";
+    const std::string args =
+            "multires '" + example("leafy_ternary.lsys") + "' --steps 3 --all --texture-threshold 0.05 --texture-planes --out '";
     const auto r = run_cli(args + (dir / "a").string() + "' --json");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto summary = nlohmann::json::parse(r.out);
@@ -175,7 +174,7 @@ TEST(MultiresCli, FoliageHierarchyTexturesAndAtlas) {
         EXPECT_EQ(lod["foliage"]["leaves_omitted"], 0);  // default: small branches as geometry
         const auto& f = lod["foliage"];
         EXPECT_EQ(f["leaves_as_geometry"].get<std::size_t>() + f["leaves_in_textures"].get<std::size_t>() +
-                      f["leaves_omitted"].get<std::size_t>(),
+                          f["leaves_omitted"].get<std::size_t>(),
                   foliage["leaves"].get<std::size_t>());
         EXPECT_EQ(f["texture_quads"], 6 * f["textured_boxes"].size());
     }
@@ -184,14 +183,16 @@ TEST(MultiresCli, FoliageHierarchyTexturesAndAtlas) {
     // Omitting small branches' leaves keeps the count honest too.
     const auto omit = run_cli(args + (dir / "o").string() + "' --small-foliage omit --lod 20 --json");
     ASSERT_EQ(omit.exit_code, 1) << "--lod and --all exclude each other";
-    const auto o2 = run_cli("multires '" + example("leafy_ternary.lsys") + "' --steps 3 --texture-threshold 0.05 --lod 20 "
-                            "--small-foliage omit --json --out '" + (dir / "o").string() + "'");
+    const auto o2 = run_cli("multires '" + example("leafy_ternary.lsys") +
+                            "' --steps 3 --texture-threshold 0.05 --lod 20 "
+                            "--small-foliage omit --json --out '" +
+                            (dir / "o").string() + "'");
     ASSERT_EQ(o2.exit_code, 0) << o2.err;
     const auto omitted = nlohmann::json::parse(o2.out);
     const auto& f20 = omitted["lods"][0]["foliage"];
     EXPECT_GT(f20["leaves_omitted"].get<std::size_t>(), 0u);
     EXPECT_EQ(f20["leaves_as_geometry"].get<std::size_t>() + f20["leaves_in_textures"].get<std::size_t>() +
-                  f20["leaves_omitted"].get<std::size_t>(),
+                      f20["leaves_omitted"].get<std::size_t>(),
               foliage["leaves"].get<std::size_t>());
     // Same input, same files.
     ASSERT_EQ(run_cli(args + (dir / "b").string() + "'").exit_code, 0);

@@ -15,9 +15,7 @@ using namespace treelobes::lsystem::test_util;
 
 namespace {
 
-TurtleResult draw(const std::string& text, const TurtleOptions& options = {}) {
-    return interpret(parse_module_string(text), options);
-}
+TurtleResult draw(const std::string& text, const TurtleOptions& options = {}) { return interpret(parse_module_string(text), options); }
 
 void expect_near(const Eigen::Vector3f& a, const Eigen::Vector3d& b, double tolerance = 1e-6) {
     EXPECT_NEAR(a.x(), b.x(), tolerance);
@@ -44,10 +42,10 @@ TEST(Turtle, Seed003BracketExample) {
 
 TEST(Turtle, RotationCommands) {
     // Frame: H = +z, L = +y, U = -x.
-    expect_near(draw("&(90)F").tree.nodes[1].position, {1, 0, 0});    // pitch down: toward -U
-    expect_near(draw("^(90)F").tree.nodes[1].position, {-1, 0, 0});   // pitch up: toward U
-    expect_near(draw("-(90)F").tree.nodes[1].position, {0, -1, 0});   // turn right
-    expect_near(draw("|F").tree.nodes[1].position, {0, 0, -1});       // turn around
+    expect_near(draw("&(90)F").tree.nodes[1].position, {1, 0, 0});         // pitch down: toward -U
+    expect_near(draw("^(90)F").tree.nodes[1].position, {-1, 0, 0});        // pitch up: toward U
+    expect_near(draw("-(90)F").tree.nodes[1].position, {0, -1, 0});        // turn right
+    expect_near(draw("|F").tree.nodes[1].position, {0, 0, -1});            // turn around
     expect_near(draw("\\(90)+(90)F").tree.nodes[1].position, {-1, 0, 0});  // roll moves L to U
     expect_near(draw("/(90)+(90)F").tree.nodes[1].position, {1, 0, 0});
     // Default angle and step from the options.

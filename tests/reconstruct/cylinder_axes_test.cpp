@@ -89,8 +89,10 @@ TEST(CylinderAxes, NodesPlacedByCircleFitsStay) {
     for (std::size_t u = 0; u < 8; ++u) fixed[u] = true;
     EXPECT_EQ(fit_cylinder_axes(c.tree, points, c.internode, on(), fixed), c.tree.size() - 8);
     for (std::size_t u = 0; u < c.tree.size(); ++u) {
-        if (fixed[u]) EXPECT_EQ(c.tree.nodes[u].position.z(), -0.019f) << "node " << u;
-        else EXPECT_LT(lateral_offset(c.tree.nodes[u].position), 0.006f) << "node " << u;
+        if (fixed[u])
+            EXPECT_EQ(c.tree.nodes[u].position.z(), -0.019f) << "node " << u;
+        else
+            EXPECT_LT(lateral_offset(c.tree.nodes[u].position), 0.006f) << "node " << u;
     }
 }
 
@@ -104,7 +106,8 @@ TEST(CylinderAxes, FlatStripIsNotTrusted) {
     for (int i = 0; i < 300; ++i) points.emplace_back(along(rng), across(rng), jitter(rng));
     Chain c(points, 1.0f, 0.05f, [](float x) { return Eigen::Vector3f(x, 0.0f, 0.0f); });
     EXPECT_EQ(fit_cylinder_axes(c.tree, points, c.internode, on()), 0u);
-    for (std::size_t u = 0; u < c.tree.size(); ++u) EXPECT_EQ(c.tree.nodes[u].position, Eigen::Vector3f(0.05f * static_cast<float>(u), 0, 0));
+    for (std::size_t u = 0; u < c.tree.size(); ++u)
+        EXPECT_EQ(c.tree.nodes[u].position, Eigen::Vector3f(0.05f * static_cast<float>(u), 0, 0));
 }
 
 // A 5 mm twig bent along a 0.3 m circle: a wide cylinder fits the bend (its surface follows
@@ -124,7 +127,8 @@ TEST(CylinderAxes, BentTwigIsNotTrusted) {
         Chain c(points, 0.5f, 0.025f, centre);
         fit_cylinder_axes(c.tree, points, c.internode, o);
         float worst = 0;
-        for (std::size_t u = 1; u < c.tree.size(); ++u) worst = std::max(worst, (c.tree.nodes[u].position - centre(0.025f * static_cast<float>(u))).norm());
+        for (std::size_t u = 1; u < c.tree.size(); ++u)
+            worst = std::max(worst, (c.tree.nodes[u].position - centre(0.025f * static_cast<float>(u))).norm());
         return worst;
     };
     CylinderAxesOptions o = on();
@@ -163,7 +167,8 @@ TEST(CylinderAxes, CliSwitchReachesTheSummary) {
     // The Y tree of synthetic_clouds.hpp, scanned from one side only.
     write_point_cloud(test::cloud_from(test::y_tree(), 3000.0f, 7, 0.45f), dir / "y.xyz");
     auto moved = [&](const std::string& flags) {
-        const auto r = test::run_cli("reconstruct " + test::quoted(dir / "y.xyz") + " --out " + test::quoted(dir / "out") + " --overwrite " + flags);
+        const auto r = test::run_cli("reconstruct " + test::quoted(dir / "y.xyz") + " --out " + test::quoted(dir / "out") +
+                                     " --overwrite " + flags);
         EXPECT_EQ(r.exit_code, 0) << r.err;
         std::ifstream in(dir / "out" / "y_summary.json");
         std::stringstream text;
@@ -174,5 +179,7 @@ TEST(CylinderAxes, CliSwitchReachesTheSummary) {
     };
     EXPECT_EQ(moved(""), 0);  // off by default
     EXPECT_GT(moved("--cylinder-axes true"), 0);
-    EXPECT_EQ(test::run_cli("reconstruct " + test::quoted(dir / "y.xyz") + " --out " + test::quoted(dir / "out") + " --cylinder-window 0").exit_code, 1);
+    EXPECT_EQ(test::run_cli("reconstruct " + test::quoted(dir / "y.xyz") + " --out " + test::quoted(dir / "out") + " --cylinder-window 0")
+                      .exit_code,
+              1);
 }

@@ -127,7 +127,7 @@ TEST(Outliers, CliOptionReachesTheFilter) {
     EXPECT_GT(global, local + 20) << "the sparse branch was not kept through the CLI";
     EXPECT_EQ(test::run_cli("reconstruct " + test::quoted(dir / "scan.xyz") + " --out " + test::quoted(dir / "bad") +
                             " --outlier-test sometimes")
-                  .exit_code,
+                      .exit_code,
               1);
 }
 

@@ -46,8 +46,10 @@ TEST(Recentre, ThinInternodesMoveAcrossOntoTheirPoints) {
             EXPECT_NEAR(p.x(), 0.1f * static_cast<float>(u), 1e-5f) << "node " << u << " slid along the branch";
             // Onto the axis, or to the dead band's edge: half the bark's spread (the 1 cm radius).
             const float d = std::hypot(p.y(), p.z());
-            if (band == 0.0) EXPECT_LT(d, 0.003f) << "node " << u;
-            else EXPECT_NEAR(d, 0.005f, 0.002f) << "node " << u;
+            if (band == 0.0)
+                EXPECT_LT(d, 0.003f) << "node " << u;
+            else
+                EXPECT_NEAR(d, 0.005f, 0.002f) << "node " << u;
         }
     }
 }

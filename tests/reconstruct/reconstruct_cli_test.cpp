@@ -27,9 +27,7 @@ std::string slurp(const std::filesystem::path& p) {
 
 using test::quoted;
 
-void write_y_tree(const std::filesystem::path& path) {
-    write_point_cloud(test::cloud_from(test::y_tree(), 2500), path);
-}
+void write_y_tree(const std::filesystem::path& path) { write_point_cloud(test::cloud_from(test::y_tree(), 2500), path); }
 
 }  // namespace
 
@@ -85,8 +83,8 @@ TEST(ReconstructCli, OneBadInputDoesNotStopTheOthers) {
     TempDir dir;
     write_y_tree(dir / "good.xyz");
     test::write_text(dir / "bad.xyz", "1 2 3\n4 5 6\n");  // two points: not a tree
-    const auto r = run_cli("reconstruct " + quoted(dir / "bad.xyz") + " " + quoted(dir / "good.xyz") + " " +
-                           quoted(dir / "missing.xyz") + " --out " + quoted(dir / "out"));
+    const auto r = run_cli("reconstruct " + quoted(dir / "bad.xyz") + " " + quoted(dir / "good.xyz") + " " + quoted(dir / "missing.xyz") +
+                           " --out " + quoted(dir / "out"));
     EXPECT_EQ(r.exit_code, 3) << r.err;
     EXPECT_TRUE(std::filesystem::exists(dir / "out" / "good_skeleton.ply"));
     std::istringstream failures(slurp(dir / "out" / "failures.jsonl"));
@@ -174,7 +172,8 @@ TEST(ReconstructCli, PiecesBeyondGapsAreCountedInTheSummary) {
     EXPECT_EQ(tips, 1);
     EXPECT_EQ(beyond_gaps("--max-gap 0.15 --max-gap-points 20"), std::pair(0, 2));
     EXPECT_EQ(run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --max-gap-points -3").exit_code, 1);
-    const auto alone = run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --overwrite --max-gap-points 20");
+    const auto alone =
+            run_cli("reconstruct " + quoted(dir / "t.xyz") + " --out " + quoted(dir / "out") + " --overwrite --max-gap-points 20");
     EXPECT_EQ(alone.exit_code, 1);
     EXPECT_NE(alone.err.find("--max-gap-points needs --max-gap"), std::string::npos) << alone.err;
 }

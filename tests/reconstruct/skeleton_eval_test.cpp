@@ -85,17 +85,18 @@ TEST(SkeletonEval, BranchRecallScoresTheThickPart) {
         t.add_node(tip, tip_radius, 3);
         return t;
     };
-    const SkeletonGraph reference = write_and_read(tree({0.4f, 0, 1}, {2.0f, 0, 1}, 0.02f, 0.004f), dir, "ref.ply");  // 4 cm, then an 8 mm twig
+    const SkeletonGraph reference =
+            write_and_read(tree({0.4f, 0, 1}, {2.0f, 0, 1}, 0.02f, 0.004f), dir, "ref.ply");  // 4 cm, then an 8 mm twig
     // Ours follows the thick part, then turns up away from the twig: detected (scored over the
     // whole axis it would not be, 0.4 of 2 m matched).
     const SkeletonComparison found =
-        compare_skeletons(write_and_read(tree({0.4f, 0, 1}, {0.4f, 0, 2.0f}, 0.02f, 0.01f), dir, "a.ply"), reference);
+            compare_skeletons(write_and_read(tree({0.4f, 0, 1}, {0.4f, 0, 2.0f}, 0.02f, 0.01f), dir, "a.ply"), reference);
     ASSERT_TRUE(found.branches);
     EXPECT_EQ(found.branches->reference_branches, 2u);
     EXPECT_DOUBLE_EQ(found.branches->recall, 1.0);
     // Ours goes up and out, missing the thick part, and only meets the twig: missed.
     const SkeletonComparison missed =
-        compare_skeletons(write_and_read(tree({0.6f, 0, 1.6f}, {2.0f, 0, 1}, 0.02f, 0.01f), dir, "b.ply"), reference);
+            compare_skeletons(write_and_read(tree({0.6f, 0, 1.6f}, {2.0f, 0, 1}, 0.02f, 0.01f), dir, "b.ply"), reference);
     ASSERT_TRUE(missed.branches);
     EXPECT_EQ(missed.branches->reference_branches, 2u);
     EXPECT_DOUBLE_EQ(missed.branches->recall, 0.5);

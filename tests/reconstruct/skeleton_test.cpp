@@ -99,9 +99,8 @@ TEST(Skeleton, NarrowForkOfThinTwigsKeepsBothTwigsOnTheirAxes) {
     // apart at their tips). Binned at the stem's width, the twigs' slices were joined into one
     // cluster centred in the empty space between them: one tip, nodes 5 cm off both axes. Thin
     // slices are now cut finer and joined only across short edges, so each twig keeps its chain.
-    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 2}, 0.08f},
-                                     {{0, 0, 2}, {0.06f, 0, 3.2f}, 0.01f},
-                                     {{0, 0, 2}, {-0.06f, 0, 3.2f}, 0.01f}};
+    const std::vector<Segment> truth{
+            {{0, 0, 0}, {0, 0, 2}, 0.08f}, {{0, 0, 2}, {0.06f, 0, 3.2f}, 0.01f}, {{0, 0, 2}, {-0.06f, 0, 3.2f}, 0.01f}};
     const PointCloud cloud = test::cloud_from(truth, 2000);
     const TreeGraph tree = reconstruct_skeleton(cloud.positions, {}).tree;
     tree.validate("narrow fork");
@@ -196,9 +195,8 @@ TEST(Skeleton, SizeLimitedDetachmentKeepsABigBranchAcrossAGapAndDropsASmallPiece
     // Two pieces cut off from the stem by ~0.3 m gaps: a 1.1 m branch (~830 points) and a
     // 0.2 m crumb (~120 points). --max-gap alone drops both with the joins drawn to them; with
     // a size limit between the two only the crumb goes.
-    const std::vector<Segment> truth{{{0, 0, 0}, {0, 0, 3}, 0.08f},
-                                     {{0.35f, 0, 1.5f}, {1.2f, 0, 2.2f}, 0.04f},
-                                     {{-0.45f, 0, 2.0f}, {-0.6f, 0, 2.15f}, 0.03f}};
+    const std::vector<Segment> truth{
+            {{0, 0, 0}, {0, 0, 3}, 0.08f}, {{0.35f, 0, 1.5f}, {1.2f, 0, 2.2f}, 0.04f}, {{-0.45f, 0, 2.0f}, {-0.6f, 0, 2.15f}, 0.03f}};
     const PointCloud cloud = test::cloud_from(truth, 3000);
     auto near = [](const SkeletonResult& r, const Eigen::Vector3f& p) {
         for (const auto& node : r.tree.nodes)

@@ -52,8 +52,8 @@ PointCloud house() {
 TEST(Preprocess, DuplicatesOutliersAndMapping) {
     PointCloud cloud = test::cloud_from({{{0, 0, 0}, {0, 0, 2}, 0.1f}}, 2000);
     const std::size_t n = cloud.size();
-    cloud.positions.push_back(cloud.positions[5]);          // exact duplicate
-    cloud.positions.push_back({5.0f, 5.0f, 1.0f});          // far outlier
+    cloud.positions.push_back(cloud.positions[5]);  // exact duplicate
+    cloud.positions.push_back({5.0f, 5.0f, 1.0f});  // far outlier
     PreprocessOptions o;
     o.ground = GroundMode::Keep;
     const Preprocessed p = preprocess_cloud(cloud, o);

@@ -45,8 +45,8 @@ std::string chunk(const std::string& type, const std::string& data) {
 struct Apng {
     std::vector<std::string> chunk_types;
     std::uint32_t declared_frames = 0, plays = 99;
-    std::vector<std::uint32_t> sequence;     // fcTL and fdAT sequence numbers in file order
-    std::vector<Image> frames;               // decoded
+    std::vector<std::uint32_t> sequence;                               // fcTL and fdAT sequence numbers in file order
+    std::vector<Image> frames;                                         // decoded
     std::vector<std::pair<std::uint32_t, std::uint32_t>> frame_sizes;  // from fcTL
 };
 
@@ -81,7 +81,8 @@ Apng parse_apng(const std::string& bytes) {
         at += 12 + length;
     }
     for (const auto& data : frame_data)
-        apng.frames.push_back(decode_png(std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", header) + chunk("IDAT", data) + chunk("IEND", ""), "frame"));
+        apng.frames.push_back(
+                decode_png(std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", header) + chunk("IDAT", data) + chunk("IEND", ""), "frame"));
     return apng;
 }
 

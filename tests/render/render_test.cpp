@@ -12,7 +12,8 @@ namespace {
 
 TriangleMesh unit_square_at(double z) {
     TriangleMesh mesh;  // a 1 x 1 square in the x-z plane at depth y = z
-    mesh.vertices = {{0, static_cast<float>(z), 0}, {1, static_cast<float>(z), 0}, {1, static_cast<float>(z), 1}, {0, static_cast<float>(z), 1}};
+    mesh.vertices = {
+            {0, static_cast<float>(z), 0}, {1, static_cast<float>(z), 0}, {1, static_cast<float>(z), 1}, {0, static_cast<float>(z), 1}};
     mesh.faces = {{0, 1, 2}, {0, 2, 3}};
     return mesh;
 }

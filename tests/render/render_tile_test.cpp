@@ -101,7 +101,8 @@ double top_aspect(const fs::path& cloud_file) {
 
 TEST_F(RenderTile, SpeciesOfACloudAttributeWithLegend) {
     const auto tile = test::source_dir() / "data" / "synthetic" / "tile" / "tile.las";
-    const auto r = test::run_cli("render " + test::quoted(tile) + " --view top --color species --size 240 --out " + test::quoted(path("sp.png")));
+    const auto r =
+            test::run_cli("render " + test::quoted(tile) + " --view top --color species --size 240 --out " + test::quoted(path("sp.png")));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const Image image = read_png(path("sp.png"));
     const int panel = static_cast<int>(std::lround(240 * top_aspect(tile)));  // the panel takes the tile's shape
@@ -134,7 +135,8 @@ TEST_F(RenderTile, SpeciesOfATileOutputFolder) {
     EXPECT_NE(r.out.find("\"species\": 3"), std::string::npos) << r.out;
     const int panel = static_cast<int>(std::lround(240 * top_aspect(path("species") / "points.las")));
     const auto counts = colour_counts(read_png(path("tile_sp.png")), 0, panel - 4);
-    for (const char* name : {"pine", "birch", "palm"}) EXPECT_GT(counts.count(id_colour(library_ids.at(name))) ? counts.at(id_colour(library_ids.at(name))) : 0, 200u) << name;
+    for (const char* name : {"pine", "birch", "palm"})
+        EXPECT_GT(counts.count(id_colour(library_ids.at(name))) ? counts.at(id_colour(library_ids.at(name))) : 0, 200u) << name;
     EXPECT_EQ(counts.count(id_colour(library_ids.at("lagerstroemia"))), 0u);  // trees.csv wins over the points' own attribute
     r = test::run_cli("render " + test::quoted(path("plain")) + " --color species --out " + test::quoted(path("x.png")));
     EXPECT_EQ(r.exit_code, 2);  // a tile run without --model names no species
@@ -142,7 +144,8 @@ TEST_F(RenderTile, SpeciesOfATileOutputFolder) {
 }
 
 TEST_F(RenderTile, ContactSheetOnePanelPerTreeSortedAndLabelled) {
-    const std::string command = "render " + test::quoted(path("species")) + " --contact-sheet --view front --color species --size 160 --json --out ";
+    const std::string command =
+            "render " + test::quoted(path("species")) + " --contact-sheet --view front --color species --size 160 --json --out ";
     auto r = test::run_cli(command + test::quoted(path("sheet.png")));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     std::ifstream rows(path("species") / "trees.csv");
@@ -171,11 +174,13 @@ TEST_F(RenderTile, ContactSheetOnePanelPerTreeSortedAndLabelled) {
         const int x0 = gap + (k % columns) * (width + gap), y0 = gap + (k / columns) * (height + label + gap);
         // The label strip reads "ID <id>  <species>  <height> M", drawn with the project's font.
         std::ostringstream text;
-        text << "ID " << id << "  " << species_of(id) << "  " << std::fixed << std::setprecision(1) << std::stod(cells[height_column]) << " M";
+        text << "ID " << id << "  " << species_of(id) << "  " << std::fixed << std::setprecision(1) << std::stod(cells[height_column])
+             << " M";
         Image expected(width, label, label_grey);
         draw_text(expected, 2, 2, text.str(), 1, {20, 20, 20, 255});
         for (int y = 0; y < label; ++y)
-            for (int x = 0; x < width; ++x) ASSERT_EQ(sheet.at(x0 + x, y0 + y), expected.at(x, y)) << "label of tree " << id << " at " << x << "," << y;
+            for (int x = 0; x < width; ++x)
+                ASSERT_EQ(sheet.at(x0 + x, y0 + y), expected.at(x, y)) << "label of tree " << id << " at " << x << "," << y;
         // The tree fills its panel: its points reach within 8 % of two opposite borders.
         int left = width, right = -1, top = height, bottom = -1;
         std::set<Rgba> colours;
@@ -188,14 +193,17 @@ TEST_F(RenderTile, ContactSheetOnePanelPerTreeSortedAndLabelled) {
             }
         const bool fills_height = top <= height * 0.08 && bottom >= height * 0.92;
         const bool fills_width = left <= width * 0.08 && right >= width * 0.92;
-        EXPECT_TRUE(fills_height || fills_width) << "tree " << id << " spans x " << left << ".." << right << ", y " << top << ".." << bottom;
-        EXPECT_EQ(colours, std::set<Rgba>{id_colour(library_ids.at(species_of(id)))}) << "tree " << id << " drawn in its species colour only";
+        EXPECT_TRUE(fills_height || fills_width)
+                << "tree " << id << " spans x " << left << ".." << right << ", y " << top << ".." << bottom;
+        EXPECT_EQ(colours, std::set<Rgba>{id_colour(library_ids.at(species_of(id)))})
+                << "tree " << id << " drawn in its species colour only";
     }
     // Deterministic.
     r = test::run_cli(command + test::quoted(path("sheet2.png")));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(read_file(path("sheet.png")), read_file(path("sheet2.png")));
     // Not a tile output folder: exit 2.
-    r = test::run_cli("render " + test::quoted(test::source_dir() / "data/synthetic/birch_3.las") + " --contact-sheet --out " + test::quoted(path("x.png")));
+    r = test::run_cli("render " + test::quoted(test::source_dir() / "data/synthetic/birch_3.las") + " --contact-sheet --out " +
+                      test::quoted(path("x.png")));
     EXPECT_EQ(r.exit_code, 2) << r.err;
 }

@@ -34,7 +34,7 @@ TEST(RenderViews, AspectIsTheSubjectsShapeOnTheImage) {
 TEST(RenderViews, RampAndIdColours) {
     EXPECT_EQ(ramp_colour(0.0), (Rgba{68, 1, 84, 255}));
     EXPECT_EQ(ramp_colour(1.0), (Rgba{253, 231, 37, 255}));
-    EXPECT_EQ(ramp_colour(2.0), ramp_colour(1.0));  // clamped
+    EXPECT_EQ(ramp_colour(2.0), ramp_colour(1.0));                                                        // clamped
     for (double t = 0.1; t <= 1.0; t += 0.1) EXPECT_GT(ramp_colour(t)[1], ramp_colour(t - 0.1)[1]) << t;  // green rises
     EXPECT_EQ(id_colour(0), (Rgba{170, 170, 170, 255}));
     std::set<Rgba> ids;
@@ -54,13 +54,14 @@ TEST(RenderViews, CliViewsAndColouringsFillTheFrame) {
     Eigen::Vector3f lo = cloud.positions.front(), hi = lo;
     for (const auto& p : cloud.positions) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
     EXPECT_NEAR(top.width, 200.0 * (hi.x() - lo.x()) / (hi.y() - lo.y()), 2);  // the tile's shape seen from above
-    EXPECT_GT(distinct_colours(top).size(), 8u);  // several trees, several colours
+    EXPECT_GT(distinct_colours(top).size(), 8u);                               // several trees, several colours
 
-    r = test::run_cli("render " + test::quoted(skeleton) + " --view front --color order --size 300 --out " + test::quoted(dir / "order.png"));
+    r = test::run_cli("render " + test::quoted(skeleton) + " --view front --color order --size 300 --out " +
+                      test::quoted(dir / "order.png"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const Image front = read_png(dir / "order.png");
     EXPECT_NEAR(front.width, 300.0 * 4.53 / 8.97, 3);  // birch_3: 4.53 m wide (x), 8.97 m tall
-    EXPECT_GE(distinct_colours(front).size(), 4u);      // background + orders 0..3
+    EXPECT_GE(distinct_colours(front).size(), 4u);     // background + orders 0..3
 
     r = test::run_cli("render " + test::quoted(skeleton) + " --view side --color tree --out " + test::quoted(dir / "x.png"));
     EXPECT_EQ(r.exit_code, 0) << r.err;  // colourings that do not apply leave the input plain

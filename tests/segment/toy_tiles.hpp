@@ -35,8 +35,8 @@ void add_ground(ToyTile& tile, float x0, float x1, float y0, float y1, float spa
 
 // Airborne view of a conical crown: surface points on a grid of `spacing`, top at `height`
 // above the ground, falling 2 m per metre of radius, plus a few stem points beneath.
-inline void add_cone_crown(ToyTile& tile, float cx, float cy, float height, float radius, float spacing, float slope_deg,
-                           float roughness, std::int32_t id) {
+inline void add_cone_crown(ToyTile& tile, float cx, float cy, float height, float radius, float spacing, float slope_deg, float roughness,
+                           std::int32_t id) {
     const float ground = ground_height(cx, cy, slope_deg, roughness);
     for (float y = cy - radius; y <= cy + radius; y += spacing)
         for (float x = cx - radius; x <= cx + radius; x += spacing) {

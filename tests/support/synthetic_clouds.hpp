@@ -20,8 +20,8 @@ struct Segment {
 
 // `density` points per square metre of bark; `visible` is the fraction of the circumference
 // scanned (1 = all round; 0.5 = one side, facing +x); `noise` is Gaussian, metres.
-inline void add_cylinder(std::vector<Eigen::Vector3f>& points, const Segment& s, float density, std::mt19937& rng,
-                         float visible = 1.0f, float noise = 0.002f) {
+inline void add_cylinder(std::vector<Eigen::Vector3f>& points, const Segment& s, float density, std::mt19937& rng, float visible = 1.0f,
+                         float noise = 0.002f) {
     const Eigen::Vector3f axis = s.b - s.a;
     const float length = axis.norm();
     const Eigen::Vector3f t = axis / length;

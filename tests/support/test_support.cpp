@@ -19,8 +19,7 @@ fs::path real_data_dir() {
     const char* env = std::getenv("TREELOBES_REAL_DATA");
     fs::path dir = env && *env ? fs::path(env) : fs::path(TREELOBES_DEFAULT_REAL_DATA);
     if (!fs::is_directory(dir)) {
-        ADD_FAILURE() << "real scan folder not found: " << dir
-                      << " (set TREELOBES_REAL_DATA to the folder of ../shared/data)";
+        ADD_FAILURE() << "real scan folder not found: " << dir << " (set TREELOBES_REAL_DATA to the folder of ../shared/data)";
         return {};
     }
     return dir;
@@ -42,8 +41,7 @@ TempDir::TempDir() {
     std::string name = info ? std::string(info->test_suite_name()) + "_" + info->name() : "test";
     for (char& c : name)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-    path_ = fs::temp_directory_path() /
-            ("treelobes_" + name + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+    path_ = fs::temp_directory_path() / ("treelobes_" + name + "_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
     fs::remove_all(path_);
     fs::create_directories(path_);
 }
@@ -63,8 +61,8 @@ static std::string slurp(const fs::path& path) {
 CommandResult run_cli(const std::string& arguments) {
     TempDir scratch;
     const fs::path out = scratch / "stdout", err = scratch / "stderr";
-    const std::string command = std::string("'") + TREELOBES_CLI + "' " + arguments + " >'" + out.string() +
-                                "' 2>'" + err.string() + "' </dev/null";
+    const std::string command =
+            std::string("'") + TREELOBES_CLI + "' " + arguments + " >'" + out.string() + "' 2>'" + err.string() + "' </dev/null";
     const int status = std::system(command.c_str());
     CommandResult result;
     result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);

@@ -69,7 +69,9 @@ const Plot& plot() {
                         (p->dir / "single").string() + "' " + kTileOptions + " >/dev/null"),
                   0);
         p->single = p->dir / "single_merged";
-        EXPECT_EQ(shell(cli() + " --log-level error merge '" + (p->dir / "single").string() + "' --out '" + p->single.string() + "' >/dev/null"), 0);
+        EXPECT_EQ(shell(cli() + " --log-level error merge '" + (p->dir / "single").string() + "' --out '" + p->single.string() +
+                        "' >/dev/null"),
+                  0);
         return p;
     }();
     return *made;
@@ -139,7 +141,7 @@ TEST(SurveyBuffer, EveryTreeOnceAndAsInOneRunOfTheUncutPlot) {
         // A stem base estimated from an airborne scan lies under the tree's crown (the highest
         // point when the stem is not seen), not always on the stem.
         EXPECT_LE(std::hypot(number(a, "x") - number(t, "x"), number(a, "y") - number(t, "y")), number(t, "crown_diameter_m") / 2 + 0.5)
-            << "true tree " << a.at("tree_id");
+                << "true tree " << a.at("tree_id");
         // The tree is the one of the tile whose square holds its base.
         char tile[64];
         std::snprintf(tile, sizeof tile, "tile_%.0f_%.0f", std::floor(number(a, "x") / kTileSize) * kTileSize,
@@ -170,5 +172,6 @@ TEST(SurveyBuffer, WithoutABufferTreesAcrossEdgesComeOutInPieces) {
     EXPECT_GE(cut, 4) << "trees modelled in pieces by several tiles";
     EXPECT_EQ(cut_with_buffer, 0);
     EXPECT_GT(extra_rows, 0);
-    std::printf("without a buffer: %d true trees in %d pieces too many; with a %.0f m buffer: %d\n", cut, extra_rows, kBuffer, cut_with_buffer);
+    std::printf("without a buffer: %d true trees in %d pieces too many; with a %.0f m buffer: %d\n", cut, extra_rows, kBuffer,
+                cut_with_buffer);
 }

@@ -39,7 +39,8 @@ struct Reference {
 };
 
 std::string batch_command(const fs::path& tiles, const fs::path& out, const std::string& extra = "", const std::string& global = "") {
-    return cli() + " --log-level warn " + global + " batch '" + tiles.string() + "' --out '" + out.string() + "' " + extra + " " + kTileOptions;
+    return cli() + " --log-level warn " + global + " batch '" + tiles.string() + "' --out '" + out.string() + "' " + extra + " " +
+           kTileOptions;
 }
 
 std::string merge_command(const std::vector<fs::path>& dirs, const fs::path& out) {
@@ -126,11 +127,12 @@ TEST(SurveyCli, KilledBatchResumesWithoutRedoingATile) {
                 finished[entry.path().filename().string()] = fs::last_write_time(entry.path() / survey::kCompletionMarker);
     TempDir scratch;
     ASSERT_EQ(shell(batch_command(r.tiles, out, "", "--json") + " >'" + (scratch / "summary.json").string() + "'"), 0)
-        << "killed after " << moment << " s";
+            << "killed after " << moment << " s";
     const auto summary = nlohmann::json::parse(file_bytes(scratch / "summary.json"));
     EXPECT_EQ(summary["tiles_skipped"].get<std::size_t>(), finished.size()) << "killed after " << moment << " s";
     EXPECT_EQ(summary["tiles_done"].get<std::size_t>(), kTiles - finished.size());
-    for (const auto& [name, time] : finished) EXPECT_EQ(fs::last_write_time(out / name / survey::kCompletionMarker), time) << name << " redone";
+    for (const auto& [name, time] : finished)
+        EXPECT_EQ(fs::last_write_time(out / name / survey::kCompletionMarker), time) << name << " redone";
     ASSERT_EQ(shell(merge_command({out}, dir / "merged")), 0);
     expect_same_merge(r.merged, dir / "merged");
 }

@@ -85,9 +85,10 @@ TEST(MemoryEstimate, HeaderCountAndRefusal) {
     EXPECT_DOUBLE_EQ(parse_memory_size("512m"), 512.0 * 1024 * 1024);
     for (const char* bad : {"", "0", "-1G", "2X", "G", "1GB"})
         EXPECT_EQ(test::error_code_of([&] { parse_memory_size(bad); }), ExitCode::Usage) << bad;
-    test::write_text(dir / "fake.las", "not a las file at all, just text that is long enough to look like a header to a careless reader"
-                                       "..........................................................................................."
-                                       "...........................................................................................");
+    test::write_text(dir / "fake.las",
+                     "not a las file at all, just text that is long enough to look like a header to a careless reader"
+                     "..........................................................................................."
+                     "...........................................................................................");
     EXPECT_EQ(test::error_code_of([&] { header_point_count(dir / "fake.las"); }), ExitCode::InvalidInput);
 }
 
@@ -96,7 +97,8 @@ TEST(StableTreeId, OneCentimetreCellOfTheBase) {
     EXPECT_EQ(survey::stable_tree_id(-0.005, -12.341), "-0.01_-12.35");
     EXPECT_EQ(survey::stable_tree_id(0.0, 7.0), "0.00_7.00");
     // A base on a cell edge (LAS coordinates on a 1 cm grid) seen through another float frame.
-    for (double noise : {-2e-6, 0.0, 2e-6}) EXPECT_EQ(survey::stable_tree_id(500012.34 + noise, 5400056.70 - noise), "500012.34_5400056.70");
+    for (double noise : {-2e-6, 0.0, 2e-6})
+        EXPECT_EQ(survey::stable_tree_id(500012.34 + noise, 5400056.70 - noise), "500012.34_5400056.70");
     // Two bases in one cell: the lower keeps the id.
     const auto ids = survey::stable_tree_ids({{10.001, 20.001, 301.0}, {10.004, 20.002, 300.0}, {11.0, 20.0, 299.0}});
     EXPECT_EQ(ids, (std::vector<std::string>{"10.00_20.00~2", "10.00_20.00", "11.00_20.00"}));

@@ -72,7 +72,8 @@ TEST(Grow, MainChildContinuesTheStem) {
     int checked = 0;
     for (std::size_t i = 0; i < tree.skeleton.size(); ++i) {
         const auto& children = tree.skeleton.nodes[i].children;
-        const bool continues = std::any_of(children.begin(), children.end(), [&](int c) { return tree.node_level[c] == tree.node_level[i]; });
+        const bool continues =
+                std::any_of(children.begin(), children.end(), [&](int c) { return tree.node_level[c] == tree.node_level[i]; });
         if (children.size() < 2 || !continues) continue;
         EXPECT_EQ(tree.node_level[children[0]], tree.node_level[i]) << "node " << i;
         ++checked;
@@ -102,8 +103,8 @@ TEST(Grow, IndividualsVaryLikeRealTrees) {
     }
     const auto [hlo, hhi] = std::minmax_element(heights.begin(), heights.end());
     const auto [clo, chi] = std::minmax_element(crowns.begin(), crowns.end());
-    EXPECT_GT(*hhi - *hlo, 5.0);   // the 12-28 m range is used
-    EXPECT_GT(*chi / *clo, 1.3);    // crowns differ too
+    EXPECT_GT(*hhi - *hlo, 5.0);  // the 12-28 m range is used
+    EXPECT_GT(*chi / *clo, 1.3);  // crowns differ too
 }
 
 TEST(Grow, SpeciesLookDifferent) {
@@ -233,6 +234,7 @@ TEST(Grow, DeadLowerCrownKeepsBareBranches) {
     const double lowest_leaf = leaf_quantile(b, 0.0);
     bool bare_branch = false;
     for (std::size_t i = 1; i < b.skeleton.size() && !bare_branch; ++i)
-        bare_branch = b.node_level[i] == 1 && b.node_level[b.skeleton.nodes[i].parent] == 0 && b.skeleton.nodes[i].position.z() < lowest_leaf;
+        bare_branch =
+                b.node_level[i] == 1 && b.node_level[b.skeleton.nodes[i].parent] == 0 && b.skeleton.nodes[i].position.z() < lowest_leaf;
     EXPECT_TRUE(bare_branch);
 }

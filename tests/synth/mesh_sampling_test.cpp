@@ -63,8 +63,8 @@ TEST(MeshLabels, NamesDecideMaterialThenGroup) {
     EXPECT_EQ(tree.report.degenerate_faces, 1u);
     MeshLabelReport report;
     const std::vector<std::uint8_t> wood = label_faces(tree, {}, &report);
-    EXPECT_EQ(report.wood_by_name, 20u);  // trunk (material), branch (group "Branch01")
-    EXPECT_EQ(report.leaf_by_name, 9u);   // leaves (material), needles (group)
+    EXPECT_EQ(report.wood_by_name, 20u);     // trunk (material), branch (group "Branch01")
+    EXPECT_EQ(report.leaf_by_name, 9u);      // leaves (material), needles (group)
     EXPECT_EQ(report.leaf_by_geometry, 1u);  // the flat triangle of Part2
     EXPECT_EQ(report.wood_by_geometry, 4u);  // the small solid of Part2
     EXPECT_EQ(report.parts, 2u);

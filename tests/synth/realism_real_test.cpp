@@ -87,8 +87,8 @@ TEST(RealismReal, AlsTileLooksLikeMegaplot) {
     als.pulse_density = 1.0;
     const synth::ReturnMix sim = synth::return_mix(synth::scan_als(tile.scene, als, 1));
 
-    std::printf("Megaplot   %.2f pts/m2 (%.2f first), returns 1/2/3/4+: %.3f %.3f %.3f %.3f\n", real.points_per_m2, real.first_returns_per_m2,
-                real.by_return[0], real.by_return[1], real.by_return[2], real.by_return[3]);
+    std::printf("Megaplot   %.2f pts/m2 (%.2f first), returns 1/2/3/4+: %.3f %.3f %.3f %.3f\n", real.points_per_m2,
+                real.first_returns_per_m2, real.by_return[0], real.by_return[1], real.by_return[2], real.by_return[3]);
     std::printf("simulated  %.2f pts/m2 (%.2f first), returns 1/2/3/4+: %.3f %.3f %.3f %.3f\n", sim.points_per_m2, sim.first_returns_per_m2,
                 sim.by_return[0], sim.by_return[1], sim.by_return[2], sim.by_return[3]);
     RecordProperty("points_per_m2_real", std::to_string(real.points_per_m2));

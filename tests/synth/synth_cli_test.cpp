@@ -47,13 +47,14 @@ TEST(SynthCli, SameSeedGivesByteIdenticalFiles) {
     const std::string args = " --species birch --seed 21 --scanner als --pulse-density 50 --max-leaves 5000 --height 8 --preview";
     ASSERT_EQ(run_cli("synth tree --out " + quoted(a.path()) + args).exit_code, 0);
     ASSERT_EQ(run_cli("synth tree --out " + quoted(b.path()) + args + " --threads 1").exit_code, 0);
-    for (const char* file : {"birch_21.las", "birch_21_skeleton.ply", "birch_21_mesh.ply", "birch_21_truth.json", "birch_21_mesh.png", "birch_21_preview.png",
-                             "birch_21_scan.png"})
+    for (const char* file : {"birch_21.las", "birch_21_skeleton.ply", "birch_21_mesh.ply", "birch_21_truth.json", "birch_21_mesh.png",
+                             "birch_21_preview.png", "birch_21_scan.png"})
         EXPECT_EQ(read_file(a / file), read_file(b / file)) << file;
 
     TempDir c;
-    ASSERT_EQ(run_cli("synth tree --out " + quoted(c.path()) + " --species birch --seed 22 --scanner als --pulse-density 50 --max-leaves 5000 --height 8")
-                  .exit_code,
+    ASSERT_EQ(run_cli("synth tree --out " + quoted(c.path()) +
+                      " --species birch --seed 22 --scanner als --pulse-density 50 --max-leaves 5000 --height 8")
+                      .exit_code,
               0);
     EXPECT_NE(read_file(a / "birch_21_skeleton.ply"), read_file(c / "birch_22_skeleton.ply"));
 }
@@ -83,7 +84,8 @@ TEST(SynthCli, TileWritesLabelledLasTruthAndSkeletons) {
 
 TEST(SynthCli, DatasetWritesLabelsAndResumes) {
     TempDir dir;
-    const std::string args = "synth dataset --per-species 2 --species pine palm --seed 5 --angular-step 0.5 --max-leaves 3000 --out " + quoted(dir.path());
+    const std::string args =
+            "synth dataset --per-species 2 --species pine palm --seed 5 --angular-step 0.5 --max-leaves 3000 --out " + quoted(dir.path());
     const auto first = run_cli(args);
     ASSERT_EQ(first.exit_code, 0) << first.err;
     const std::string labels = read_file(dir / "labels.csv");
