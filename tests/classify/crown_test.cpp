@@ -30,13 +30,21 @@ void add_point(PointCloud& c, float x, float y, float z, std::uint8_t cls, std::
 PointCloud survey_clip(std::uint64_t seed) {
     Rng rng(seed);
     PointCloud c;
-    for (int i = 0; i < 60; ++i) add_point(c, rng.uniform(-5, 5), rng.uniform(-5, 5), 300.0f + rng.uniform(-0.1, 0.1), 2, 40);
+    // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+    // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+    for (int i = 0; i < 60; ++i) {
+        const double z = 300.0f + rng.uniform(-0.1, 0.1), y = rng.uniform(-5, 5), x = rng.uniform(-5, 5);
+        add_point(c, x, y, z, 2, 40);
+    }
     for (int i = 0; i < 200; ++i) {
         const double r = 4 * std::sqrt(rng.uniform(0, 1)), a = rng.uniform(0, 6.283);
         const double top = 320 - 2 * r * r / 16;
         add_point(c, r * std::cos(a), r * std::sin(a), top - rng.uniform(0, 5), 5, 200, 1, 2);
     }
-    for (int i = 0; i < 25; ++i) add_point(c, rng.uniform(-3, 3), rng.uniform(-3, 3), 301.0f + rng.uniform(0, 2), 1, 80, 2, 2);
+    for (int i = 0; i < 25; ++i) {
+        const double z = 301.0f + rng.uniform(0, 2), y = rng.uniform(-3, 3), x = rng.uniform(-3, 3);
+        add_point(c, x, y, z, 1, 80, 2, 2);
+    }
     add_point(c, 1, 1, 299, 7);
     add_point(c, 0, 0, 490, 1);
     return c;

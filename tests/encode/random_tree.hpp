@@ -95,7 +95,10 @@ inline std::vector<float> pipe_radii(const std::vector<int>& parent, double tip_
 
 inline TreeGraph random_tree(const RandomTreeProfile& profile, std::uint32_t seed) {
     TreeRandom random(seed);
-    std::vector<Eigen::Vector3d> position{Eigen::Vector3d(random.uniform(-5, 5), random.uniform(-5, 5), random.uniform(0, 1))};
+    // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+    // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+    const double root_z = random.uniform(0, 1), root_y = random.uniform(-5, 5), root_x = random.uniform(-5, 5);
+    std::vector<Eigen::Vector3d> position{Eigen::Vector3d(root_x, root_y, root_z)};
     std::vector<int> parent{-1};
     const double wiggle = profile.wiggle_degrees * M_PI / 180.0;
     const double branch_angle = profile.branch_angle_degrees * M_PI / 180.0;

@@ -17,7 +17,10 @@ TEST(CircleFit, LeastSquaresRecoversANoisyArcAndRefusesDegenerateInput) {
     std::vector<Eigen::Vector2d> arc;
     for (int i = 0; i < 200; ++i) {
         const double angle = std::numbers::pi * i / 199.0;
-        arc.push_back(Eigen::Vector2d(1 + 0.2 * std::cos(angle) + noise(random), -2 + 0.2 * std::sin(angle) + noise(random)));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const double y = -2 + 0.2 * std::sin(angle) + noise(random), x = 1 + 0.2 * std::cos(angle) + noise(random);
+        arc.push_back(Eigen::Vector2d(x, y));
     }
     const auto circle = fit_circle_least_squares(arc);
     ASSERT_TRUE(circle.has_value());
@@ -42,7 +45,12 @@ TEST(CircleFit, RansacIgnoresOutliersAndReportsCoverage) {
         const float angle = 2.0f * std::numbers::pi_v<float> * unit(random);
         points.emplace_back(0.5f + 0.15f * std::cos(angle), 0.5f + 0.15f * std::sin(angle));
     }
-    for (int i = 0; i < 200; ++i) points.emplace_back(0.4f + 0.2f * unit(random), 0.4f + 0.2f * unit(random));
+    // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+    // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+    for (int i = 0; i < 200; ++i) {
+        const float y = 0.4f + 0.2f * unit(random), x = 0.4f + 0.2f * unit(random);
+        points.emplace_back(x, y);
+    }
     const CircleFit fit = fit_circle(points, 0.01f, 0.05f, 0.5f);
     ASSERT_TRUE(fit.ok);
     EXPECT_NEAR(fit.radius, 0.15f, 0.003f);

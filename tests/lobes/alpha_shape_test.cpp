@@ -22,7 +22,10 @@ std::vector<Eigen::Vector3f> ball(float r, int n, unsigned seed = 3) {
     std::uniform_real_distribution<float> u(-r, r);
     std::vector<Eigen::Vector3f> points;
     while (static_cast<int>(points.size()) < n) {
-        const Eigen::Vector3f p(u(rng), u(rng), u(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const float z = u(rng), y = u(rng), x = u(rng);
+        const Eigen::Vector3f p(x, y, z);
         if (p.norm() <= r) points.push_back(p + Eigen::Vector3f(2, 3, 4));
     }
     return points;

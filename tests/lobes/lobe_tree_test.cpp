@@ -23,7 +23,10 @@ PointCloud trunk_and_crown(std::size_t* crown_points = nullptr) {
     std::uniform_real_distribution<float> u(-0.9f, 0.9f);
     std::size_t added = 0;
     while (added < 5000) {
-        const Eigen::Vector3f p(u(rng), u(rng), u(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const float z = u(rng), y = u(rng), x = u(rng);
+        const Eigen::Vector3f p(x, y, z);
         if (p.norm() > 0.9f) continue;
         cloud.positions.push_back(p + Eigen::Vector3f(0, 0, 3.8f));
         ++added;

@@ -135,7 +135,10 @@ std::vector<Eigen::Vector3f> corner_points(const Eigen::Vector3f& centre) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-0.3f, 0.3f);
     while (pts.size() < 3000) {
-        const Eigen::Vector3f d(u(rng), u(rng), u(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const float z = u(rng), y = u(rng), x = u(rng);
+        const Eigen::Vector3f d(x, y, z);
         if (d.norm() <= 0.3f) pts.push_back(centre + d);
     }
     for (int i = 0; i < 50; ++i) pts.push_back(centre + Eigen::Vector3f(0.5f, 0, -0.4f + 0.016f * i));

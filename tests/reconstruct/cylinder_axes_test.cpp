@@ -33,7 +33,11 @@ std::vector<Eigen::Vector3f> lower_arc(float radius, float half_angle, float len
     const int count = static_cast<int>(static_cast<float>(per_metre) * length);
     for (int i = 0; i < count; ++i) {
         const float a = angle(rng);
-        points.emplace_back(along(rng) + jitter(rng), radius * std::sin(a) + jitter(rng), -radius * std::cos(a) + jitter(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const float z = -radius * std::cos(a) + jitter(rng), y = radius * std::sin(a) + jitter(rng);
+        const float x = along(rng) + jitter(rng);  // along first, then its jitter (GCC's order within the sum)
+        points.emplace_back(x, y, z);
     }
     return points;
 }
@@ -103,7 +107,12 @@ TEST(CylinderAxes, FlatStripIsNotTrusted) {
     std::uniform_real_distribution<float> along(0.0f, 1.0f), across(-0.02f, 0.02f);
     std::normal_distribution<float> jitter(0.0f, 0.002f);
     std::vector<Eigen::Vector3f> points;
-    for (int i = 0; i < 300; ++i) points.emplace_back(along(rng), across(rng), jitter(rng));
+    // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+    // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+    for (int i = 0; i < 300; ++i) {
+        const float z = jitter(rng), y = across(rng), x = along(rng);
+        points.emplace_back(x, y, z);
+    }
     Chain c(points, 1.0f, 0.05f, [](float x) { return Eigen::Vector3f(x, 0.0f, 0.0f); });
     EXPECT_EQ(fit_cylinder_axes(c.tree, points, c.internode, on()), 0u);
     for (std::size_t u = 0; u < c.tree.size(); ++u)

@@ -34,7 +34,10 @@ struct SparseBranchScan {
         std::uniform_real_distribution<float> jitter(-0.004f, 0.004f);
         for (int i = 0; i <= samples; ++i) {
             const float t = static_cast<float>(i) / static_cast<float>(samples);
-            cloud.positions.push_back(branch.a + t * axis + Eigen::Vector3f(jitter(rng), jitter(rng), 0.01f + jitter(rng)));
+            // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+            // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+            const float z = 0.01f + jitter(rng), y = jitter(rng), x = jitter(rng);
+            cloud.positions.push_back(branch.a + t * axis + Eigen::Vector3f(x, y, z));
         }
         branch_end = cloud.positions.size();
         cloud.positions.push_back({-0.8f, 0.5f, 2.0f});
@@ -148,13 +151,21 @@ PointCloud thin_tree(bool leaves) {
     std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
     for (int blade = 0; blade < 8000; ++blade) {
         Eigen::Vector3f c, n;
-        do c = Eigen::Vector3f(unit(rng), unit(rng), unit(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const auto draw = [&] {
+            const float z = unit(rng), y = unit(rng), x = unit(rng);
+            return Eigen::Vector3f(x, y, z);
+        };
+        do c = draw();
         while (c.norm() > 1.0f);
-        do n = Eigen::Vector3f(unit(rng), unit(rng), unit(rng));
+        do n = draw();
         while (n.norm() > 1.0f || n.norm() < 0.1f);
         const Eigen::Vector3f u = n.unitOrthogonal(), v = n.normalized().cross(u);
-        for (int k = 0; k < 4; ++k)
-            cloud.positions.push_back(Eigen::Vector3f(0, 0, 2.5f) + 0.9f * c + 0.02f * (unit(rng) * u + unit(rng) * v));
+        for (int k = 0; k < 4; ++k) {
+            const float along_v = unit(rng), along_u = unit(rng);  // GCC's order within the sum
+            cloud.positions.push_back(Eigen::Vector3f(0, 0, 2.5f) + 0.9f * c + 0.02f * (along_u * u + along_v * v));
+        }
     }
     return cloud;
 }

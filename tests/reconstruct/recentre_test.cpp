@@ -102,7 +102,10 @@ TEST(Recentre, LeavesSharingTheInternodePullLessThanTheBark) {
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     const std::size_t bark = f.points.size();
     for (std::size_t i = 0; i < bark / 3; ++i) {
-        const Eigen::Vector3f p(unit(rng), 0.1f * (unit(rng) - 0.5f), -0.06f - 0.1f * unit(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const float z = -0.06f - 0.1f * unit(rng), y = 0.1f * (unit(rng) - 0.5f), x = unit(rng);
+        const Eigen::Vector3f p(x, y, z);
         f.points.push_back(p);
         f.internode.push_back(std::clamp(static_cast<int>(std::ceil(p.x() / 0.1f)), 1, 10));
     }

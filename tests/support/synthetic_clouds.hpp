@@ -37,7 +37,10 @@ inline void add_cylinder(std::vector<Eigen::Vector3f>& points, const Segment& s,
     for (int i = 0; i < count; ++i) {
         const float a = angle(rng);
         const Eigen::Vector3f n = std::cos(a) * u + std::sin(a) * v;
-        const Eigen::Vector3f jitter3(jitter(rng), jitter(rng), jitter(rng));
+        // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
+        // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
+        const float jitter_z = jitter(rng), jitter_y = jitter(rng), jitter_x = jitter(rng);
+        const Eigen::Vector3f jitter3(jitter_x, jitter_y, jitter_z);
         points.push_back(s.a + along(rng) * t + s.radius * n + jitter3);
     }
 }
