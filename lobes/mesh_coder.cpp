@@ -54,6 +54,15 @@ std::uint64_t ByteReader::varint() {
     fail("malformed varint");
 }
 
+std::int64_t ByteReader::delta_coordinate(std::int64_t base) {
+    constexpr std::int64_t kMax = std::numeric_limits<std::int32_t>::max(), kMin = std::numeric_limits<std::int32_t>::min();
+    const std::int64_t delta = svarint();
+    if (delta < kMin - kMax || delta > kMax - kMin) fail("coordinate delta out of range");
+    const std::int64_t value = base + delta;
+    if (value < kMin || value > kMax) fail("coordinate out of range");
+    return value;
+}
+
 float ByteReader::f32() {
     std::uint32_t bits = 0;
     for (int i = 0; i < 4; ++i) bits |= static_cast<std::uint32_t>(u8()) << (8 * i);
@@ -124,7 +133,7 @@ TriangleMesh decode_mesh(ByteReader& in, double quantum) {
     for (std::size_t i = 0; i < vertices; ++i) {
         Eigen::Vector3f p;
         for (int k = 0; k < 3; ++k) {
-            q[k] += in.svarint();
+            q[k] = in.delta_coordinate(q[k]);
             p[k] = static_cast<float>(static_cast<double>(q[k]) * quantum);
         }
         mesh.vertices.push_back(p);

@@ -41,6 +41,10 @@ public:
         const std::uint64_t v = varint();
         return static_cast<std::int64_t>(v >> 1) ^ -static_cast<std::int64_t>(v & 1);
     }
+    // `base` plus a delta (svarint): the next coordinate of a delta-coded sequence. The writer's
+    // grid coordinates are int32 (quantize), so a result outside that range is a damaged file,
+    // refused before the sum can overflow.
+    std::int64_t delta_coordinate(std::int64_t base);
     float f32();
     double f64();
     std::string string();

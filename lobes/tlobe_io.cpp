@@ -66,7 +66,7 @@ TreeGraph decode_skeleton(ByteReader& in, double quantum, double diameter_quantu
         }
         Eigen::Vector3f p;
         for (int k = 0; k < 3; ++k) {
-            q[i][k] = in.svarint() + (parent >= 0 ? q[parent][k] : 0);
+            q[i][k] = in.delta_coordinate(parent >= 0 ? q[parent][k] : 0);
             p[k] = static_cast<float>(static_cast<double>(q[i][k]) * quantum);
         }
         const double diameter = static_cast<double>(in.varint()) * diameter_quantum;

@@ -6,9 +6,10 @@
 #      TREELOBES_TSAN=1 also the tests of the parallel code under TSan (build-tsan; opt-in until
 #      the reports of Debian's uninstrumented TBB are all suppressed, docs/fuzzing.md)
 #   3. every fuzz target for TREELOBES_FUZZ_SECONDS (default 20) seconds (ctest -L fuzz in build-san)
-# Steps 2-3 run with TREELOBES_HARDENING=1. CI runs step 1 only for now: the tree merged last
-# (LAZ, segment, forestry, survey, export, rebuild) has not yet passed the sanitizer run as a
-# whole, and a step that has never passed must not decide whether a commit lands.
+# Steps 2-3 run with TREELOBES_HARDENING=1. CI runs step 1 only for now: the unit suite passed
+# under ASan + UBSan without a report before the last merges (docs/fuzzing.md), but the merged
+# tree has not been through the sanitized build yet, and a step that has never passed must not
+# decide whether a commit lands.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 step() { echo "test.sh: $1 ($(date -u +%H:%M:%S), ${SECONDS}s so far)" >&2; }

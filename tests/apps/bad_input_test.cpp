@@ -94,8 +94,8 @@ TEST_P(BadInputCorpus, ExitsWithCodeTwoAndOneLineNamingTheProblemAndLeavesNoOutp
     EXPECT_TRUE(only_failure_records(dir.path())) << "output left behind by " << command;
 }
 
-INSTANTIATE_TEST_SUITE_P(Corpus, BadInputCorpus, testing::ValuesIn(kCorpus), [](const auto& info) {
-    std::string name = info.param.file;
+INSTANTIATE_TEST_SUITE_P(Corpus, BadInputCorpus, testing::ValuesIn(kCorpus), [](const auto& param) {
+    std::string name = param.param.file;
     for (char& ch : name)
         if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
     return name;

@@ -226,4 +226,4 @@ TEST_P(Determinism, OneAndTwoThreadsGiveIdenticalOutputs) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Subcommands, Determinism, testing::ValuesIn(kCommands),
-                         [](const auto& info) { return std::string(info.param.name); });
+                         [](const auto& param) { return std::string(param.param.name); });

@@ -259,8 +259,8 @@ TEST_P(OptionSummary, EveryDeclaredFlagAppearsWithItsResolvedValue) {
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(Subcommands, OptionSummary, testing::ValuesIn(kRows), [](const auto& info) {
-    std::string name = info.param.command;
+INSTANTIATE_TEST_SUITE_P(Subcommands, OptionSummary, testing::ValuesIn(kRows), [](const auto& param) {
+    std::string name = param.param.command;
     for (char& c : name)
         if (c == ' ' || c == '-') c = '_';
     return name;

@@ -290,13 +290,14 @@ TEST(ClassifyFeatures, RejectsCloudsThatAreNotTrees) {
     EXPECT_TRUE(std::isnan(feature(compute_features(few, {}, "few.xyz"), "height")));
     PointCloud flat;
     Rng rng(2);
-    for (int i = 0; i < 2000; ++i)
+    for (int i = 0; i < 2000; ++i) {
         // Coordinates drawn one statement each, last first: the order GCC evaluated the arguments in
         // (C++ leaves it open; Clang goes left to right), so both compilers make the same points.
         const auto z = static_cast<float>(rng.normal(0, 0.02));
-    const auto y = static_cast<float>(rng.uniform(0, 10));
-    const auto x = static_cast<float>(rng.uniform(0, 10));
-    flat.positions.emplace_back(x, y, z);
+        const auto y = static_cast<float>(rng.uniform(0, 10));
+        const auto x = static_cast<float>(rng.uniform(0, 10));
+        flat.positions.emplace_back(x, y, z);
+    }
     try {
         compute_features(flat, {}, "lawn.xyz");
         FAIL() << "a flat patch gave features";

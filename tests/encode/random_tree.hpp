@@ -124,8 +124,9 @@ inline TreeGraph random_tree(const RandomTreeProfile& profile, std::uint32_t see
             const int laterals = 1 + random.below(profile.max_laterals);
             for (int k = 0; k < laterals; ++k) {
                 const double angle = branch_angle * random.uniform(0.7, 1.3);
-                const int length = std::max(1, static_cast<int>(remaining * profile.lateral_length_ratio * random.uniform(0.5, 1.2)));
-                stems.push_back({node, detail::turn(direction, angle, random), length, stem.order + 1});
+                const int lateral_internodes =
+                        std::max(1, static_cast<int>(remaining * profile.lateral_length_ratio * random.uniform(0.5, 1.2)));
+                stems.push_back({node, detail::turn(direction, angle, random), lateral_internodes, stem.order + 1});
             }
         }
     }

@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+#include <limits>
 #include <random>
 
 using namespace treelobes;
@@ -213,4 +216,22 @@ TEST(Tlobe, FileRoundTripAndBadOptions) {
     TlobeOptions bad;
     bad.quantum = 0;
     EXPECT_EQ(error_code_of([&] { encode_tlobe(t, bad); }), ExitCode::Usage);
+}
+
+// Found by the tlobe_payload fuzzer (UBSan: signed overflow adding a huge coordinate delta to its
+// parent's coordinate): a delta-coded coordinate outside the writer's int32 grid is bad input.
+TEST(Tlobe, CoordinateDeltaBeyondTheGridIsBadInputNotAnOverflow) {
+    std::ifstream in(test::source_dir() / "tests/data/fuzz/tlobe_payload_coordinate_overflow.bin", std::ios::binary);
+    const std::string payload((std::istreambuf_iterator<char>(in)), {});
+    ASSERT_FALSE(payload.empty());
+    EXPECT_THROW(lobes::decode_tlobe_payload(payload, "fuzz input"), Error);
+
+    ByteWriter out;
+    out.svarint(std::numeric_limits<std::int32_t>::max());
+    out.svarint(1);
+    out.svarint(std::numeric_limits<std::int64_t>::min());
+    ByteReader reader(out.bytes(), "test");
+    EXPECT_EQ(reader.delta_coordinate(0), std::numeric_limits<std::int32_t>::max());
+    EXPECT_THROW(reader.delta_coordinate(std::numeric_limits<std::int32_t>::max()), Error);  // one past the grid
+    EXPECT_THROW(reader.delta_coordinate(0), Error);                                         // an absurd delta
 }
