@@ -15,9 +15,9 @@
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
-#include "lobes/closed_mesh.hpp"
+#include "geometry/closed_mesh.hpp"
 #include "lobes/lobe_tree.hpp"
-#include "lobes/mesh_distance.hpp"
+#include "geometry/mesh_distance.hpp"
 #include "lobes/synthesis.hpp"
 #include "lobes/tlobe_io.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
@@ -90,7 +90,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const OptionTable& table, const
     // Read back what is written: the summary reports the decoded lobes' closedness.
     const lobes::LobeTree decoded = lobes::decode_tlobe(bytes, input.string());
     std::size_t closed = 0;
-    for (const auto& lobe : decoded.lobes) closed += lobes::check_closed(lobe.mesh).closed() && lobe.volume() > 0 ? 1 : 0;
+    for (const auto& lobe : decoded.lobes) closed += check_closed(lobe.mesh).closed() && lobe.volume() > 0 ? 1 : 0;
     const auto coded = std::chrono::steady_clock::now();
 
     const fs::path dir(o.out);
@@ -330,7 +330,7 @@ int run_synthesize(const SynthesizeCliOptions& o, const OptionTable& table, cons
     if (cloud && mesh.triangles() > 0) {
         mark = std::chrono::steady_clock::now();
         const PointCloud tree_points = points_of_tree(*cloud, tree);
-        const lobes::MeshDistance distance(mesh.combined());
+        const MeshDistance distance(mesh.combined());
         const std::vector<float> d = distance.distances(tree_points);
         summary["fidelity"] = {{"points", d.size()},
                                {"median_point_to_mesh", rounded(percentile(d, 0.5))},

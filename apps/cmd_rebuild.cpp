@@ -21,7 +21,7 @@
 #include "core/version.hpp"
 #include "encode/tree_file.hpp"
 #include "lobes/lobe_tree.hpp"
-#include "lobes/mesh_distance.hpp"
+#include "geometry/mesh_distance.hpp"
 #include "lobes/synthesis.hpp"
 #include "lobes/tlobe_io.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
@@ -142,7 +142,7 @@ SpeciesChoice choose_species(const RebuildCliOptions& o, const PointCloud& sampl
     return {name, name, "classifier", p[best]};
 }
 
-json distance_json(const lobes::DistanceSummary& d, double diagonal) {
+json distance_json(const DistanceSummary& d, double diagonal) {
     return {{"mean", rounded(d.mean, 4)},
             {"median", rounded(d.median, 4)},
             {"p95", rounded(d.p95, 4)},
@@ -159,9 +159,9 @@ json compare_surfaces(const TriangleMesh& original, const TriangleMesh& rebuilt,
     const std::vector<std::uint8_t> no_labels_a(original.faces.size(), 1), no_labels_b(rebuilt.faces.size(), 1);
     const PointCloud on_original = synth::sample_surface(original, no_labels_a, samples, seed);
     const PointCloud on_rebuilt = synth::sample_surface(rebuilt, no_labels_b, samples, seed + 1);
-    const lobes::DistanceSummary forward = lobes::summarise_distances(lobes::MeshDistance(rebuilt).distances(on_original));
-    const lobes::DistanceSummary backward = lobes::summarise_distances(lobes::MeshDistance(original).distances(on_rebuilt));
-    lobes::DistanceSummary symmetric;
+    const DistanceSummary forward = summarise_distances(MeshDistance(rebuilt).distances(on_original));
+    const DistanceSummary backward = summarise_distances(MeshDistance(original).distances(on_rebuilt));
+    DistanceSummary symmetric;
     symmetric.count = forward.count + backward.count;
     symmetric.mean = 0.5 * (forward.mean + backward.mean);
     symmetric.median = 0.5 * (forward.median + backward.median);

@@ -3,7 +3,7 @@
 #include "core/error.hpp"
 #include "geometry/grid_thinning.hpp"
 #include "geometry/ransac_fit.hpp"
-#include "lobes/alpha_shape.hpp"
+#include "geometry/alpha_shape.hpp"
 
 #include <boost/geometry.hpp>
 #include <boost/geometry/geometries/multi_point.hpp>
@@ -136,7 +136,7 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
         m.volume_failure = "fewer than 4 crown points";
         return m;
     }
-    const lobes::AlphaShapeResult shape = lobes::alpha_shape(thinned, {.alpha_factor = options.alpha_factor});
+    const AlphaShapeResult shape = alpha_shape(thinned, {.alpha_factor = options.alpha_factor});
     if (!shape.failure.empty())
         m.volume_failure = shape.failure;
     else

@@ -8,7 +8,7 @@
 #include "core/point_cloud.hpp"
 #include "core/tree_graph.hpp"
 #include "core/triangle_mesh.hpp"
-#include "lobes/alpha_shape.hpp"
+#include "geometry/alpha_shape.hpp"
 #include "lobes/occupancy.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
 

@@ -1,7 +1,7 @@
 #include "lobes/mesh_coder.hpp"
 
 #include "core/error.hpp"
-#include "lobes/closed_mesh.hpp"
+#include "geometry/closed_mesh.hpp"
 
 #include <cmath>
 #include <cstring>

@@ -1,4 +1,4 @@
-#include "lobes/closed_mesh.hpp"
+#include "geometry/closed_mesh.hpp"
 #include "lobes/lobe_tree.hpp"
 #include "lobes/tlobe_io.hpp"
 

@@ -1,6 +1,6 @@
 // End to end on real scans: library (lobes closed, .tlobe under the 40 kB of Livny et al. 2011, Table 2, round trip)
 // and the `treelobes lobes` CLI (outputs, summary, exit codes). Small scans only, to stay fast.
-#include "lobes/closed_mesh.hpp"
+#include "geometry/closed_mesh.hpp"
 #include "lobes/lobe_tree.hpp"
 #include "lobes/tlobe_io.hpp"
 

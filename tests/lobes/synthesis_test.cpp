@@ -1,4 +1,4 @@
-#include "lobes/alpha_shape.hpp"
+#include "geometry/alpha_shape.hpp"
 #include "lobes/patch_library.hpp"
 #include "lobes/synthesis.hpp"
 #include "lobes/texturing.hpp"

@@ -1,9 +1,9 @@
-#include "lobes/mesh_distance.hpp"
+#include "geometry/mesh_distance.hpp"
 
 #include <algorithm>
 #include <numeric>
 
-namespace treelobes::lobes {
+namespace treelobes {
 
 DistanceSummary summarise_distances(std::vector<float> distances) {
     DistanceSummary s;
@@ -20,4 +20,4 @@ DistanceSummary summarise_distances(std::vector<float> distances) {
     return s;
 }
 
-}  // namespace treelobes::lobes
+}  // namespace treelobes

@@ -1,4 +1,4 @@
-#include "lobes/closed_mesh.hpp"
+#include "geometry/closed_mesh.hpp"
 
 #include <Eigen/Geometry>
 
@@ -8,7 +8,7 @@
 #include <numeric>
 #include <unordered_map>
 
-namespace treelobes::lobes {
+namespace treelobes {
 
 namespace {
 
@@ -198,4 +198,4 @@ std::vector<int> face_components(const TriangleMesh& mesh, int* count) {
     return component;
 }
 
-}  // namespace treelobes::lobes
+}  // namespace treelobes

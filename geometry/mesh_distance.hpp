@@ -1,4 +1,4 @@
-// Exact point-to-surface distances (CGAL AABB tree over the triangles; lobes/cgal_geometry.cpp).
+// Exact point-to-surface distances (CGAL AABB tree over the triangles; geometry/cgal_surfaces.cpp).
 // Used for the fidelity metrics of a synthesized tree: the one-sided distance from every input
 // point to the synthesized mesh.
 #pragma once
@@ -9,7 +9,7 @@
 #include <memory>
 #include <vector>
 
-namespace treelobes::lobes {
+namespace treelobes {
 
 // Mean, median, 95th percentile and maximum of a list of distances (all 0 for an empty list):
 // one direction of a Metro-style surface comparison (Cignoni et al. 1998), whose maximum is
@@ -38,4 +38,4 @@ private:
     Eigen::Vector3d origin_;
 };
 
-}  // namespace treelobes::lobes
+}  // namespace treelobes

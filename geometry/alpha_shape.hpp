@@ -1,6 +1,7 @@
-// Lobe geometry from a point cluster: CGAL's 3D alpha shapes [Edelsbrunner and Mücke 1994]
-// as in Livny et al. 2011, §4.2, and edge-collapse simplification of the resulting closed surface.
-// Implemented in lobes/cgal_geometry.cpp, the only file that includes CGAL.
+// The closed surface of a point cluster: CGAL's 3D alpha shapes [Edelsbrunner and Mücke 1994]
+// as Livny et al. 2011, §4.2, build their lobes (the forestry measures use them for crown
+// volumes), and edge-collapse simplification of the resulting closed surface.
+// Implemented in geometry/cgal_surfaces.cpp, the only file of these that includes CGAL.
 //
 // alpha_min is CGAL's optimal alpha for one solid component (Alpha_shape_3::find_optimal_alpha(1)):
 // the smallest alpha for which every point is on the boundary or inside the shape and the
@@ -16,7 +17,7 @@
 #include <span>
 #include <string>
 
-namespace treelobes::lobes {
+namespace treelobes {
 
 struct AlphaShapeOptions {
     double alpha_factor = 5.0;  // alpha = alpha_factor * alpha_min (ball radii), Livny et al. 2011, §4.2
@@ -43,4 +44,4 @@ struct SimplifyOptions {
 // again. Returns false and leaves `mesh` unchanged when the mesh cannot be simplified safely.
 bool simplify_closed_mesh(TriangleMesh& mesh, const SimplifyOptions& options = {});
 
-}  // namespace treelobes::lobes
+}  // namespace treelobes

@@ -1,5 +1,5 @@
-#include "lobes/alpha_shape.hpp"
-#include "lobes/closed_mesh.hpp"
+#include "geometry/alpha_shape.hpp"
+#include "geometry/closed_mesh.hpp"
 
 #include "core/error.hpp"
 #include "support/test_support.hpp"
@@ -11,7 +11,6 @@
 #include <random>
 
 using namespace treelobes;
-using namespace treelobes::lobes;
 using treelobes::test::error_code_of;
 
 namespace {

@@ -1,13 +1,14 @@
-// Everything of the lobes stage that uses CGAL, in one translation unit (CGAL is header-only
-// and slow to compile; DESIGN.md keeps third-party types inside .cpp files):
-//   - alpha shapes of lobe clusters (lobes/alpha_shape.hpp),
-//   - edge-collapse simplification of closed lobe surfaces (lobes/alpha_shape.hpp),
-//   - AABB-tree distances from points to a mesh (lobes/mesh_distance.hpp).
+// The closed surfaces built with CGAL, in one translation unit (CGAL is header-only and slow to
+// compile; DESIGN.md keeps third-party types inside .cpp files):
+//   - alpha shapes of point clusters: the lobes (Livny et al. 2011, §4.2) and crown volumes
+//     (geometry/alpha_shape.hpp),
+//   - edge-collapse simplification of closed surfaces (geometry/alpha_shape.hpp),
+//   - AABB-tree distances from points to a mesh (geometry/mesh_distance.hpp).
 // The kernel is Exact_predicates_inexact_constructions: exact orientation and in-sphere tests
 // keep the Delaunay triangulation valid on scanner data with duplicates and coplanar runs.
-#include "lobes/alpha_shape.hpp"
-#include "lobes/closed_mesh.hpp"
-#include "lobes/mesh_distance.hpp"
+#include "geometry/alpha_shape.hpp"
+#include "geometry/closed_mesh.hpp"
+#include "geometry/mesh_distance.hpp"
 
 #include "core/error.hpp"
 
@@ -32,7 +33,7 @@
 #include <cmath>
 #include <map>
 
-namespace treelobes::lobes {
+namespace treelobes {
 
 namespace {
 
@@ -243,4 +244,4 @@ std::vector<float> MeshDistance::distances(const PointCloud& cloud) const {
     return out;
 }
 
-}  // namespace treelobes::lobes
+}  // namespace treelobes

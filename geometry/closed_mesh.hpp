@@ -15,7 +15,7 @@
 #include <cstddef>
 #include <vector>
 
-namespace treelobes::lobes {
+namespace treelobes {
 
 struct ClosedMeshReport {
     std::size_t unpaired_half_edges = 0;  // half-edges without an opposite (holes, flipped faces)
@@ -42,4 +42,4 @@ void remove_unused_vertices(TriangleMesh& mesh);
 // Connected components through shared edges (face -> component id, ids from 0 in face order).
 std::vector<int> face_components(const TriangleMesh& mesh, int* count = nullptr);
 
-}  // namespace treelobes::lobes
+}  // namespace treelobes
