@@ -9,6 +9,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
 using namespace treelobes;
 
 namespace {
@@ -117,4 +121,33 @@ TEST(ReconstructReal, PineWithGround) {
     EXPECT_GT(r.summary.dbh, 0.15f);  // the stem is about 0.28 m thick at breast height
     EXPECT_LT(r.summary.dbh, 0.40f);
     EXPECT_GT(r.summary.height, 18.0f);
+}
+
+// Every LAZ and COPC file under ../shared/data/laz reconstructs from the CLI, whatever its point
+// format. laspy's plane.laz is a 2 x 2 m patch of flat ground (4 cm of relief), not a tree: by
+// default the ground filter leaves no points and the CLI says so in one line; with the ground
+// kept it gives a skeleton flagged not_a_tree.
+TEST(ReconstructReal, EveryLazFileReconstructsFromTheCli) {
+    const auto root = test::real_data_dir();
+    if (root.empty()) return;
+    const test::TempDir out;
+    int files = 0;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(root / "laz")) {
+        if (entry.path().extension() != ".laz") continue;
+        ++files;
+        const std::string stem = test::numbered("run", files);
+        const bool ground_only = entry.path().filename() == "plane.laz";
+        const auto result = test::run_cli("reconstruct " + test::quoted(entry.path()) + " --out " + test::quoted(out / stem) +
+                                          (ground_only ? " --ground keep" : ""));
+        EXPECT_EQ(result.exit_code, 0) << entry.path() << ": " << result.err;
+        if (!ground_only) continue;
+        const auto without_ground = test::run_cli("reconstruct " + test::quoted(entry.path()) + " --out " + test::quoted(out / (stem + "g")));
+        EXPECT_EQ(without_ground.exit_code, 2);
+        EXPECT_NE(without_ground.err.find("too few points left after removing duplicates, outliers and ground"), std::string::npos)
+            << without_ground.err;
+        std::ifstream summary(out / stem / "plane_summary.json");
+        const std::string text{std::istreambuf_iterator<char>(summary), {}};
+        EXPECT_NE(text.find("\"not_a_tree\": true"), std::string::npos);
+    }
+    EXPECT_GE(files, 9);  // MixedConifer, pine, pine_plot and laspy's formats 1, 3, 6, 7, extra bytes, COPC
 }
