@@ -3,8 +3,7 @@
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -85,7 +84,7 @@ FeatureBatch compute_feature_batch(const std::vector<BatchInput>& inputs, const 
         double seconds = 0;
     };
     std::vector<Result> results(inputs.size());
-    tbb::parallel_for(std::size_t(0), inputs.size(), [&](std::size_t k) {
+    treelobes::parallel_for(std::size_t(0), inputs.size(), [&](std::size_t k) {
         const BatchInput& input = inputs[k];
         Result& r = results[k];
         std::vector<Tree> trees;

@@ -3,6 +3,7 @@
 #include "classify/splits.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "core/random.hpp"
 
 #include <algorithm>
@@ -15,7 +16,6 @@
 #include <set>
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 namespace treelobes::classify {
 
@@ -317,7 +317,7 @@ EvaluationReport evaluate(const LabelledSet& set, const std::vector<NamedClassif
     for (std::size_t k = 0; k < classifiers.size(); ++k) {
         std::vector<ClassifierRun> runs(splits);
         const std::clock_t cpu_start = std::clock();
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, splits, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, splits, 1), [&](const tbb::blocked_range<std::size_t>& range) {
             for (std::size_t s = range.begin(); s != range.end(); ++s) {
                 runs[s] = run_experiment(set, classifiers[k].run, train[s], test[s], seeds[s]);
                 const std::lock_guard<std::mutex> lock(progress_mutex);

@@ -4,10 +4,10 @@
 #include "classify/splits.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 
 #include <nlohmann/json.hpp>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
@@ -182,7 +182,7 @@ public:
         std::stable_sort(visit.begin(), visit.end(), [&](std::size_t a, std::size_t b) { return priority_[a] > priority_[b]; });
         std::vector<Candidate> per_feature(f_);
         SharedBest shared;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, visit.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+        treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, visit.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
             for (std::size_t v = r.begin(); v != r.end(); ++v) per_feature[visit[v]] = best_for_feature(visit[v], shared);
         });
         // Serial reduction in feature order: the lower feature index wins a tie.
@@ -233,7 +233,7 @@ private:
     // Sample indices sorted by each candidate feature (stable: equal values keep row order).
     // Constant features and the scan descriptor get an empty order and are never split.
     void presort() {
-        tbb::parallel_for(std::size_t(0), f_, [&](std::size_t f) {
+        treelobes::parallel_for(std::size_t(0), f_, [&](std::size_t f) {
             if (is_scan_descriptor(table_.feature_names[source_[f]])) return;
             std::vector<int> order(n_);
             std::iota(order.begin(), order.end(), 0);

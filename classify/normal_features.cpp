@@ -4,10 +4,10 @@
 // lambda_min / sum lambda as in pcl::solvePlaneParameters). Neighbours come from the frame's kNN
 // table (one query shared with the cleaning and the skeleton, see TreeFrame).
 #include "classify/feature_groups.hpp"
+#include "core/parallel.hpp"
 #include "geometry/kd_tree.hpp"
 
 #include <pcl/common/eigen.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -34,7 +34,7 @@ std::vector<LocalShape> local_shapes(const std::vector<Eigen::Vector3f>& points,
                                      std::vector<float>& nn_distance) {
     std::vector<LocalShape> shapes(points.size());
     nn_distance.assign(points.size(), 0.0f);
-    tbb::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
+    treelobes::parallel_for(std::size_t(0), points.size(), [&](std::size_t i) {
         const int* row = knn.row(i);
         Eigen::Vector3d mean = points[i].cast<double>();
         int n = 1;

@@ -22,6 +22,7 @@
 #include "core/little_endian.hpp"
 #include "core/memory_limit.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "core/version.hpp"
 
 #include <algorithm>
@@ -37,7 +38,6 @@
 #include <iterator>
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -681,7 +681,7 @@ void read_uncompressed_records(InputFile& file, const LasHeader& h, const Record
 void decode_laz_chunks(InputFile& file, const LasSource& src, const std::vector<laz::Chunk>& chunks, const laz::LayerSelection& selection,
                        const RecordSink& sink) {
     const std::uint16_t record_length = src.header.record_length;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+    treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, chunks.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
         Bytes compressed, records;
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             const laz::Chunk& chunk = chunks[i];

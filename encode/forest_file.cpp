@@ -2,9 +2,8 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "encode/coder_best.hpp"
-
-#include <tbb/parallel_for.h>
 
 #include <Eigen/Geometry>
 
@@ -28,7 +27,7 @@ std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& tree
         for (const auto& error : errors)
             if (error) std::rethrow_exception(error);
     };
-    tbb::parallel_for(std::size_t{0}, trees.size(), [&](std::size_t i) {
+    treelobes::parallel_for(std::size_t{0}, trees.size(), [&](std::size_t i) {
         try {
             stored[i] = store_tree(trees[i].skeleton, options, trees[i].name.empty() ? "tree " + std::to_string(i) : trees[i].name);
         } catch (...) {
@@ -40,7 +39,7 @@ std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& tree
                               std::vector<std::vector<StreamSizes>>& sizes) {
         records.assign(trees.size(), {});
         sizes.assign(trees.size(), {});
-        tbb::parallel_for(std::size_t{0}, trees.size(), [&](std::size_t i) {
+        treelobes::parallel_for(std::size_t{0}, trees.size(), [&](std::size_t i) {
             try {
                 records[i] = write_tree_record(stored[i], &sizes[i], prior);
             } catch (...) {

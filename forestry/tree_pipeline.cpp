@@ -2,8 +2,7 @@
 
 #include "classify/feature_table.hpp"
 #include "classify/jointboost.hpp"
-
-#include <tbb/parallel_for.h>
+#include "core/parallel.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -96,7 +95,7 @@ std::vector<TreeOutcome> process_trees(std::span<const TreeInput> trees, const T
     for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
     std::stable_sort(order.begin(), order.end(),
                      [&](std::size_t a, std::size_t b) { return trees[a].points.size() > trees[b].points.size(); });
-    tbb::parallel_for(std::size_t{0}, order.size(), [&](std::size_t k) {
+    treelobes::parallel_for(std::size_t{0}, order.size(), [&](std::size_t k) {
         const std::size_t i = order[k];
         TreeProducts products;
         TreeOutcome outcome;

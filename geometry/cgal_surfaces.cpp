@@ -6,6 +6,7 @@
 //   - AABB-tree distances from points to a mesh (geometry/mesh_distance.hpp).
 // The kernel is Exact_predicates_inexact_constructions: exact orientation and in-sphere tests
 // keep the Delaunay triangulation valid on scanner data with duplicates and coplanar runs.
+#include "core/parallel.hpp"
 #include "geometry/alpha_shape.hpp"
 #include "geometry/closed_mesh.hpp"
 #include "geometry/mesh_distance.hpp"
@@ -26,7 +27,6 @@
 #include <CGAL/Surface_mesh_simplification/edge_collapse.h>
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -237,7 +237,7 @@ double MeshDistance::distance(const Eigen::Vector3d& p) const {
 std::vector<float> MeshDistance::distances(const PointCloud& cloud) const {
     std::vector<float> out(cloud.size());
     const Eigen::Vector3d shift = cloud.origin - origin_;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cloud.size(), 1024), [&](const auto& range) {
+    treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, cloud.size(), 1024), [&](const auto& range) {
         for (std::size_t i = range.begin(); i < range.end(); ++i)
             out[i] = static_cast<float>(distance(cloud.positions[i].cast<double>() + shift));
     });

@@ -1,7 +1,8 @@
 #include "geometry/kd_tree.hpp"
 
+#include "core/parallel.hpp"
+
 #include <flann/flann.hpp>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <limits>
@@ -125,7 +126,7 @@ KnnTable knn_of_all_points(const KdTree& tree, int k) {
     if (!tree.impl_->index || k <= 0) return table;
     const auto& index = *tree.impl_->index;
     const std::size_t capacity = std::min<std::size_t>(static_cast<std::size_t>(k) + 1, n);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+    treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
         // One result set and buffer per block: the same search as knn(), without two
         // allocations per query.
         flann::KNNSimpleResultSet<float> result(capacity);

@@ -2,12 +2,12 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/point_scatter.hpp"
 #include "geometry/union_find.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -312,7 +312,7 @@ NeighbourGraph to_compressed_rows(std::span<const Eigen::Vector3f> points, const
     g.lengths.resize(g.targets.size());
     g.weights.resize(g.targets.size());
     const float exponent = static_cast<float>(beta);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
+    treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t i = range.begin(); i != range.end(); ++i)
             for (std::uint32_t e = g.offsets[i]; e < g.offsets[i + 1]; ++e) {
                 const float length = (points[i] - points[g.targets[e]]).norm();

@@ -1,11 +1,10 @@
 #include "lobes/lobe_tree.hpp"
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "geometry/grid_thinning.hpp"
 #include "geometry/kd_tree.hpp"
 #include "lobes/lobe_split.hpp"
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -123,7 +122,7 @@ LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, c
 
     // Alpha shapes of the clusters, in parallel; results by index keep the output deterministic.
     std::vector<AlphaShapeResult> shapes(split.clusters.size());
-    tbb::parallel_for(std::size_t{0}, split.clusters.size(), [&](std::size_t c) {
+    treelobes::parallel_for(std::size_t{0}, split.clusters.size(), [&](std::size_t c) {
         const LobeCluster& cluster = split.clusters[c];
         if (cluster.points.size() < o.min_cluster_points) return;
         std::vector<Eigen::Vector3f> cluster_points;
@@ -160,7 +159,7 @@ LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, c
     out.skeleton.origin = tree.origin;
 
     out.lobes.resize(kept.size());
-    tbb::parallel_for(std::size_t{0}, kept.size(), [&](std::size_t k) {
+    treelobes::parallel_for(std::size_t{0}, kept.size(), [&](std::size_t k) {
         const LobeCluster& cluster = split.clusters[kept[k]];
         Lobe& lobe = out.lobes[k];
         lobe.mesh = std::move(shapes[kept[k]].mesh);

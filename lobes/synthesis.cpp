@@ -1,10 +1,10 @@
 #include "lobes/synthesis.hpp"
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "core/tree_graph.hpp"
 
 #include <Eigen/Geometry>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -135,7 +135,7 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
     std::vector<std::size_t> caps(tree.lobes.size());
     for (std::size_t i = 0; i < tree.lobes.size(); ++i)
         caps[i] = static_cast<std::size_t>(floor_triangles + std::floor(share(i, total_volume) * shared));
-    tbb::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { texture(i, caps[i]); });
+    treelobes::parallel_for(std::size_t{0}, tree.lobes.size(), [&](std::size_t i) { texture(i, caps[i]); });
     // Spare: what the filled lobes left of the budget; the starved lobes keep their caps.
     double spare = budget, starved_volume = 0;
     std::vector<std::size_t> starved;  // lobes that spent their whole budget below the fill target
@@ -149,7 +149,7 @@ TexturedTree texture_tree(const LobeTree& tree, const SpeciesProfile& species, c
         }
     }
     if (spare >= mean_triangles && !starved.empty())
-        tbb::parallel_for(std::size_t{0}, starved.size(), [&](std::size_t k) {
+        treelobes::parallel_for(std::size_t{0}, starved.size(), [&](std::size_t k) {
             const std::size_t i = starved[k];
             texture(i, caps[i] + static_cast<std::size_t>(std::floor(share(i, starved_volume) * spare)));
         });

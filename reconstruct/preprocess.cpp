@@ -2,12 +2,12 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/point_scatter.hpp"
 #include "geometry/ransac_fit.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
@@ -190,7 +190,7 @@ KnnTable kept_neighbours(const KnnTable& all, const std::vector<int>& final_inde
     const std::size_t n = source.size(), w = static_cast<std::size_t>(width);
     table.indices.assign(n * w, -1);
     table.squared_distances.assign(n * w, std::numeric_limits<float>::infinity());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+    treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& range) {
         std::vector<int> found;
         std::vector<float> d2;
         for (std::size_t i = range.begin(); i != range.end(); ++i) {

@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/log.hpp"
+#include "core/parallel.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/ransac_fit.hpp"
 #include "geometry/shortest_paths.hpp"
@@ -9,7 +10,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <tbb/parallel_invoke.h>
 
 #include <algorithm>
 #include <chrono>
@@ -823,8 +823,8 @@ SkeletonResult reconstruct_skeleton(std::span<const Eigen::Vector3f> points, con
     r.base = find_tree_base(points, graph, o.base);
     // The weighted tree and the geodesic distances are independent runs: one per core.
     ShortestPaths weighted, sp;
-    tbb::parallel_invoke([&] { weighted = shortest_paths(graph, r.base.sources); },
-                         [&] { sp = shortest_paths(graph, r.base.sources, EdgeCost::Length); });
+    treelobes::parallel_invoke([&] { weighted = shortest_paths(graph, r.base.sources); },
+                               [&] { sp = shortest_paths(graph, r.base.sources, EdgeCost::Length); });
     lap("base and shortest paths");
     const float root_spread = r.base.circle_fitted ? r.base.foot_radius : 0.0f;
     const Slicing slicing{points, graph, near, sp, weighted, r.bin_width, merge, root_spread, o.geodesic_smoothing};

@@ -1,12 +1,12 @@
 #include "synth/scanner.hpp"
 
 #include "core/error.hpp"
+#include "core/parallel.hpp"
 #include "core/random.hpp"
 #include "synth/ray_scene.hpp"
 
 #include <Eigen/Geometry>
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -125,7 +125,7 @@ private:
 template <typename Line>
 std::vector<Sample> run_lines(std::size_t lines, std::uint64_t seed, Line line) {
     std::vector<std::vector<Sample>> parts(lines);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 4), [&](const tbb::blocked_range<std::size_t>& range) {
+    treelobes::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 4), [&](const tbb::blocked_range<std::size_t>& range) {
         for (std::size_t k = range.begin(); k != range.end(); ++k) {
             Rng rng(stream_seed(seed, k));
             line(k, rng, parts[k]);

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <set>
 
 using namespace treelobes;
@@ -199,10 +200,14 @@ TEST(ClassifyEvaluation, SiteSplitTestsEachGroupOnTheOthers) {
     LabelledSet set = clustered_set(2, 9, 0.3, true, 2);
     for (std::size_t r = 0; r < set.labels.size(); ++r) set.groups.push_back("tile" + std::to_string(r % 3));
     std::vector<std::pair<std::size_t, std::size_t>> sizes;  // (train, test) rows seen by the classifier
+    std::mutex sizes_mutex;                                  // the splits run in parallel (ThreadSanitizer found the unguarded push)
     NamedClassifier spy = nearest_mean();
     const Classifier inner = spy.run;
     spy.run = [&](const FeatureTable& train, const std::vector<int>& y, int classes, const FeatureTable& test, std::uint64_t seed) {
-        sizes.emplace_back(train.rows(), test.rows());
+        {
+            const std::lock_guard lock(sizes_mutex);
+            sizes.emplace_back(train.rows(), test.rows());
+        }
         for (const auto& id : test.ids) EXPECT_FALSE(train.find(id)) << id << " is in both sets";
         return inner(train, y, classes, test, seed);
     };
