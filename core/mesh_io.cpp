@@ -14,8 +14,11 @@
 #include <OpenMesh/Core/System/omstream.hh>
 
 #include <array>
+#include <charconv>
 #include <cmath>
 #include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -44,16 +47,45 @@ Eigen::Vector3d origin_for(const PolyMesh& mesh) {
     return mesh_origin_for(Eigen::Vector3d(p[0], p[1], p[2]));
 }
 
-// OpenMesh's PLY reader loops forever on a header that never ends (found by
-// fuzz/mesh_fuzz.cpp), so the header must reach its end_header line within 64 kB.
-void check_ply_header_ends(const fs::path& path, const std::string& name) {
+// OpenMesh's PLY reader loops forever on a header it cannot parse (found by fuzz/mesh_fuzz.cpp:
+// a header that never ends; a format line whose version is not a number, after which its stream
+// fails and its keyword loop no longer advances). So the header is checked first: it starts with
+// "ply", reaches end_header within 64 kB, and each line is a PLY header line with readable values.
+void check_ply_header(const fs::path& path, const std::string& name) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
     std::size_t read = 0;
-    while (read < 65536 && std::getline(in, line)) {
+    for (int number = 1; read < 65536 && std::getline(in, line); ++number) {
         read += line.size() + 1;
         if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line == "end_header") return;
+        std::istringstream words(line);
+        std::vector<std::string> word{std::istream_iterator<std::string>(words), {}};
+        const auto bad = [&](const std::string& what) {
+            throw Error::input(name, "PLY header line " + std::to_string(number) + ": " + what);
+        };
+        const auto is_number = [](const std::string& text) {
+            double value = 0;
+            const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
+            return error == std::errc() && end == text.data() + text.size();
+        };
+        if (number == 1) {
+            if (line != "ply") bad("the file does not start with 'ply'");
+            continue;
+        }
+        if (word.empty() || word[0] == "comment" || word[0] == "obj_info") continue;
+        if (word[0] == "end_header") return;
+        if (word[0] == "format") {
+            if (word.size() != 3 || (word[1] != "ascii" && word[1] != "binary_little_endian" && word[1] != "binary_big_endian") ||
+                !is_number(word[2]))
+                bad("expected 'format ascii|binary_little_endian|binary_big_endian VERSION'");
+        } else if (word[0] == "element") {
+            if (word.size() != 3 || word[2].find_first_not_of("0123456789") != std::string::npos) bad("expected 'element NAME COUNT'");
+        } else if (word[0] == "property") {
+            if (word.size() != (word.size() > 1 && word[1] == "list" ? 5u : 3u))
+                bad("expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+        } else {
+            bad("unknown keyword '" + word[0].substr(0, 32) + "'");
+        }
     }
     throw Error::input(name, "PLY header has no end_header line");
 }
@@ -62,7 +94,7 @@ void check_ply_header_ends(const fs::path& path, const std::string& name) {
 // faces with a repeated corner or a corner index out of range.
 NamedMesh read_with_openmesh(const fs::path& path) {
     const std::string name = path.string();
-    if (file_extension(path) == "ply") check_ply_header_ends(path, name);
+    if (file_extension(path) == "ply") check_ply_header(path, name);
     silence_openmesh();
     PolyMesh mesh;
     OpenMesh::IO::Options options;

@@ -52,6 +52,39 @@ double field_value(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f,
     }
 }
 
+// Bytes of one value of a PCL datatype; 0 for a datatype PCL could not make of the header's
+// SIZE and TYPE (e.g. a SIZE that is not a number).
+std::size_t datatype_bytes(std::uint8_t datatype) {
+    switch (datatype) {
+        case pcl::PCLPointField::INT8:
+        case pcl::PCLPointField::UINT8:
+            return 1;
+        case pcl::PCLPointField::INT16:
+        case pcl::PCLPointField::UINT16:
+            return 2;
+        case pcl::PCLPointField::INT32:
+        case pcl::PCLPointField::UINT32:
+        case pcl::PCLPointField::FLOAT32:
+            return 4;
+        case pcl::PCLPointField::FLOAT64:
+            return 8;
+        default:
+            return 0;
+    }
+}
+
+// Every field must be of a known type and lie inside the point record, or reading it would run
+// past the record (found by fuzz/pcd_fuzz.cpp: "SIZE 4 z 4" gave a field of no known type).
+void check_fields(const pcl::PCLPointCloud2& blob, const std::string& name) {
+    for (const auto& f : blob.fields) {
+        const std::size_t bytes = datatype_bytes(f.datatype);
+        if (bytes == 0) throw Error::input(name, "PCD field '" + f.name + "' has no valid SIZE and TYPE");
+        if (static_cast<std::size_t>(f.offset) + bytes * std::max<std::size_t>(f.count, 1) > blob.point_step)
+            throw Error::input(
+                    name, "PCD field '" + f.name + "' does not fit in the point record of " + std::to_string(blob.point_step) + " bytes");
+    }
+}
+
 AttributeType attribute_type(std::uint8_t datatype) {
     switch (datatype) {
         case pcl::PCLPointField::INT8:
@@ -137,6 +170,7 @@ PointCloud read_pcd(const fs::path& path) {
     pcl::PCLPointCloud2 blob;
     pcl::PCDReader reader;
     if (reader.read(name, blob) < 0) throw Error::input(name, "cannot read PCD (malformed or truncated file)");
+    check_fields(blob, name);
     const auto* fx = find_field(blob, "x");
     const auto* fy = find_field(blob, "y");
     const auto* fz = find_field(blob, "z");

@@ -27,9 +27,11 @@ struct CodedStreams {
     std::vector<std::uint8_t> radii;
 };
 
-// Decoders refuse codes longer than this (a corrupt count must not allocate gigabytes); the
-// largest real trees have ~10^5 internodes and ~10^6 symbols.
-inline constexpr std::size_t kMaxCodeSymbols = std::size_t{1} << 28;
+// Decoders refuse codes longer than this: a corrupt count must not allocate gigabytes, and the
+// interpolative coder stores a run of equal values in no bits at all, so a few hundred bytes can
+// claim any count (fuzz/forest_fuzz.cpp found one decoding for 19 s under ASan at the old limit of
+// 2^28). The largest real trees have ~10^5 internodes and ~10^6 symbols: 2^24 leaves 16x.
+inline constexpr std::size_t kMaxCodeSymbols = std::size_t{1} << 24;
 
 // Throws Error(InvalidInput) naming `context` when a symbol is not 0..8 or the number of radii
 // differs from the number of internodes (6, 7 and 8).

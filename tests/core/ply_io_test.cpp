@@ -237,6 +237,20 @@ TEST(Pcd, HeaderWithoutFieldsIsBadInputNotACrash) {
     EXPECT_EQ(error_code_of([&] { read_pcd(dir / "nofields.pcd"); }), ExitCode::InvalidInput);
 }
 
+// Fuzzing found it in CI: "SIZE 4 z 4 ..." gave y a field type PCL could not name, which the
+// reader took for 8-byte doubles and read past the point record.
+TEST(Pcd, FieldWithoutAValidSizeIsBadInputNotAnOverflow) {
+    EXPECT_EQ(error_code_of([&] { read_pcd(test::source_dir() / "tests/data/fuzz/pcd_field_outside_record.pcd"); }),
+              ExitCode::InvalidInput);
+}
+
+// Found by fuzzing in CI: a format line whose version is not a number left OpenMesh's header loop
+// spinning on a failed stream.
+TEST(MeshRead, PlyFormatVersionNotANumberIsBadInputNotAHang) {
+    EXPECT_EQ(error_code_of([&] { read_mesh(test::source_dir() / "tests/data/fuzz/ply_format_version_not_a_number.ply"); }),
+              ExitCode::InvalidInput);
+}
+
 TEST(MeshRead, PlyHeaderWithoutEndIsBadInputNotAHang) {
     TempDir dir;
     write_text(dir / "open.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n0 0 0\n");

@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "encode/coder.hpp"
 #include "encode/coder_best.hpp"
+#include "encode/bitstream.hpp"
 #include "encode/coder_ic.hpp"
 #include "encode/lod.hpp"
 #include "encode/tree_code.hpp"
@@ -115,6 +116,23 @@ TEST(Coders, InvalidInputIsRejectedBeforeCoding) {
 // §3.3 on the radii of Fig. 6 (R = 10,9,6,3 | 4,3 | 2 | 1; branches end at each 7): zero-aligned
 // by the smallest radius 1 -> 9,8,5,2 | 3,2 | 1 | 0; inverted sublists 2,5,8,9 | 2,3 | 1 | 0 ->
 // d-gaps 2,3,3,1 | 2,1 | 1 | 0 -> cumulative sum 2,5,8,9,11,12,13,13.
+// The interpolative coder stores a run of equal values in no bits, so a few bytes can claim any
+// symbol count: found by fuzz/forest_fuzz.cpp in CI, a record decoding for 19 s under ASan. Counts
+// above kMaxCodeSymbols are refused before anything is allocated.
+TEST(IcCoder, ASymbolCountAboveTheLimitIsRefusedBeforeDecoding) {
+    BitWriter out;
+    write_count(out, kMaxCodeSymbols + 1);
+    for (int i = 0; i < 64; ++i) out.write_bit(false);
+    const std::vector<std::uint8_t> bytes = out.take();
+    try {
+        ic_decode_symbols(bytes, "record");
+        FAIL() << "a code longer than the limit was decoded";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.code(), ExitCode::InvalidInput);
+        EXPECT_NE(std::string(e.what()).find("exceeds the decoder limit"), std::string::npos) << e.what();
+    }
+}
+
 TEST(IcCoder, RadiiTransformOfFig6) {
     const std::string symbols = test::kFig4DBF6;
     const std::vector<int> radii{10, 9, 6, 3, 4, 3, 2, 1};
