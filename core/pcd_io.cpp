@@ -16,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <set>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -136,7 +137,7 @@ void store_field(const pcl::PCLPointCloud2& blob, const pcl::PCLPointField& f, c
 }
 
 // PCL's reader dereferences null pointers on headers without their FIELDS, SIZE or TYPE lines
-// (found by fuzz/pcd_fuzz.cpp), so the header is checked first: every required keyword once,
+// (found by fuzz/pcd_fuzz.cpp), so the header is checked first: only PCD keywords, every required one,
 // FIELDS, SIZE, TYPE (and COUNT) with the same number of entries.
 void check_pcd_header(const fs::path& path, const std::string& name) {
     std::ifstream in(path, std::ios::binary);
@@ -146,6 +147,10 @@ void check_pcd_header(const fs::path& path, const std::string& name) {
         std::istringstream words(line);
         std::string keyword, value;
         if (!(words >> keyword) || keyword[0] == '#') continue;
+        static const std::set<std::string> kKeywords{"VERSION", "FIELDS", "SIZE",      "TYPE",   "COUNT",
+                                                     "WIDTH",   "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+        if (!kKeywords.count(keyword))  // PCL crashed on a header line of binary garbage (fuzzing in CI)
+            throw Error::input(name, "PCD header line " + std::to_string(lines + 1) + " is not a PCD header line");
         std::size_t count = 0;
         while (words >> value) ++count;
         entries[keyword] = count;
