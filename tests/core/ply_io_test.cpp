@@ -251,6 +251,30 @@ TEST(MeshRead, PlyFormatVersionNotANumberIsBadInputNotAHang) {
               ExitCode::InvalidInput);
 }
 
+// Found by fuzzing: OpenMesh asked for 1.6 GB on a small OFF file whose vertex lines were damaged,
+// and PCL's PCD reader crashed on a header line of binary garbage.
+TEST(MeshRead, DamagedOffIsBadInputBeforeOpenMeshReadsIt) {
+    TempDir dir;
+    const std::string vertices = "OFF\n3 1 0\n0 0 0\n1 0 0\n";
+    write_text(dir / "vertex.off", vertices + "0 1 0-05 x\n3 0 1 2\n");
+    write_text(dir / "count.off", "OFF\n99999999 1 0\n0 0 0\n");
+    write_text(dir / "corner.off", vertices + "0 1 0\n3 0 1 7\n");
+    write_text(dir / "binary.off", "OFF BINARY\n");
+    for (const char* file : {"vertex.off", "count.off", "corner.off", "binary.off"})
+        EXPECT_EQ(error_code_of([&] { read_mesh(dir / file); }), ExitCode::InvalidInput) << file;
+    write_text(dir / "good.off", vertices + "0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(read_mesh(dir / "good.off").faces.size(), 1u);
+}
+
+TEST(Pcd, GarbageHeaderLineIsBadInputNotACrash) {
+    TempDir dir;
+    const std::string garbage = std::string("\xd7\xa3\xbb") + '\0' + "F";  // bytes of the fuzzer's input
+    write_text(dir / "garbage.pcd", "# .PCD v0.7\n" + garbage +
+                                            "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+                                            "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    EXPECT_EQ(error_code_of([&] { read_pcd(dir / "garbage.pcd"); }), ExitCode::InvalidInput);
+}
+
 TEST(MeshRead, PlyHeaderWithoutEndIsBadInputNotAHang) {
     TempDir dir;
     write_text(dir / "open.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n0 0 0\n");
