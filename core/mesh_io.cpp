@@ -18,6 +18,7 @@
 #include <cmath>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 #include <string>
 
@@ -50,11 +51,15 @@ Eigen::Vector3d origin_for(const PolyMesh& mesh) {
 // OpenMesh's PLY reader loops forever on a header it cannot parse (found by fuzz/mesh_fuzz.cpp:
 // a header that never ends; a format line whose version is not a number, after which its stream
 // fails and its keyword loop no longer advances). So the header is checked first: it starts with
-// "ply", reaches end_header within 64 kB, and each line is a PLY header line with readable values.
+// "ply", reaches end_header within 64 kB, and each line is a PLY header line with readable values,
+// properties after an element and of PLY's types.
 void check_ply_header(const fs::path& path, const std::string& name) {
     std::ifstream in(path, std::ios::binary);
+    static const std::set<std::string> kPlyTypes{"char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
+                                                 "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
     std::string line;
     std::size_t read = 0;
+    bool in_element = false;
     for (int number = 1; read < 65536 && std::getline(in, line); ++number) {
         read += line.size() + 1;
         if (!line.empty() && line.back() == '\r') line.pop_back();
@@ -80,9 +85,14 @@ void check_ply_header(const fs::path& path, const std::string& name) {
                 bad("expected 'format ascii|binary_little_endian|binary_big_endian VERSION'");
         } else if (word[0] == "element") {
             if (word.size() != 3 || word[2].find_first_not_of("0123456789") != std::string::npos) bad("expected 'element NAME COUNT'");
+            in_element = true;
         } else if (word[0] == "property") {
-            if (word.size() != (word.size() > 1 && word[1] == "list" ? 5u : 3u))
-                bad("expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+            // OpenMesh wrote through a null pointer on a property before any element (fuzzing, 60 s with seed 1).
+            if (!in_element) bad("a property before any element");
+            const bool list = word.size() > 1 && word[1] == "list";
+            if (word.size() != (list ? 5u : 3u)) bad("expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+            for (std::size_t k = list ? 2 : 1; k + 1 < word.size(); ++k)
+                if (!kPlyTypes.count(word[k])) bad("unknown property type '" + word[k].substr(0, 16) + "'");
         } else {
             bad("unknown keyword '" + word[0].substr(0, 32) + "'");
         }

@@ -74,6 +74,53 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     EXPECT_GE(png.width, 3 * 40);
 }
 
+// --species auto: without --model the documented default (generic reconstruction parameters,
+// crape myrtle patches); with --model the classifier's most probable species, here from a model
+// trained on the committed synthetic birch, crape myrtle and palm scans.
+TEST(RebuildCli, SpeciesAutoTakesTheClassifiersChoiceElseTheDefault) {
+    TempDir in, training, with_model, without_model;
+    const auto mesh = small_tree_obj(in);
+    const std::filesystem::path synthetic = test::source_dir() / "data/synthetic";
+    std::string labels = "file,species\n";
+    for (const std::string tree : {"birch_3", "lagerstroemia_2", "palm_1"})
+        for (const std::string copy : {"a", "b"}) {
+            std::filesystem::copy_file(synthetic / (tree + ".las"), training / (tree + copy + ".las"));
+            labels += tree + copy + ".las," + tree.substr(0, tree.find('_')) + "\n";
+        }
+    test::write_text(training / "labels.csv", labels);
+    const std::string model = quoted(training / "model.json");
+    ASSERT_EQ(run_cli("classify features " + quoted(training.path()) + "/*.las --relative-to " + quoted(training.path()) + " --out " +
+                      quoted(training / "features.csv"))
+                      .exit_code,
+              0);
+    ASSERT_EQ(run_cli("classify train " + quoted(training / "features.csv") + " --labels " + quoted(training / "labels.csv") + " --out " +
+                      model + " --folds 0 --max-rounds 20 --no-scan-routing")
+                      .exit_code,
+              0);
+
+    const auto classified = run_cli("rebuild " + quoted(mesh) + " --out " + quoted(with_model.path()) + " --species auto --model " + model +
+                                    kFastRebuild + " --json");
+    ASSERT_EQ(classified.exit_code, 0) << classified.err;
+    const auto chosen = nlohmann::json::parse(classified.out)["species"];
+    EXPECT_EQ(chosen["source"], "classifier");
+    EXPECT_GT(chosen["probability"].get<double>(), 0.0);
+    EXPECT_LE(chosen["probability"].get<double>(), 1.0);
+    const std::string species = chosen["patches"].get<std::string>();
+    EXPECT_TRUE(species == "birch" || species == "lagerstroemia" || species == "palm") << species;
+    EXPECT_EQ(chosen["reconstruction"], species);
+
+    const auto fallback = run_cli("rebuild " + quoted(mesh) + " --out " + quoted(without_model.path()) + kFastRebuild + " --json");
+    ASSERT_EQ(fallback.exit_code, 0) << fallback.err;
+    const auto fallback_species = nlohmann::json::parse(fallback.out)["species"];
+    EXPECT_EQ(fallback_species["source"], "default");
+    EXPECT_EQ(fallback_species["patches"], "lagerstroemia");
+    EXPECT_TRUE(fallback_species["reconstruction"].is_null());
+    EXPECT_TRUE(fallback_species["probability"].is_null());
+
+    EXPECT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(without_model.path()) + " --species palm --model " + model).exit_code,
+              1);
+}
+
 TEST(RebuildCli, SameInputSameOutputs) {
     TempDir in, a, b;
     const auto mesh = small_tree_obj(in);

@@ -280,3 +280,37 @@ TEST(MeshRead, PlyHeaderWithoutEndIsBadInputNotAHang) {
     write_text(dir / "open.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n0 0 0\n");
     EXPECT_EQ(error_code_of([&] { read_mesh(dir / "open.ply"); }), ExitCode::InvalidInput);
 }
+
+// Found by the 60-second fuzz runs with seed 1: PCL threw std::length_error from inside its
+// reader on a COUNT of "1%" (an internal error, exit 4, instead of bad input).
+TEST(Pcd, HeaderValueThatIsNotANumberIsBadInput) {
+    EXPECT_EQ(error_code_of([&] { read_pcd(test::source_dir() / "tests/data/fuzz/pcd_count_not_a_number.pcd"); }), ExitCode::InvalidInput);
+    TempDir dir;
+    write_text(dir / "type.pcd",
+               "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F Q\nCOUNT 1 1 1\n"
+               "WIDTH 1\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+    EXPECT_EQ(error_code_of([&] { read_pcd(dir / "type.pcd"); }), ExitCode::InvalidInput);
+    // The second finding of those runs: PCL threw from inside its header parser on repeated and
+    // overlapping header lines.
+    EXPECT_EQ(error_code_of([&] { read_pcd(test::source_dir() / "tests/data/fuzz/pcd_header_repeated_lines.pcd"); }),
+              ExitCode::InvalidInput);
+    // The third: NUL bytes in the FIELDS line made PCL use memory it had freed (ASan).
+    EXPECT_EQ(error_code_of([&] { read_pcd(test::source_dir() / "tests/data/fuzz/pcd_fields_line_with_nul_bytes.pcd"); }),
+              ExitCode::InvalidInput);
+}
+
+// Found by the 60-second fuzz runs with seed 1: OpenMesh's PLY reader wrote through a null
+// pointer (SEGV) on a property declared before any element; unknown property types are refused too.
+TEST(MeshRead, PlyPropertyBeforeAnyElementIsBadInputNotACrash) {
+    EXPECT_EQ(error_code_of([&] { read_mesh(test::source_dir() / "tests/data/fuzz/ply_property_before_element.ply"); }),
+              ExitCode::InvalidInput);
+    TempDir dir;
+    write_text(dir / "type.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty real z\n"
+               "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(error_code_of([&] { read_mesh(dir / "type.ply"); }), ExitCode::InvalidInput);
+    write_text(dir / "good.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+               "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(read_mesh(dir / "good.ply").faces.size(), 1u);
+}

@@ -197,3 +197,10 @@ TEST(QsmIo, BadQsmFilesAreInputErrors) {
     EXPECT_EQ(detect_qsm_file(dir / "missing.csv"), QsmFileKind::None);
     EXPECT_EQ(test::error_code_of([&] { read_qsm(dir / "nothing.txt"); }), ExitCode::InvalidInput);
 }
+
+// Found by the 60-second fuzz runs with seed 1: a CSV header naming columns twice let rows
+// through that were narrower than the columns read from them (heap-buffer-overflow under ASan).
+TEST(QsmIo, CsvHeaderNamingAColumnTwiceIsBadInputNotAnOverflow) {
+    EXPECT_EQ(test::error_code_of([&] { read_qsm(test::source_dir() / "tests/data/fuzz/qsm_csv_column_named_twice.csv"); }),
+              ExitCode::InvalidInput);
+}
