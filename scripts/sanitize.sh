@@ -3,7 +3,7 @@
 #
 #   scripts/sanitize.sh asan   build-san (clang, ASan + UBSan): every unit test (label `unit`,
 #                              CLI tests included, running the sanitized binary) but the three
-#                              `slow` ones (a 24-tree plot each, 2-4 minutes under ASan); not the
+#                              three SurveyBuffer ones (a 24-tree plot each, 2-4 minutes under ASan); not the
 #                              `real` tests (minutes each, the normal build runs them)
 #   scripts/sanitize.sh tsan   build-tsan (clang, ThreadSanitizer): only the test programs of the
 #                              parallel code (kNN, neighbour graph and Dijkstra in reconstruct,
@@ -25,7 +25,7 @@ TSAN_TESTS=(reconstruct_test classify_jointboost_test classify_evaluation_test s
 
 run_asan() {
   build_sanitized all
-  ctest --test-dir "$SAN_BUILD_DIR" -L unit -LE slow --output-on-failure -j "$(nproc)" --timeout 900
+  ctest --test-dir "$SAN_BUILD_DIR" -L unit -E '^SurveyBuffer[.]' --output-on-failure -j "$(nproc)" --timeout 900
 }
 
 run_tsan() {

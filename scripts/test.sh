@@ -2,7 +2,7 @@
 # Everything CI proves on every commit (.ci/run calls exactly this), in three steps:
 #   1. set-up (scripts/setup.sh), the Release build and the whole suite: unit tests and the
 #      end-to-end tests on the real scans in ../shared/data (label `real`; TREELOBES_REAL_DATA)
-#   2. the sanitizers (scripts/sanitize.sh): the unit tests but the `slow` ones under ASan + UBSan
+#   2. the sanitizers (scripts/sanitize.sh): the unit tests but the three SurveyBuffer ones under ASan + UBSan
 #      (build-san), the tests of the parallel code under TSan (build-tsan)
 #   3. every fuzz target but pcd for TREELOBES_FUZZ_SECONDS (default 20) seconds (ctest -L fuzz in
 #      build-san); pcd stays out while PCL's PCD reader, which it fuzzes, still fails under ASan
