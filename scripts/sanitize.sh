@@ -3,7 +3,7 @@
 #
 #   scripts/sanitize.sh asan   build-san (clang, ASan + UBSan): every unit test (label `unit`,
 #                              CLI tests included, running the sanitized binary) but the three
-#                              three SurveyBuffer ones (a 24-tree plot each, 2-4 minutes under ASan); not the
+#                              SurveyBuffer ones (a 24-tree plot each, 2-4 minutes under ASan); not the
 #                              `real` tests (minutes each, the normal build runs them)
 #   scripts/sanitize.sh tsan   build-tsan (clang, ThreadSanitizer): only the test programs of the
 #                              parallel code (kNN, neighbour graph and Dijkstra in reconstruct,
