@@ -5,6 +5,7 @@
 //   evaluate  DATASET_DIR... --splits 100 --out report/   the paper's protocol, voting, XGBoost
 #include "apps/command.hpp"
 #include "apps/option_table.hpp"
+#include "apps/summary_values.hpp"
 #include "classify/batch.hpp"
 #include "classify/evaluation.hpp"
 #include "classify/feature_table.hpp"
@@ -35,12 +36,6 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 using namespace treelobes::classify;
-
-std::string format(const char* pattern, double value) {
-    char text[64];
-    std::snprintf(text, sizeof text, pattern, value);
-    return text;
-}
 
 void print(const json& summary, const GlobalOptions& global, const std::string& human) {
     if (global.json)
@@ -125,7 +120,7 @@ int run_features(const FeaturesCommand& c, const OptionTable& option_table, cons
     print(summary, global,
           std::to_string(batch.table.rows()) + " trees x " + std::to_string(batch.table.cols()) + " features -> " + c.out +
                   (batch.failures.empty() ? "" : " (" + std::to_string(batch.failures.size()) + " failed, see failures.jsonl)") +
-                  format(" (%.1f s)\n", batch.seconds) + removed_line(summary["removed"]));
+                  format_numbers(" (%.1f s)\n", batch.seconds) + removed_line(summary["removed"]));
     return batch.failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
 }
 
@@ -143,7 +138,7 @@ int run_train(const TrainCommand& c, const OptionTable& option_table, const Glob
     const auto start = std::chrono::steady_clock::now();
     JointBoostReport report;
     const JointBoostModel model = train_jointboost(set.features, set.labels, set.classes, c.options, &report);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = seconds_since(start);
     save_jointboost(model, c.out);
     int correct = 0;
     for (std::size_t r = 0; r < table.rows(); ++r) {
@@ -169,15 +164,15 @@ int run_train(const TrainCommand& c, const OptionTable& option_table, const Glob
                                    {"threshold", model.route_threshold},
                                    {"sparse_classes", model.parts[0].classes.size()},
                                    {"dense_classes", model.parts[1].classes.size()}};
-        routing = "  one model per scan kind: " + model.feature_names[model.route_feature] + format(" <= %.1f", model.route_threshold) +
-                  " (sparse: " + std::to_string(report.parts[0].rounds) +
+        routing = "  one model per scan kind: " + model.feature_names[model.route_feature] +
+                  format_numbers(" <= %.1f", model.route_threshold) + " (sparse: " + std::to_string(report.parts[0].rounds) +
                   " rounds), above (dense: " + std::to_string(report.parts[1].rounds) + " rounds)\n";
     }
     print(summary, global,
           "JointBoost: " + std::to_string(table.rows()) + " trees, " + std::to_string(set.classes.size()) + " species, " +
                   std::to_string(table.cols()) + " features, " + std::to_string(report.rounds) + " rounds (early stop after " +
-                  std::to_string(report.rounds_tried) + format(", temperature %.2f", report.temperature) + "), training accuracy " +
-                  format("%.1f %%", 100 * accuracy) + " -> " + c.out + format(" (%.2f s)\n", seconds) + routing);
+                  std::to_string(report.rounds_tried) + format_numbers(", temperature %.2f", report.temperature) + "), training accuracy " +
+                  format_numbers("%.1f %%", 100 * accuracy) + " -> " + c.out + format_numbers(" (%.2f s)\n", seconds) + routing);
     return 0;
 }
 
@@ -242,9 +237,9 @@ int run_predict(const PredictCommand& c, const OptionTable& option_table, const 
         confident += sure;
         changed += c.vote && vote.changed[r];
         ++counts[final_species];
-        csv += table.ids[r] + "," + model.classes[best] + "," + format("%.4f", p[r][best]) + "," + (sure ? "1" : "0");
+        csv += table.ids[r] + "," + model.classes[best] + "," + format_numbers("%.4f", p[r][best]) + "," + (sure ? "1" : "0");
         if (c.vote) csv += "," + final_species;
-        for (double v : p[r]) csv += "," + format("%.4f", v);
+        for (double v : p[r]) csv += "," + format_numbers("%.4f", v);
         csv += "\n";
         trees.push_back({{"id", table.ids[r]}, {"species", final_species}, {"probability", p[r][best]}, {"confident", sure}});
     }
@@ -346,7 +341,7 @@ NamedClassifier jointboost_classifier(const JointBoostOptions& base) {
                 const auto trained = std::chrono::steady_clock::now();
                 for (std::size_t r = 0; r < test.rows(); ++r) run.probabilities.push_back(model.probabilities(test.row(r)));
                 run.train_seconds = std::chrono::duration<double>(trained - start).count();
-                run.predict_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - trained).count();
+                run.predict_seconds = seconds_since(trained);
                 run.rounds = report.rounds;
                 return run;
             }};

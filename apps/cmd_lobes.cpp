@@ -9,20 +9,20 @@
 #include "apps/option_table.hpp"
 #include "apps/reconstruction_flags.hpp"
 #include "apps/summary_values.hpp"
-#include "core/cloud_io.hpp"
+#include "config/species_profile.hpp"
 #include "core/atomic_file.hpp"
+#include "core/cloud_io.hpp"
 #include "core/error.hpp"
+#include "core/log.hpp"
 #include "core/mesh_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
 #include "geometry/closed_mesh.hpp"
-#include "lobes/lobe_tree.hpp"
 #include "geometry/mesh_distance.hpp"
+#include "lobes/lobe_tree.hpp"
 #include "lobes/synthesis.hpp"
 #include "lobes/tlobe_io.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
-#include "config/species_profile.hpp"
-#include "core/log.hpp"
 #include "render/rasterizer.hpp"
 
 #include <nlohmann/json.hpp>
@@ -200,10 +200,6 @@ struct SynthesizeCliOptions {
     double lod = 1.0;
     lobes::SynthesisOptions synthesis;
 };
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 double percentile(std::vector<float> values, double q) {
     if (values.empty()) return 0.0;

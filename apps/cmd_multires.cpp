@@ -9,6 +9,7 @@
 // textures stand in for the branches its chain prefix has not reached (combined LOD, §3.3).
 #include "apps/command.hpp"
 #include "apps/option_table.hpp"
+#include "apps/summary_values.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
@@ -69,10 +70,6 @@ struct Source {
     Eigen::Vector3d origin{0, 0, 0};
     std::size_t derived_modules = 0;  // L-system: modules before the homomorphism
 };
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 std::map<std::string, double> parse_defines(const std::vector<std::string>& items) {
     std::map<std::string, double> defines;

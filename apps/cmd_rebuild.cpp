@@ -20,8 +20,8 @@
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
 #include "encode/tree_file.hpp"
-#include "lobes/lobe_tree.hpp"
 #include "geometry/mesh_distance.hpp"
+#include "lobes/lobe_tree.hpp"
 #include "lobes/synthesis.hpp"
 #include "lobes/tlobe_io.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
@@ -355,7 +355,7 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     std::size_t lobe_faces = 0;
     for (const auto& lobe : tree.lobes) lobe_faces += lobe.mesh.faces.size();
     json seconds = clock.seconds();
-    seconds["total"] = rounded(std::chrono::duration<double>(Clock::now() - started).count(), 3);
+    seconds["total"] = rounded(seconds_since(started), 3);
     seconds["cpu"] = rounded(cpu_seconds(), 3);  // all threads; on a busy machine a steadier figure than the wall time
     json report = {{"treelobes", kVersion},
                    {"command", "rebuild"},

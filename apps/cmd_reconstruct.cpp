@@ -154,15 +154,15 @@ nlohmann::json run_one(const ReconstructCliOptions& o, const OptionTable& table,
                                                    " of the points lie on wide planes (drop --reject-non-trees to keep it)");
     auto mark = std::chrono::steady_clock::now();
     const TriangleMesh mesh = build_branch_mesh(r.skeleton, o.mesh);
-    r.summary.seconds.emplace_back("mesh", std::chrono::duration<double>(std::chrono::steady_clock::now() - mark).count());
+    r.summary.seconds.emplace_back("mesh", seconds_since(mark));
     mark = std::chrono::steady_clock::now();
     write_skeleton_ply(r.skeleton, out.skeleton);
     write_mesh(mesh, out.branches);
     write_points(cloud, r, out.points);
-    r.summary.seconds.emplace_back("write", std::chrono::duration<double>(std::chrono::steady_clock::now() - mark).count());
+    r.summary.seconds.emplace_back("write", seconds_since(mark));
     nlohmann::json summary = summary_json(o, table, input, out, r);
     write_file_atomically(out.summary, summary.dump(2) + "\n");  // last: its presence marks a finished tree
-    if (!global.json) print_human(input, r.summary, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (!global.json) print_human(input, r.summary, seconds_since(start));
     return summary;
 }
 

@@ -169,8 +169,6 @@ fs::path prepare_folder(const std::string& out) {
     return out;
 }
 
-double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
-
 json metrics_json(const synth::TreeMetrics& m, double age) {
     return {{"height_m", m.height_m},
             {"dbh_m", m.dbh_m},
@@ -269,12 +267,6 @@ void print_or_json(const json& summary, const GlobalOptions& global, const std::
         std::cout << human;
 }
 
-std::string format(const char* pattern, double a, double b = 0, double c = 0) {
-    char text[256];
-    std::snprintf(text, sizeof text, pattern, a, b, c);
-    return text;
-}
-
 int run_tree(SynthFlags f, const TreeFlags& t, const OptionTable& table, const GlobalOptions& global) {
     const auto start = Clock::now();
     if (f.scanner.empty()) f.scanner = "tls";
@@ -303,11 +295,11 @@ int run_tree(SynthFlags f, const TreeFlags& t, const OptionTable& table, const G
     const json& tree = r.truth["tree"];
     print_or_json(
             summary, global,
-            profile.entry.display_name + " (seed " + std::to_string(f.seed) +
-                    "): " + format("height %.1f m, DBH %.2f m, crown %.1f m", tree["height_m"], tree["dbh_m"], tree["crown_diameter_m"]) +
+            profile.entry.display_name + " (seed " + std::to_string(f.seed) + "): " +
+                    format_numbers("height %.1f m, DBH %.2f m, crown %.1f m", tree["height_m"], tree["dbh_m"], tree["crown_diameter_m"]) +
                     ", " + std::to_string(tree["internodes"].get<std::size_t>()) + " internodes, " +
                     std::to_string(tree["leaves"].get<std::size_t>()) + " leaves\n" + f.scanner + " scan: " + std::to_string(r.points) +
-                    " points -> " + (folder / (name + "." + f.cloud_format)).string() + format(" (%.1f s)\n", summary["seconds"]));
+                    " points -> " + (folder / (name + "." + f.cloud_format)).string() + format_numbers(" (%.1f s)\n", summary["seconds"]));
     return 0;
 }
 
@@ -392,7 +384,7 @@ int run_dataset(SynthFlags f, const DatasetFlags& d, const OptionTable& table, c
     print_or_json(summary, global,
                   std::to_string(made + skipped) + " trees of " + std::to_string(chosen.size()) + " species (" + std::to_string(made) +
                           " made, " + std::to_string(skipped) + " kept, " + std::to_string(failed) + " failed), " + std::to_string(points) +
-                          " points -> " + (folder / "labels.csv").string() + format(" (%.1f s)\n", summary["seconds"]));
+                          " points -> " + (folder / "labels.csv").string() + format_numbers(" (%.1f s)\n", summary["seconds"]));
     return failed ? static_cast<int>(ExitCode::PartialFailure) : 0;
 }
 
@@ -469,9 +461,10 @@ int run_tile(SynthFlags f, TileFlags t, const OptionTable& table, const GlobalOp
                     {"peak_memory_mb", peak_memory_mb()}};
     write_file_atomically(folder / "summary.json", summary.dump(2) + "\n");
     print_or_json(summary, global,
-                  format("tile %.0f x %.0f m", t.tile.size_m, t.tile.size_m) + ", " + std::to_string(tile.scene.trees.size()) + " trees, " +
-                          f.scanner + " scan: " + std::to_string(cloud.size()) + format(" points (%.2f per m^2) -> ", cloud.size() / area) +
-                          cloud_file.string() + format(" (%.1f s)\n", seconds_since(start)));
+                  format_numbers("tile %.0f x %.0f m", t.tile.size_m, t.tile.size_m) + ", " + std::to_string(tile.scene.trees.size()) +
+                          " trees, " + f.scanner + " scan: " + std::to_string(cloud.size()) +
+                          format_numbers(" points (%.2f per m^2) -> ", cloud.size() / area) + cloud_file.string() +
+                          format_numbers(" (%.1f s)\n", seconds_since(start)));
     return 0;
 }
 

@@ -101,13 +101,6 @@ const char* kTlobeSuffix = ".tlobe";
 const char* kDbf6Suffix = ".dbf6";
 const char* kRecordSuffix = ".json";
 
-double seconds_since(Clock::time_point& mark) {
-    const auto now = Clock::now();
-    const double s = std::chrono::duration<double>(now - mark).count();
-    mark = now;
-    return s;
-}
-
 // The resolved options that shape the outputs (summary.json records them; the per-tree part is
 // the key that lets a re-run reuse a finished tree).
 json tree_options_json(const TileCliOptions& o) {
@@ -348,10 +341,10 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         buffered = survey::add_buffer(std::move(buffered.cloud), o.input, *plan.core, o.buffer, plan.candidates);
     }
     const PointCloud& cloud = buffered.cloud;
-    seconds["read"] = rounded(seconds_since(mark));
+    seconds["read"] = rounded(lap_seconds(mark));
 
     const Terrain terrain = analyse_terrain(cloud, o.terrain);
-    seconds["terrain"] = rounded(seconds_since(mark));
+    seconds["terrain"] = rounded(lap_seconds(mark));
     TreeSegmentation segmentation;
     std::map<int, Eigen::Vector3d> bases;
     if (o.use_input_segmentation) {
@@ -364,7 +357,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     const std::size_t trees_in_buffer = plan.core ? keep_core_trees(trees, segmentation.tree_id, *plan.core, cloud.origin) : 0;
     const std::map<int, std::string> global_ids = survey_ids(trees, cloud.origin);
     for (forestry::TreeInput& tree : trees) order_points_by_position(tree);
-    seconds["segmentation"] = rounded(seconds_since(mark));
+    seconds["segmentation"] = rounded(lap_seconds(mark));
     if (trees.empty())
         log_warn(o.input + ": no trees found (" + std::to_string(terrain.ground_points) + " of " + std::to_string(cloud.size()) +
                  " points are ground); the outputs list none");
@@ -405,7 +398,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         for (std::size_t k = 0; k < made.size(); ++k) outcomes[todo_index[k]] = made[k];
     }
     todo.clear();
-    seconds["trees"] = rounded(seconds_since(mark));
+    seconds["trees"] = rounded(lap_seconds(mark));
     for (auto& [stage, s] : stage_seconds.items()) s = rounded(s.get<double>());
     seconds["tree_stages_summed"] = stage_seconds;
 
@@ -437,7 +430,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     for (std::size_t i : todo_index)  // after the tree's files: a record marks a finished tree
         if (row_of[i] != SIZE_MAX)
             write_file_atomically(out.tree_file(outcomes[i].id, kRecordSuffix), forestry::tree_record(rows[row_of[i]], cloud.origin, key));
-    seconds["species"] = rounded(seconds_since(mark));
+    seconds["species"] = rounded(lap_seconds(mark));
 
     // Tile outputs.
     write_output(out.points, o.overwrite, [&] {
@@ -467,8 +460,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     } else {
         fs::remove(out.failures, ec);  // a failure list of an earlier run no longer holds
     }
-    seconds["outputs"] = rounded(seconds_since(mark));
-    seconds["total"] = rounded(std::chrono::duration<double>(Clock::now() - start).count());
+    seconds["outputs"] = rounded(lap_seconds(mark));
+    seconds["total"] = rounded(seconds_since(start));
 
     json dbh = json::object();
     const std::string dbh_text = dbh_counts(rows, dbh);

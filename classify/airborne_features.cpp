@@ -25,8 +25,8 @@ namespace treelobes::classify::detail {
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-constexpr int kLayers = 5;        // density profile layers
-constexpr double kTopCell = 1.0;  // crown-top raster cell, m (ALS: a few points per m^2)
+constexpr int kDensityLayers = 5;  // density profile layers
+constexpr double kTopCell = 1.0;   // crown-top raster cell, m (ALS: a few points per m^2)
 
 // Missing values stay NaN here (the other groups map an undefined ratio to 0).
 void emit(FeatureSink& out, const std::string& name, double value) {
@@ -106,9 +106,10 @@ void add_shape(const CrownPoints& p, FeatureSink& out) {
     emit(out, "als_crown_radius", p.radius);
     emit(out, "als_radius_height_ratio", ratio(p.radius, p.top));
     emit(out, "als_crown_depth_ratio", ratio(p.top - quantile(p.h, 0.1), p.top));
-    std::vector<std::size_t> layer(kLayers, 0);
-    for (float h : p.h) ++layer[std::min(kLayers - 1, static_cast<int>(p.top > 0 ? kLayers * h / p.top : kLayers - 1))];
-    for (int k = 0; k < kLayers; ++k) emit(out, indexed("als_layer_share", k), share(layer[k], p.h.size()));
+    std::vector<std::size_t> layer(kDensityLayers, 0);
+    for (float h : p.h)
+        ++layer[std::min(kDensityLayers - 1, static_cast<int>(p.top > 0 ? kDensityLayers * h / p.top : kDensityLayers - 1))];
+    for (int k = 0; k < kDensityLayers; ++k) emit(out, indexed("als_layer_share", k), share(layer[k], p.h.size()));
     const Moments m = moments(p.h);
     emit(out, "als_height_cv", ratio(m.sd, m.mean));
     emit(out, "als_height_q25", quantile(p.h, 0.25));
@@ -243,7 +244,7 @@ void describe_airborne(Catalogue& c) {
     c.add("als_crown_radius", "m", "90 % quantile of the crown points' horizontal distances to their centroid");
     c.add("als_radius_height_ratio", "1", "als_crown_radius / als_height");
     c.add("als_crown_depth_ratio", "1", "(als_height - 10 % height quantile of the crown points) / als_height");
-    for (int k = 0; k < kLayers; ++k)
+    for (int k = 0; k < kDensityLayers; ++k)
         c.add(indexed("als_layer_share", k), "1",
               "density profile: share of the crown points with height / als_height in [" + std::to_string(k * 20) + ", " +
                       std::to_string((k + 1) * 20) + ") %");

@@ -9,31 +9,31 @@
 #include <cmath>
 #include <set>
 #include <tuple>
+#include <numbers>
 
 namespace treelobes::classify::detail {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr int kLayers = 10;       // envelope and occupancy layers (each H/10 high)
-constexpr int kSectors = 16;      // azimuth sectors of the envelope
-constexpr int kCellDivisor = 20;  // occupancy cells of size H/20
-constexpr int kRings = 5;         // radial rings r / R in [0, 0.2), ..., [0.8, inf)
+constexpr int kEnvelopeLayers = 10;   // envelope and occupancy layers (each H/10 high)
+constexpr int kEnvelopeSectors = 16;  // azimuth sectors of the envelope
+constexpr int kCellDivisor = 20;      // occupancy cells of size H/20
+constexpr int kRings = 5;             // radial rings r / R in [0, 0.2), ..., [0.8, inf)
 
 // Per layer: the area of the star-shaped polygon through the outermost point of each azimuth
 // sector (an empty sector contributes radius 0), in m^2.
 std::vector<double> layer_envelope_areas(const TreeFrame& f) {
-    std::vector<std::vector<float>> outer(kLayers, std::vector<float>(kSectors, 0.0f));
+    std::vector<std::vector<float>> outer(kEnvelopeLayers, std::vector<float>(kEnvelopeSectors, 0.0f));
     for (std::size_t i = 0; i < f.points.size(); ++i) {
-        const int k = std::min(kLayers - 1, static_cast<int>(f.rel_height[i] * kLayers));
-        const double phi = std::atan2(f.points[i].y(), f.points[i].x()) + kPi;  // [0, 2 pi]
-        const int s = std::min(kSectors - 1, static_cast<int>(phi / (2 * kPi) * kSectors));
+        const int k = std::min(kEnvelopeLayers - 1, static_cast<int>(f.rel_height[i] * kEnvelopeLayers));
+        const double phi = std::atan2(f.points[i].y(), f.points[i].x()) + std::numbers::pi;  // [0, 2 pi]
+        const int s = std::min(kEnvelopeSectors - 1, static_cast<int>(phi / (2 * std::numbers::pi) * kEnvelopeSectors));
         outer[k][s] = std::max(outer[k][s], f.radius[i]);
     }
-    const double wedge = 0.5 * std::sin(2 * kPi / kSectors);
-    std::vector<double> area(kLayers, 0.0);
-    for (int k = 0; k < kLayers; ++k)
-        for (int s = 0; s < kSectors; ++s) area[k] += wedge * outer[k][s] * outer[k][(s + 1) % kSectors];
+    const double wedge = 0.5 * std::sin(2 * std::numbers::pi / kEnvelopeSectors);
+    std::vector<double> area(kEnvelopeLayers, 0.0);
+    for (int k = 0; k < kEnvelopeLayers; ++k)
+        for (int s = 0; s < kEnvelopeSectors; ++s) area[k] += wedge * outer[k][s] * outer[k][(s + 1) % kEnvelopeSectors];
     return area;
 }
 
@@ -55,13 +55,13 @@ double cumulative_height(const std::vector<double>& per_layer, double share) {
 }  // namespace
 
 void describe_envelope(Catalogue& c) {
-    const std::string sectors = std::to_string(kSectors);
-    for (int k = 0; k < kLayers; ++k)
+    const std::string sectors = std::to_string(kEnvelopeSectors);
+    for (int k = 0; k < kEnvelopeLayers; ++k)
         c.add(indexed("env_area", k), "1",
               "crown outline area in height layer " + std::to_string(k + 1) + " of 10 (h in [" + std::to_string(k) + ", " +
                       std::to_string(k + 1) + ") / 10): star polygon through the outermost voxel point of each of " + sectors +
                       " azimuth sectors, / (pi R^2)");
-    for (int k = 0; k < kLayers; ++k)
+    for (int k = 0; k < kEnvelopeLayers; ++k)
         c.add(indexed("env_volume_share", k), "1",
               "share of the envelope volume (sum of the layer outline areas) in height layer " + std::to_string(k + 1) + " of 10");
     for (int d = 1; d <= 9; ++d)
@@ -69,7 +69,7 @@ void describe_envelope(Catalogue& c) {
               "relative height h below which " + std::to_string(10 * d) + " % of the envelope volume lies (linear within layers)");
     c.add("env_volume_ratio", "1", "envelope volume (layer outline areas x H/10) / (pi R^2 H)");
     c.add("env_widest_layer", "1", "relative height of the centre of the layer with the largest outline area");
-    for (int k = 0; k < kLayers; ++k)
+    for (int k = 0; k < kEnvelopeLayers; ++k)
         c.add(indexed("occ_share", k), "1",
               "share of the occupied cells (size H/20, any point counts once) in height layer " + std::to_string(k + 1) + " of 10");
     for (int d = 1; d <= 9; ++d)
@@ -91,15 +91,16 @@ void describe_envelope(Catalogue& c) {
 
 void compute_envelope(const TreeFrame& f, FeatureSink& out) {
     const std::vector<double> area = layer_envelope_areas(f);
-    const double disc = kPi * f.crown_radius * f.crown_radius;
+    const double disc = std::numbers::pi * f.crown_radius * f.crown_radius;
     double volume = 0;
-    for (double a : area) volume += a * f.height / kLayers;
-    for (int k = 0; k < kLayers; ++k) out.add(indexed("env_area", k), area[k] / disc);
-    for (int k = 0; k < kLayers; ++k) out.add(indexed("env_volume_share", k), volume > 0 ? area[k] * f.height / kLayers / volume : 0.0);
+    for (double a : area) volume += a * f.height / kEnvelopeLayers;
+    for (int k = 0; k < kEnvelopeLayers; ++k) out.add(indexed("env_area", k), area[k] / disc);
+    for (int k = 0; k < kEnvelopeLayers; ++k)
+        out.add(indexed("env_volume_share", k), volume > 0 ? area[k] * f.height / kEnvelopeLayers / volume : 0.0);
     for (int d = 1; d <= 9; ++d) out.add(indexed("env_volume_decile", d), cumulative_height(area, d / 10.0));
     out.add("env_volume_ratio", volume / (disc * f.height));
     const auto widest = std::max_element(area.begin(), area.end()) - area.begin();
-    out.add("env_widest_layer", (static_cast<double>(widest) + 0.5) / kLayers);
+    out.add("env_widest_layer", (static_cast<double>(widest) + 0.5) / kEnvelopeLayers);
 
     // Cells indexed in the tree frame (origin on the stem axis at the ground), so they turn and
     // move with the tree.
@@ -112,14 +113,14 @@ void compute_envelope(const TreeFrame& f, FeatureSink& out) {
         cells.insert({x, y, z});
         plan.insert({x, y});
     }
-    std::vector<double> per_layer(kLayers, 0.0);
+    std::vector<double> per_layer(kEnvelopeLayers, 0.0);
     std::vector<float> heights;
     for (const auto& [x, y, z] : cells) {
-        per_layer[std::min<long>(kLayers - 1, z * kLayers / kCellDivisor)] += 1.0;
+        per_layer[std::min<long>(kEnvelopeLayers - 1, z * kEnvelopeLayers / kCellDivisor)] += 1.0;
         heights.push_back((static_cast<float>(z) + 0.5f) / kCellDivisor);
     }
     const double occupied = static_cast<double>(cells.size());
-    for (int k = 0; k < kLayers; ++k) out.add(indexed("occ_share", k), occupied > 0 ? per_layer[k] / occupied : 0.0);
+    for (int k = 0; k < kEnvelopeLayers; ++k) out.add(indexed("occ_share", k), occupied > 0 ? per_layer[k] / occupied : 0.0);
     for (int d = 1; d <= 9; ++d) out.add(indexed("occ_decile", d), quantile(heights, d / 10.0));
     // Top and bottom surfaces per ring. The lowest 5 % of the height (stem foot, ground) is left
     // out of the bottom, so a visible trunk does not make every inner ring reach the ground.

@@ -9,6 +9,7 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
 #include <cmath>
+#include <numbers>
 
 namespace treelobes::classify::detail {
 
@@ -18,7 +19,6 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Delaunay = CGAL::Delaunay_triangulation_3<Kernel>;
 using Point = Kernel::Point_3;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kAlphaDivisors[] = {10, 20, 40};  // alpha radius = H / divisor
 
 // One point per cell of size `cell` (the first one met), as CGAL points.
@@ -76,8 +76,8 @@ void compute_hull(const TreeFrame& f, FeatureSink& out) {
     const double box = double(f.height) * (quantile(x, 0.98) - quantile(x, 0.02)) * (quantile(y, 0.98) - quantile(y, 0.02));
     const double h = f.height, r = f.crown_radius;
     out.add("hull_box_ratio", box > 0 ? volume / box : 0.0);
-    out.add("hull_cylinder_ratio", volume / (kPi * r * r * h));
-    out.add("hull_sphericity", area > 0 ? std::cbrt(kPi) * std::pow(6 * volume, 2.0 / 3.0) / area : 0.0);
+    out.add("hull_cylinder_ratio", volume / (std::numbers::pi * r * r * h));
+    out.add("hull_sphericity", area > 0 ? std::cbrt(std::numbers::pi) * std::pow(6 * volume, 2.0 / 3.0) / area : 0.0);
     out.add("hull_centroid_height", volume > 0 ? centroid_z / volume / h : 0.0);
     for (std::size_t k = 0; k < std::size(kAlphaDivisors); ++k)
         out.add("alpha_hull_ratio_" + std::to_string(kAlphaDivisors[k]), volume > 0 ? alpha_volume[k] / volume : 0.0);

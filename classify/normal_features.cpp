@@ -4,6 +4,7 @@
 // lambda_min / sum lambda as in pcl::solvePlaneParameters). Neighbours come from the frame's kNN
 // table (one query shared with the cleaning and the skeleton, see TreeFrame).
 #include "classify/feature_groups.hpp"
+#include "core/angles.hpp"
 #include "core/parallel.hpp"
 #include "geometry/kd_tree.hpp"
 
@@ -16,7 +17,6 @@ namespace treelobes::classify::detail {
 
 namespace {
 
-constexpr double kRadToDeg = 57.29577951308232;
 constexpr int kAngleBins = 9;       // 10 degree bins over 0..90
 constexpr int kLayerAngleBins = 6;  // 15 degree bins per crown third
 constexpr int kCurvatureBins = 8;   // over 0 .. 1/3 (the maximum of lambda_min / sum)
@@ -123,7 +123,7 @@ void compute_normals(const TreeFrame& f, FeatureSink& out) {
         if (!s.valid) continue;
         n += 1;
         const double nz = std::min(1.0f, std::abs(s.normal.z()));
-        const double elev = std::asin(nz) * kRadToDeg;
+        const double elev = std::asin(nz) * kDegreesPerRadian;
         elevation[bin(elev, 10, kAngleBins)] += 1;
         const int third = std::min(2, static_cast<int>(f.rel_height[i] * 3));
         layered[third][bin(elev, 15, kLayerAngleBins)] += 1;
@@ -132,7 +132,7 @@ void compute_normals(const TreeFrame& f, FeatureSink& out) {
         if (f.radius[i] > f.voxel) {
             const Eigen::Vector2f radial = f.points[i].head<2>() / f.radius[i];
             const double c = std::min(1.0f, std::abs(s.normal.head<2>().dot(radial)));
-            axis_angle[bin(std::acos(c) * kRadToDeg, 10, kAngleBins)] += 1;
+            axis_angle[bin(std::acos(c) * kDegreesPerRadian, 10, kAngleBins)] += 1;
             axis_sum += c, n_axis += 1;
         }
         surface_variation.push_back(s.l3);
@@ -141,7 +141,7 @@ void compute_normals(const TreeFrame& f, FeatureSink& out) {
         lin += linearity, pla += planarity, sca += scattering;
         if (linearity >= planarity && linearity >= scattering) {
             n_linear += 1;
-            direction[bin(std::asin(std::min(1.0f, std::abs(s.direction.z()))) * kRadToDeg, 15, kDirectionBins)] += 1;
+            direction[bin(std::asin(std::min(1.0f, std::abs(s.direction.z()))) * kDegreesPerRadian, 15, kDirectionBins)] += 1;
         } else if (planarity >= scattering) {
             n_planar += 1;
         } else {

@@ -12,17 +12,17 @@
 #include <complex>
 #include <optional>
 #include <unordered_map>
+#include <numbers>
 
 namespace treelobes::classify::detail {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kProfileLayers = 15;    // radial profile layers
 constexpr int kCrownBaseLayers = 50;  // layers scanned for the crown base
 constexpr int kHeightBins = 20;
 constexpr int kRadialBins = 10;
-constexpr int kSectors = 8;
+constexpr int kCrownSectors = 8;
 
 // Indices of voxel points whose relative height lies in [lo, hi).
 std::vector<std::size_t> layer(const TreeFrame& f, double lo, double hi) {
@@ -247,7 +247,7 @@ void describe_horizontal(Catalogue& c) {
             c.add(std::string("azimuth_fourier_") + thirds[t] + "_" + std::to_string(m), "1",
                   "|mean of exp(i " + std::to_string(m) + " phi)| over the azimuths phi of the " + thirds[t] +
                           " third's points with r > 0.2 R (crown asymmetry; 0 = round)");
-    for (int k = 0; k < kSectors; ++k)
+    for (int k = 0; k < kCrownSectors; ++k)
         c.add(indexed("sector_radius_sorted", k + 1), "1",
               "crown outline: 90 % radius / R in each of 8 azimuth sectors (45 deg, from the major axis) of the crown, sorted "
               "from the largest; this is rank " +
@@ -289,16 +289,16 @@ void compute_horizontal(const TreeFrame& f, FeatureSink& out) {
         for (int m = 1; m <= 3; ++m)
             out.add(std::string("azimuth_fourier_") + thirds[t] + "_" + std::to_string(m), n > 0 ? std::abs(sum[m - 1]) / n : 0.0);
     }
-    std::vector<std::vector<float>> sectors(kSectors);
+    std::vector<std::vector<float>> sectors(kCrownSectors);
     for (std::size_t i = 0; i < f.points.size(); ++i) {
         if (f.points[i].z() < f.crown_base) continue;
-        const double phi = std::atan2(f.points[i].y(), f.points[i].x()) + kPi;  // [0, 2 pi]
-        sectors[std::min(kSectors - 1, static_cast<int>(phi / (2 * kPi) * kSectors))].push_back(f.radius[i]);
+        const double phi = std::atan2(f.points[i].y(), f.points[i].x()) + std::numbers::pi;  // [0, 2 pi]
+        sectors[std::min(kCrownSectors - 1, static_cast<int>(phi / (2 * std::numbers::pi) * kCrownSectors))].push_back(f.radius[i]);
     }
     std::vector<float> sector_radius;
     for (auto& s : sectors) sector_radius.push_back(quantile(s, 0.9) / f.crown_radius);
     std::sort(sector_radius.begin(), sector_radius.end(), std::greater<>());
-    for (int k = 0; k < kSectors; ++k) out.add(indexed("sector_radius_sorted", k + 1), sector_radius[k]);
+    for (int k = 0; k < kCrownSectors; ++k) out.add(indexed("sector_radius_sorted", k + 1), sector_radius[k]);
     const Moments m = moments(sector_radius);
     out.add("sector_radius_cv", m.mean > 0 ? m.sd / m.mean : 0.0);
     const double ratio = f.major_variance > 0 ? f.minor_variance / f.major_variance : 0.0;
@@ -470,7 +470,8 @@ void compute_structure(const TreeFrame& f, FeatureSink& out) {
                 occupied += filled.count({ix, iy, 0});
             }
         out.add("projection_gap_fraction", in_hull > 0 ? 1.0 - static_cast<double>(occupied) / in_hull : 0.0);
-        out.add("projection_hull_ratio", hull.size() >= 3 ? polygon_area(hull) / (kPi * f.crown_radius * f.crown_radius) : 0.0);
+        out.add("projection_hull_ratio",
+                hull.size() >= 3 ? polygon_area(hull) / (std::numbers::pi * f.crown_radius * f.crown_radius) : 0.0);
     }
     std::vector<int> layers(kCrownBaseLayers, 0);
     for (float h : f.rel_height) ++layers[std::min(kCrownBaseLayers - 1, static_cast<int>(h * kCrownBaseLayers))];

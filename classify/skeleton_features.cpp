@@ -3,6 +3,7 @@
 // then branch angles, lengths and radii by branch order, whorls, trunk form, crown asymmetry and
 // the skeleton's box-counting dimension.
 #include "classify/feature_groups.hpp"
+#include "core/angles.hpp"
 #include "reconstruct/allometry.hpp"
 #include "reconstruct/skeleton.hpp"
 
@@ -15,8 +16,6 @@
 namespace treelobes::classify::detail {
 
 namespace {
-
-constexpr double kRadToDeg = 57.29577951308232;
 
 // An axis: a lateral child (or the root) followed through main children to a tip.
 struct Axis {
@@ -55,7 +54,7 @@ Eigen::Vector3f along(const TreeGraph& t, const Axis& a, double distance) {
 double angle_deg(const Eigen::Vector3f& a, const Eigen::Vector3f& b) {
     const double na = a.norm(), nb = b.norm();
     if (na <= 0 || nb <= 0) return 0.0;
-    return std::acos(std::clamp(static_cast<double>(a.dot(b)) / (na * nb), -1.0, 1.0)) * kRadToDeg;
+    return std::acos(std::clamp(static_cast<double>(a.dot(b)) / (na * nb), -1.0, 1.0)) * kDegreesPerRadian;
 }
 
 std::vector<Axis> axes_of(const TreeGraph& t, const std::vector<int>& orders, const std::vector<float>& radius, float height) {
@@ -78,7 +77,7 @@ std::vector<Axis> axes_of(const TreeGraph& t, const std::vector<int>& orders, co
         const double reach = std::min(0.5 * a.length, std::max(reach_min, 3.0 * t.edge_length(s)));
         const Eigen::Vector3f start = parent >= 0 ? t.nodes[parent].position : t.nodes[s].position;
         const Eigen::Vector3f dir = along(t, a, reach) - start;
-        a.elevation = dir.norm() > 0 ? std::asin(std::clamp(dir.z() / dir.norm(), -1.0f, 1.0f)) * kRadToDeg : 0.0;
+        a.elevation = dir.norm() > 0 ? std::asin(std::clamp(dir.z() / dir.norm(), -1.0f, 1.0f)) * kDegreesPerRadian : 0.0;
         if (parent >= 0) {
             const Eigen::Vector3f up = t.nodes[parent].position - t.nodes[ancestor_at(t, parent, reach)].position;
             a.angle = angle_deg(dir, up.norm() > 0 ? up : Eigen::Vector3f(0, 0, 1));

@@ -65,6 +65,9 @@ struct SourceFormat {
     std::size_t copc_nodes_read = 0;  // nodes decoded (fewer than copc_nodes under a bounds query)
 };
 
+// ASPRS classification codes (LAS 1.4 R15, Table 17) that the pipeline reads or writes.
+inline constexpr std::uint8_t kAsprsGround = 2, kAsprsLowNoise = 7, kAsprsHighNoise = 18;
+
 struct PointCloud {
     Eigen::Vector3d origin{0, 0, 0};         // add to a local position for the original coordinates
     std::vector<Eigen::Vector3f> positions;  // local coordinates (metres)
@@ -73,7 +76,7 @@ struct PointCloud {
     std::vector<std::uint16_t> intensity;
     std::vector<std::uint8_t> return_number;
     std::vector<std::uint8_t> number_of_returns;
-    std::vector<std::uint8_t> classification;  // ASPRS codes: 2 = ground
+    std::vector<std::uint8_t> classification;  // ASPRS codes (kAsprsGround, ...)
     std::vector<std::array<std::uint16_t, 3>> rgb;
     std::vector<double> gps_time;
     std::vector<ExtraAttribute> extras;

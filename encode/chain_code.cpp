@@ -13,7 +13,6 @@ namespace treelobes::encode {
 namespace {
 
 bool is_move(char symbol) { return symbol >= '0' && symbol <= '5'; }
-bool is_terminator(char symbol) { return symbol == kFork || symbol == kTip || symbol == kEndOfInternode; }
 
 std::string at_character(std::size_t index) { return "at character " + std::to_string(index + 1); }
 

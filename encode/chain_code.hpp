@@ -25,6 +25,7 @@ const char* code_kind_name(CodeKind kind);
 inline constexpr char kFork = '6';
 inline constexpr char kTip = '7';
 inline constexpr char kEndOfInternode = '8';
+inline constexpr bool is_terminator(char symbol) { return symbol == kFork || symbol == kTip || symbol == kEndOfInternode; }
 
 // Voxel coordinates and moves. 64-bit because DBF6 corrections accumulate: a corrupt code of n
 // symbols can describe coordinates of order n^3, which must be rejected, not overflow.

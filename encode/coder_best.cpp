@@ -96,7 +96,6 @@ std::uint64_t read_varint(std::span<const std::uint8_t> bytes, std::size_t& posi
     throw Error::input(context, "invalid stream header");
 }
 
-bool is_terminator(char c) { return c == kFork || c == kTip || c == kEndOfInternode; }
 int sign_of(std::int64_t v) { return (v > 0) - (v < 0); }
 
 // ---- Symbols: the structured (canonical) model ----------------------------------------------

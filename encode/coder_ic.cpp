@@ -18,8 +18,6 @@ constexpr std::uint64_t kMaxMtfPosition = kAlphabet - 1;
 // Radius d-gaps are differences of two ints, so shifted or zig-zagged gaps stay below 2^34.
 constexpr std::uint64_t kMaxShiftedGap = std::uint64_t{1} << 34;
 
-bool is_terminator(char c) { return c == kFork || c == kTip || c == kEndOfInternode; }
-
 // Internode index ranges [begin, end) of the branches: each ends at the internode closed by a 7;
 // internodes after the last 7 (only in codes that do not end with one) form a final sublist.
 std::vector<std::pair<std::size_t, std::size_t>> branch_sublists(const std::string& symbols) {

@@ -13,7 +13,7 @@ namespace treelobes::encode {
 
 namespace {
 
-constexpr char kMagic[4] = {'D', 'B', 'F', 'F'};
+constexpr char kForestMagic[4] = {'D', 'B', 'F', 'F'};
 constexpr std::size_t kHeaderBytes = 4 + 1 + 4 + 4 + 3 * 8;
 constexpr std::size_t kMaxNameBytes = 4096;
 
@@ -90,7 +90,7 @@ std::vector<std::uint8_t> write_forest_bytes(const std::vector<ForestTree>& tree
         put_varint(index, t.name.size());
         index.insert(index.end(), t.name.begin(), t.name.end());
     }
-    std::vector<std::uint8_t> out(std::begin(kMagic), std::end(kMagic));
+    std::vector<std::uint8_t> out(std::begin(kForestMagic), std::end(kForestMagic));
     out.push_back(kForestFileVersion);
     put_u32(out, static_cast<std::uint32_t>(trees.size()));
     put_u32(out, static_cast<std::uint32_t>(index.size()));
@@ -152,7 +152,8 @@ ForestReader::ForestReader(std::vector<std::uint8_t> bytes, std::string context)
 }
 
 void ForestReader::parse_index(std::span<const std::uint8_t> head, std::uint64_t file_size) {
-    if (head.size() < 4 || std::memcmp(head.data(), kMagic, 4) != 0) throw Error::input(context_, "not a .forest file (no DBFF magic)");
+    if (head.size() < 4 || std::memcmp(head.data(), kForestMagic, 4) != 0)
+        throw Error::input(context_, "not a .forest file (no DBFF magic)");
     ByteReader in(head, 4, context_);
     const std::uint8_t version = in.u8();
     if (version != kForestFileVersion)

@@ -14,7 +14,7 @@ namespace treelobes::encode {
 
 namespace {
 
-constexpr char kMagic[4] = {'D', 'B', 'F', '6'};
+constexpr char kTreeFileMagic[4] = {'D', 'B', 'F', '6'};
 
 // Record flags: which optional fields follow.
 enum RecordFlag : std::uint8_t { kHasRootPosition = 1, kUsesPrior = 2 };
@@ -225,7 +225,7 @@ TreeGraph decode_tree_record(std::span<const std::uint8_t> bytes, std::size_t& p
 }
 
 std::vector<std::uint8_t> write_tree_file_bytes(const StoredTree& tree, std::vector<StreamSizes>* sizes) {
-    std::vector<std::uint8_t> out(std::begin(kMagic), std::end(kMagic));
+    std::vector<std::uint8_t> out(std::begin(kTreeFileMagic), std::end(kTreeFileMagic));
     out.push_back(kTreeFileVersion);
     const std::vector<std::uint8_t> record = write_tree_record(tree, sizes);
     out.insert(out.end(), record.begin(), record.end());
@@ -234,7 +234,8 @@ std::vector<std::uint8_t> write_tree_file_bytes(const StoredTree& tree, std::vec
 }
 
 StoredTree read_tree_file_bytes(std::span<const std::uint8_t> bytes, int lod, const std::string& context, std::vector<StreamSizes>* sizes) {
-    if (bytes.size() < 4 || std::memcmp(bytes.data(), kMagic, 4) != 0) throw Error::input(context, "not a .dbf6 file (no DBF6 magic)");
+    if (bytes.size() < 4 || std::memcmp(bytes.data(), kTreeFileMagic, 4) != 0)
+        throw Error::input(context, "not a .dbf6 file (no DBF6 magic)");
     if (bytes.size() < 4 + 1 + 4) throw Error::input(context, "truncated .dbf6 file");
     if (bytes[4] != kTreeFileVersion)
         throw Error::input(context, "unsupported .dbf6 version " + std::to_string(bytes[4]) + " (this build reads " +

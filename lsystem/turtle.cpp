@@ -1,5 +1,6 @@
 #include "lsystem/turtle.hpp"
 
+#include "core/angles.hpp"
 #include "core/error.hpp"
 
 #include <Eigen/Geometry>
@@ -11,8 +12,6 @@
 namespace treelobes::lsystem {
 
 namespace {
-
-constexpr double kDegree = 3.14159265358979323846 / 180.0;
 
 std::string module_text(const ModuleString& string, std::size_t i) {
     return "'" + string.to_string(i, i + 1) + "' (module " + std::to_string(i) + ")";
@@ -66,7 +65,7 @@ Turtle::Turtle(const Alphabet& alphabet, const TurtleOptions& options) : options
 }
 
 void Turtle::rotate(Eigen::Vector3d& a, Eigen::Vector3d& b, double degrees) {
-    const double c = std::cos(degrees * kDegree), s = std::sin(degrees * kDegree);
+    const double c = std::cos(degrees * kRadiansPerDegree), s = std::sin(degrees * kRadiansPerDegree);
     const Eigen::Vector3d a2 = a * c + b * s;
     b = b * c - a * s;
     a = a2;

@@ -58,5 +58,8 @@ BUILD_DIR=${TREELOBES_BUILD_DIR:-build}
 # Warnings are errors here (demo, tests and CI all build through this script): the compiler is
 # Debian 12's GCC 12 installed above, so any warning is a defect of ours. A hand-made build with
 # another compiler keeps the default TREELOBES_WERROR=OFF.
-cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTREELOBES_WERROR=ON >/dev/null
+# A unity build (CMake compiles each folder's sources in batches of 8 as one file): Eigen, CLI11 and
+# the JSON library are parsed and instantiated once a batch, not once a file, which makes a build
+# from scratch about twice as fast.
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DTREELOBES_WERROR=ON -DCMAKE_UNITY_BUILD=ON >/dev/null
 cmake --build "$BUILD_DIR" -j "$(nproc)"

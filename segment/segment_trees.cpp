@@ -22,8 +22,6 @@ namespace treelobes {
 
 namespace {
 
-constexpr std::uint8_t kLowNoiseClass = 7, kHighNoiseClass = 18;
-
 void check_options(const SegmentOptions& o) {
     const auto positive = [](float v, const char* name) {
         if (!(v > 0.0f) || !std::isfinite(v)) throw Error::usage(std::string("segment: ") + name + " must be > 0");
@@ -75,7 +73,7 @@ std::vector<std::uint8_t> vegetation_points(const PointCloud& cloud, const Terra
     std::vector<std::uint8_t> keep(cloud.size(), 0);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const bool noise =
-                !cloud.classification.empty() && (cloud.classification[i] == kLowNoiseClass || cloud.classification[i] == kHighNoiseClass);
+                !cloud.classification.empty() && (cloud.classification[i] == kAsprsLowNoise || cloud.classification[i] == kAsprsHighNoise);
         keep[i] = !noise && !terrain.is_ground[i] && terrain.height_above_ground[i] >= clearance;
     }
     return keep;

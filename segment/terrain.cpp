@@ -25,7 +25,6 @@ namespace treelobes {
 namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-constexpr std::uint8_t kGroundClass = 2, kLowNoiseClass = 7, kHighNoiseClass = 18;
 
 void check_options(const TerrainOptions& o) {
     const auto positive = [](float v, const char* name) {
@@ -50,7 +49,7 @@ void check_finite(const PointCloud& cloud) {
 
 bool is_noise(const PointCloud& cloud, std::size_t i) {
     if (cloud.classification.empty()) return false;
-    return cloud.classification[i] == kLowNoiseClass || cloud.classification[i] == kHighNoiseClass;
+    return cloud.classification[i] == kAsprsLowNoise || cloud.classification[i] == kAsprsHighNoise;
 }
 
 // The grid covering the cloud's xy extent, all cells NaN.
@@ -363,20 +362,20 @@ Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options) 
 
     const bool has_ground_class =
             options.use_classification && !cloud.classification.empty() &&
-            std::find(cloud.classification.begin(), cloud.classification.end(), kGroundClass) != cloud.classification.end();
+            std::find(cloud.classification.begin(), cloud.classification.end(), kAsprsGround) != cloud.classification.end();
     if (looks_normalised(cloud, options.cell_size, options.normalised_tolerance)) {
         terrain.ground_source = "normalised";
         terrain.dtm = shape;
         std::fill(terrain.dtm.heights.begin(), terrain.dtm.heights.end(), static_cast<float>(-cloud.origin.z()));
         terrain.is_ground.resize(cloud.size());
         for (std::size_t i = 0; i < cloud.size(); ++i)
-            terrain.is_ground[i] = has_ground_class ? cloud.classification[i] == kGroundClass
+            terrain.is_ground[i] = has_ground_class ? cloud.classification[i] == kAsprsGround
                                                     : !is_noise(cloud, i) && std::abs(cloud.origin.z() + cloud.positions[i].z()) <=
                                                                                      options.ground_tolerance;
     } else if (has_ground_class) {
         terrain.ground_source = "classified";
         terrain.is_ground.resize(cloud.size());
-        for (std::size_t i = 0; i < cloud.size(); ++i) terrain.is_ground[i] = cloud.classification[i] == kGroundClass;
+        for (std::size_t i = 0; i < cloud.size(); ++i) terrain.is_ground[i] = cloud.classification[i] == kAsprsGround;
         terrain.dtm = ground_height_grid(cloud, shape, terrain.is_ground);
     } else {
         terrain.ground_source = "filtered";

@@ -2,6 +2,7 @@
 // node indices, random streams and therefore the output are fully determined by the seed.
 #include "synth/grow.hpp"
 
+#include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/random.hpp"
 
@@ -17,14 +18,14 @@ namespace {
 
 using Vec3 = Eigen::Vector3d;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr double kMinRadius = 0.0005;      // 1 mm twig tips: nothing real is thinner
 constexpr std::size_t kMaxStems = 300000;  // a runaway profile fails instead of eating memory
 constexpr std::size_t kMaxLeaves = 3000000;
 constexpr double kGroundClearance = 0.3;  // weeping and spreading branches end on the ground, not in it
 
-Vec3 rotate(const Vec3& v, const Vec3& axis, double degrees) { return Eigen::AngleAxisd(degrees * kDeg, axis.normalized()) * v; }
+Vec3 rotate(const Vec3& v, const Vec3& axis, double degrees) {
+    return Eigen::AngleAxisd(degrees * kRadiansPerDegree, axis.normalized()) * v;
+}
 
 Vec3 any_perpendicular(const Vec3& d) {
     const Vec3 helper = std::abs(d.z()) < 0.9 ? Vec3::UnitZ() : Vec3::UnitX();
@@ -374,7 +375,7 @@ private:
             const int node = node_at(p.offset);
             const Vec3 start = tree_.skeleton.nodes[node].position.cast<double>();
             for (int m = 0; m < p.count; ++m) {
-                const double phi = azimuth(level, phase, p, m, rng) * kDeg;
+                const double phi = azimuth(level, phase, p, m, rng) * kRadiansPerDegree;
                 const Vec3 axis = std::cos(phi) * side + std::sin(phi) * across;
                 Stem child;
                 child.level = stem.level + 1;
@@ -463,7 +464,7 @@ private:
             const Vec3 at = chunk.position(p.offset);
             const int node = node_at(p.offset);
             for (int m = 0; m < p.count; ++m) {
-                const double phi = azimuth(arrangement, phase, p, m, rng) * kDeg;
+                const double phi = azimuth(arrangement, phase, p, m, rng) * kRadiansPerDegree;
                 const Vec3 axis = std::cos(phi) * side + std::sin(phi) * across;
                 const Vec3 d = rotate(dir, axis, lp.down_angle + rng.vary(lp.down_angle_v)).normalized();
                 add_leaf(at + d * stem_radius(stem, p.offset), dir, d, node, rng);

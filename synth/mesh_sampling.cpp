@@ -1,5 +1,6 @@
 #include "synth/mesh_sampling.hpp"
 
+#include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/random.hpp"
 #include "synth/scanner.hpp"
@@ -14,8 +15,6 @@ namespace treelobes::synth {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr std::size_t kMaxSamples = 50'000'000;
 // Fractions of a scan's pulses expected to come back from a tree model: a first guess for the
 // raster (a second scan corrects it when the guess was far off).
@@ -84,7 +83,7 @@ PointCloud scan_tls_sized(const Scene& scene, const MeshSamplingOptions& o, Mesh
     const double window = std::max(1e-6, azimuth_span * elevation_span);
     auto step_for = [&](double points_per_pulse) {
         const double pulses = static_cast<double>(o.samples) / (o.stations * points_per_pulse);
-        return std::clamp(std::sqrt(window / std::max(1.0, pulses)) / kDeg, 0.005, 5.0);
+        return std::clamp(std::sqrt(window / std::max(1.0, pulses)) / kRadiansPerDegree, 0.005, 5.0);
     };
     tls.angular_step_deg = step_for(kTlsHitFraction);
     ScanSummary summary;
@@ -105,7 +104,7 @@ PointCloud scan_als_sized(const Scene& scene, const MeshSamplingOptions& o, Mesh
     AlsOptions als;
     als.altitude_m = 300;
     const double half_width = 0.5 * (hi.x() - lo.x()) + 2.0;
-    als.max_scan_angle_deg = std::clamp(std::atan(half_width / als.altitude_m) / kDeg, 0.5, 60.0);
+    als.max_scan_angle_deg = std::clamp(std::atan(half_width / als.altitude_m) / kRadiansPerDegree, 0.5, 60.0);
     const double area = std::max(0.01, (hi.x() - lo.x()) * (hi.y() - lo.y()));
     auto density_for = [&](double points_per_pulse) {
         return std::clamp(static_cast<double>(o.samples) / (area * points_per_pulse), 0.01, 2000.0);

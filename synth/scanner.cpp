@@ -1,5 +1,6 @@
 #include "synth/scanner.hpp"
 
+#include "core/angles.hpp"
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/random.hpp"
@@ -10,13 +11,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace treelobes::synth {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = kPi / 180.0;
 constexpr std::uint64_t kMaxPulses = 400'000'000;  // beyond this a scan takes hours: refuse
 
 // A sub-ray of the beam pattern: offset on the unit disc (radius 1 = half the divergence).
@@ -31,7 +31,7 @@ std::vector<BeamRay> beam_pattern(int sub_rays) {
     for (int k = 1; k <= rings; ++k)
         for (int i = 0; i < 6 * k; ++i) {
             const double r = static_cast<double>(k) / rings;
-            rays.push_back({r, 2 * kPi * i / (6 * k), std::exp(-2.0 * r * r)});
+            rays.push_back({r, 2 * std::numbers::pi * i / (6 * k), std::exp(-2.0 * r * r)});
         }
     double total = 0;
     for (const auto& r : rays) total += r.weight;
@@ -64,7 +64,7 @@ public:
         hits_.clear();
         const Eigen::Vector3d u = perpendicular(dir), v = dir.cross(u);
         const double half_angle = 0.5e-3 * beam_.divergence_mrad;
-        const double spin = rng.uniform(0, 2 * kPi);  // pattern orientation: no aliasing between pulses
+        const double spin = rng.uniform(0, 2 * std::numbers::pi);  // pattern orientation: no aliasing between pulses
         const Eigen::Vector3f o = origin.cast<float>();
         for (const BeamRay& b : pattern_) {
             const double a = b.angle + spin, off = std::tan(b.radius * half_angle);
@@ -208,23 +208,23 @@ Window tls_window(const Eigen::Vector3d& station, const Eigen::Vector3d& lo, con
     const bool inside = station.x() >= lo.x() && station.x() <= hi.x() && station.y() >= lo.y() && station.y() <= hi.y();
     const Eigen::Vector3d centre = 0.5 * (lo + hi);
     const double az_centre = std::atan2(centre.y() - station.y(), centre.x() - station.x());
-    double daz0 = 0, daz1 = 0, el0 = kPi / 2, el1 = -kPi / 2;
+    double daz0 = 0, daz1 = 0, el0 = std::numbers::pi / 2, el1 = -std::numbers::pi / 2;
     for (int c = 0; c < 8; ++c) {
         const Eigen::Vector3d p((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
         const Eigen::Vector3d d = p - station;
         double daz = std::atan2(d.y(), d.x()) - az_centre;
-        daz = std::remainder(daz, 2 * kPi);
+        daz = std::remainder(daz, 2 * std::numbers::pi);
         daz0 = std::min(daz0, daz), daz1 = std::max(daz1, daz);
         const double el = std::atan2(d.z(), d.head<2>().norm());
         el0 = std::min(el0, el), el1 = std::max(el1, el);
     }
     Window w;
     if (inside)
-        w.az0 = -kPi, w.az1 = kPi;
+        w.az0 = -std::numbers::pi, w.az1 = std::numbers::pi;
     else
         w.az0 = az_centre + daz0, w.az1 = az_centre + daz1;
-    w.el0 = std::max(inside ? -kPi / 2 : el0, o.min_elevation_deg * kDeg);
-    w.el1 = std::min(inside ? kPi / 2 : el1, o.max_elevation_deg * kDeg);
+    w.el0 = std::max(inside ? -std::numbers::pi / 2 : el0, o.min_elevation_deg * kRadiansPerDegree);
+    w.el1 = std::min(inside ? std::numbers::pi / 2 : el1, o.max_elevation_deg * kRadiansPerDegree);
     return w;
 }
 
@@ -240,9 +240,9 @@ std::vector<Eigen::Vector3d> tls_stations(const Scene& scene, const TlsOptions& 
             centre /= static_cast<double>(scene.trees.size());
         }
         const double distance = o.station_distance_m > 0 ? o.station_distance_m : std::max(6.0, 0.6 * (hi.z() - lo.z()));
-        const double phase = Rng(stream_seed(seed, 0x57A7)).uniform(0, 2 * kPi);
+        const double phase = Rng(stream_seed(seed, 0x57A7)).uniform(0, 2 * std::numbers::pi);
         for (int k = 0; k < o.stations; ++k) {
-            const double a = phase + 2 * kPi * k / o.stations;
+            const double a = phase + 2 * std::numbers::pi * k / o.stations;
             xy.push_back(centre + distance * Eigen::Vector2d(std::cos(a), std::sin(a)));
         }
     }
@@ -281,7 +281,7 @@ PointCloud scan_tls(const Scene& scene, const TlsOptions& o, std::uint64_t seed,
     const auto [lo, hi] = scene.bounds();
     const RayScene rays(scene);
     const std::vector<Eigen::Vector3d> stations = tls_stations(scene, o, lo, hi, seed);
-    const double step = o.angular_step_deg * kDeg;
+    const double step = o.angular_step_deg * kRadiansPerDegree;
 
     // Columns (one azimuth each) of all stations, numbered station by station.
     struct Column {
@@ -339,16 +339,16 @@ PointCloud scan_als(const Scene& scene, const AlsOptions& o, std::uint64_t seed,
     const double flying = top + o.altitude_m;
     const double spacing = 1.0 / std::sqrt(o.pulse_density);
     const double h = o.altitude_m;
-    const double swath = 2.0 * h * std::tan(o.max_scan_angle_deg * kDeg);
+    const double swath = 2.0 * h * std::tan(o.max_scan_angle_deg * kRadiansPerDegree);
     const double strip_step = swath * (1.0 - o.strip_overlap);
     const double width = area_hi.x() - area_lo.x();
     const int strips = std::max(1, static_cast<int>(std::ceil(width / strip_step)));
     const double first_strip = 0.5 * (area_lo.x() + area_hi.x()) - 0.5 * (strips - 1) * strip_step;
-    const double margin = 2.0 * (hi.z() - lo.z()) * std::tan(o.max_scan_angle_deg * kDeg);
+    const double margin = 2.0 * (hi.z() - lo.z()) * std::tan(o.max_scan_angle_deg * kRadiansPerDegree);
     const double y0 = area_lo.y() - margin, y1 = area_hi.y() + margin;
     const auto lines_per_strip = static_cast<std::size_t>(std::ceil((y1 - y0) / spacing));
     const double angle_step = spacing / h;  // nadir spacing on flat ground
-    const auto per_line = static_cast<std::size_t>(std::floor(2.0 * o.max_scan_angle_deg * kDeg / angle_step)) + 1;
+    const auto per_line = static_cast<std::size_t>(std::floor(2.0 * o.max_scan_angle_deg * kRadiansPerDegree / angle_step)) + 1;
     const std::uint64_t pulses = static_cast<std::uint64_t>(strips) * lines_per_strip * per_line;
     if (pulses > kMaxPulses)
         throw Error::usage("ALS scan would fire more than " + std::to_string(kMaxPulses) + " pulses; lower the pulse density");
@@ -359,7 +359,7 @@ PointCloud scan_als(const Scene& scene, const AlsOptions& o, std::uint64_t seed,
                 const double x = first_strip + static_cast<double>(k / lines_per_strip) * strip_step;
                 const double y = y0 + (static_cast<double>(k % lines_per_strip) + 0.5) * spacing;
                 for (std::size_t j = 0; j < per_line; ++j) {
-                    const double angle = -o.max_scan_angle_deg * kDeg + (j + rng.vary(o.jitter)) * angle_step;
+                    const double angle = -o.max_scan_angle_deg * kRadiansPerDegree + (j + rng.vary(o.jitter)) * angle_step;
                     const double yj = y + rng.vary(o.jitter) * spacing;
                     const Eigen::Vector3d dir(std::sin(angle), 0.0, -std::cos(angle));
                     tracer.fire(Eigen::Vector3d(x, yj, flying), dir, 2.0 * (flying - lo.z()) + 10.0, rng, out);

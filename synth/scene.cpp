@@ -6,12 +6,11 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace treelobes::synth {
 
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // Smooth value noise in [-1, 1]: random values on an integer lattice, interpolated with a
 // smoothstep. Lattice values come from hashed streams, so any point is reproducible alone.
@@ -52,8 +51,8 @@ Heightfield make_ground(double x0, double y0, double x1, double y1, double slope
     g.nx = static_cast<int>(std::ceil((x1 - x0) / cell)) + 1;
     g.ny = static_cast<int>(std::ceil((y1 - y0) / cell)) + 1;
     g.z.resize(static_cast<std::size_t>(g.nx) * g.ny);
-    const double gradient = std::tan(slope_deg * kPi / 180.0);
-    const double ax = std::cos(aspect_deg * kPi / 180.0), ay = std::sin(aspect_deg * kPi / 180.0);
+    const double gradient = std::tan(slope_deg * std::numbers::pi / 180.0);
+    const double ax = std::cos(aspect_deg * std::numbers::pi / 180.0), ay = std::sin(aspect_deg * std::numbers::pi / 180.0);
     const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
     for (int j = 0; j < g.ny; ++j)
         for (int i = 0; i < g.nx; ++i) {
@@ -85,14 +84,14 @@ std::vector<Leaf> make_understory(const Heightfield& ground, int count, double m
         const double radius = rng.uniform(0.2, 0.4 + 0.6 * height);
         const int n = 15 + static_cast<int>(rng.below(static_cast<std::uint64_t>(20 + 60 * height)));
         for (int b = 0; b < n; ++b) {
-            const double r = radius * std::sqrt(rng.uniform()), a = rng.uniform(0, 2 * kPi);
+            const double r = radius * std::sqrt(rng.uniform()), a = rng.uniform(0, 2 * std::numbers::pi);
             const double x = centre.x() + r * std::cos(a), y = centre.y() + r * std::sin(a);
             // Blades higher in the middle of the clump: a dome of foliage.
             const double top = height * (1.0 - 0.7 * (r / radius) * (r / radius));
             Leaf leaf;
             leaf.base = Eigen::Vector3f(static_cast<float>(x), static_cast<float>(y),
                                         static_cast<float>(ground.height(x, y) + rng.uniform(0.0, top)));
-            const double tilt = rng.uniform(0.2, 1.3), az = rng.uniform(0, 2 * kPi);
+            const double tilt = rng.uniform(0.2, 1.3), az = rng.uniform(0, 2 * std::numbers::pi);
             leaf.direction = Eigen::Vector3f(static_cast<float>(std::sin(tilt) * std::cos(az)),
                                              static_cast<float>(std::sin(tilt) * std::sin(az)), static_cast<float>(std::cos(tilt)));
             Eigen::Vector3f side = leaf.direction.cross(Eigen::Vector3f::UnitZ());

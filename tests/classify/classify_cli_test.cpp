@@ -12,7 +12,9 @@
 
 using namespace treelobes;
 using treelobes::test::run_cli;
+using treelobes::test::shared_fixture;
 using treelobes::test::TempDir;
+using treelobes::test::write_text;
 
 namespace {
 
@@ -31,40 +33,45 @@ std::vector<std::string> lines_of(const std::string& text) {
 
 class ClassifyCli : public ::testing::Test {
 protected:
-    // One dataset and its feature table for the whole suite (the expensive part).
+    // One dataset and its feature table (the expensive part), made once for the ctest run
+    // (test::shared_fixture); the features run's exit code and output are kept beside them.
     static void SetUpTestSuite() {
-        dir_ = new TempDir;
-        const auto r =
-                run_cli("--log-level warn synth dataset --per-species 4 --species palm pine oak --seed 3 --angular-step 0.5 "
-                        "--max-leaves 3000 --out " +
-                        quoted(dataset()));
-        ASSERT_EQ(r.exit_code, 0) << r.err;
-        std::string files;
-        for (const auto& line : lines_of(read_file(dataset() / "labels.csv")))
-            if (line.rfind("file,", 0) != 0) (files += ' ') += quoted(dataset() / line.substr(0, line.find(',')));
-        features_run_ = new test::CommandResult(
-                run_cli("classify features" + files + " --relative-to " + quoted(dataset()) + " --out " + quoted(features()) + " --json"));
+        dir_ = shared_fixture("classify_cli_dataset", [](const std::filesystem::path& dir) {
+            const auto r =
+                    run_cli("--log-level warn synth dataset --per-species 4 --species palm pine oak --seed 3 --angular-step 0.5 "
+                            "--max-leaves 3000 --out " +
+                            quoted(dir / "dataset"));
+            ASSERT_EQ(r.exit_code, 0) << r.err;
+            std::string files;
+            for (const auto& line : lines_of(read_file(dir / "dataset" / "labels.csv")))
+                if (line.rfind("file,", 0) != 0) (files += ' ') += quoted(dir / "dataset" / line.substr(0, line.find(',')));
+            const auto features = run_cli("classify features" + files + " --relative-to " + quoted(dir / "dataset") + " --out " +
+                                          quoted(dir / "features.csv") + " --json");
+            write_text(dir / "features_run.exit", std::to_string(features.exit_code));
+            write_text(dir / "features_run.out", features.out);
+            write_text(dir / "features_run.err", features.err);
+        });
+        const std::string exit_code = read_file(dir_ / "features_run.exit");
+        features_run_.exit_code = exit_code.empty() ? -1 : std::stoi(exit_code);
+        features_run_.out = read_file(dir_ / "features_run.out");
+        features_run_.err = read_file(dir_ / "features_run.err");
     }
-    static void TearDownTestSuite() {
-        delete features_run_;
-        delete dir_;
-    }
-    static std::filesystem::path dataset() { return dir_->path() / "dataset"; }
-    static std::filesystem::path features() { return dir_->path() / "features.csv"; }
+    static std::filesystem::path dataset() { return dir_ / "dataset"; }
+    static std::filesystem::path features() { return dir_ / "features.csv"; }
     static std::filesystem::path labels() { return dataset() / "labels.csv"; }
 
-    static TempDir* dir_;
-    static test::CommandResult* features_run_;
+    static std::filesystem::path dir_;
+    static test::CommandResult features_run_;
 };
 
-TempDir* ClassifyCli::dir_ = nullptr;
-test::CommandResult* ClassifyCli::features_run_ = nullptr;
+std::filesystem::path ClassifyCli::dir_;
+test::CommandResult ClassifyCli::features_run_;
 
 }  // namespace
 
 TEST_F(ClassifyCli, FeaturesWritesOneRowPerTreeWithLabelIds) {
-    ASSERT_EQ(features_run_->exit_code, 0) << features_run_->err;
-    const auto summary = nlohmann::json::parse(features_run_->out);
+    ASSERT_EQ(features_run_.exit_code, 0) << features_run_.err;
+    const auto summary = nlohmann::json::parse(features_run_.out);
     EXPECT_EQ(summary["trees"], 12);
     EXPECT_GT(summary["features"].get<int>(), 200);
     const auto lines = lines_of(read_file(features()));
@@ -84,7 +91,7 @@ TEST_F(ClassifyCli, FeaturesWritesOneRowPerTreeWithLabelIds) {
 }
 
 TEST_F(ClassifyCli, TrainPredictAndVote) {
-    ASSERT_EQ(features_run_->exit_code, 0);
+    ASSERT_EQ(features_run_.exit_code, 0);
     TempDir dir;
     const auto train = run_cli("classify train " + quoted(features()) + " --labels " + quoted(labels()) + " --out " +
                                quoted(dir / "model.jb") + " --folds 0 --max-rounds 60 --json");
@@ -123,7 +130,7 @@ TEST_F(ClassifyCli, TrainPredictAndVote) {
 }
 
 TEST_F(ClassifyCli, EvaluateWritesTheReport) {
-    ASSERT_EQ(features_run_->exit_code, 0);
+    ASSERT_EQ(features_run_.exit_code, 0);
     TempDir dir;
     const auto r = run_cli("classify evaluate " + quoted(dataset()) + " --features " + quoted(features()) + " --splits 5 --out " +
                            quoted(dir / "report") + " --max-rounds 80 --json");
@@ -192,7 +199,7 @@ TEST_F(ClassifyCli, EvaluateTrainsOnOneFolderAndTestsOnAnother) {
 }
 
 TEST_F(ClassifyCli, BadInputsExitWithCode2AndUsageErrorsWith1) {
-    ASSERT_EQ(features_run_->exit_code, 0);
+    ASSERT_EQ(features_run_.exit_code, 0);
     TempDir dir;
     test::write_text(dir / "broken.jb", "{\"format\": \"treelobes-jointboost\", \"version\": 1, \"classes\": [");
     auto r = run_cli("classify predict " + quoted(dir / "broken.jb") + " " + quoted(features()));

@@ -6,6 +6,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "core/random.hpp"
+#include "support/species_profiles.hpp"
 #include "support/test_support.hpp"
 #include "synth/scanner.hpp"
 
@@ -20,14 +21,10 @@
 #include <set>
 
 using namespace treelobes;
+using treelobes::test::species_profiles;
 using namespace treelobes::classify;
 
 namespace {
-
-const std::vector<SpeciesProfile>& library() {
-    static const std::vector<SpeciesProfile> profiles = load_species_profiles(default_species_file());
-    return profiles;
-}
 
 // One tree of `species` on a small ground patch, scanned from three TLS stations at 0.4 deg
 // (about a hundred thousand points: a realistic single-tree scan, a few seconds to make).
@@ -36,7 +33,7 @@ PointCloud scanned_tree(const std::string& species, double height, std::uint64_t
     grow.height_m = height;
     grow.max_leaves = 6000;
     synth::Scene scene;
-    scene.trees.push_back({synth::grow(find_species_profile(library(), species), seed, grow), Eigen::Vector3d::Zero(), 1});
+    scene.trees.push_back({synth::grow(find_species_profile(species_profiles(), species), seed, grow), Eigen::Vector3d::Zero(), 1});
     scene.ground = synth::make_ground(-8, -8, 8, 8, 0, 0, 0.02, seed);
     synth::TlsOptions tls;
     tls.angular_step_deg = 0.4;
@@ -49,7 +46,7 @@ PointCloud airborne_tree(const std::string& species, std::uint64_t seed) {
     grow.height_m = 12.0;
     grow.max_leaves = 6000;
     synth::Scene scene;
-    scene.trees.push_back({synth::grow(find_species_profile(library(), species), seed, grow), Eigen::Vector3d::Zero(), 1});
+    scene.trees.push_back({synth::grow(find_species_profile(species_profiles(), species), seed, grow), Eigen::Vector3d::Zero(), 1});
     scene.ground = synth::make_ground(-10, -10, 10, 10, 0, 0, 0.02, seed);
     synth::AlsOptions als;
     als.pulse_density = 20;

@@ -1,5 +1,6 @@
 // kd-trees (geometry/kd_tree.hpp) against brute force on random clouds.
 #include "geometry/kd_tree.hpp"
+#include "support/point_sets.hpp"
 
 #include <gtest/gtest.h>
 
@@ -9,18 +10,7 @@
 #include <vector>
 
 using namespace treelobes;
-
-namespace {
-
-std::vector<Eigen::Vector3f> random_points(int n, unsigned seed, float scale = 1.0f) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, scale);
-    std::vector<Eigen::Vector3f> p(n);
-    for (auto& q : p) q = {u(rng), u(rng), u(rng)};
-    return p;
-}
-
-}  // namespace
+using treelobes::test::random_points;
 
 TEST(KdTree, KnnMatchesBruteForce) {
     const auto points = random_points(2000, 1);

@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/neighbour_graph.hpp"
+#include "support/point_sets.hpp"
 
 #include <gtest/gtest.h>
 
@@ -12,24 +13,8 @@
 #include <vector>
 
 using namespace treelobes;
-
-namespace {
-
-std::vector<Eigen::Vector3f> random_points(int n, unsigned seed, float scale = 1.0f) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, scale);
-    std::vector<Eigen::Vector3f> p(n);
-    for (auto& q : p) q = {u(rng), u(rng), u(rng)};
-    return p;
-}
-
-// Points every `step` metres from a to b (inclusive).
-void add_line(std::vector<Eigen::Vector3f>& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b, float step) {
-    const int n = static_cast<int>(std::round((b - a).norm() / step));
-    for (int i = 0; i <= n; ++i) p.push_back(a + (b - a) * (static_cast<float>(i) / static_cast<float>(n)));
-}
-
-}  // namespace
+using treelobes::test::add_line;
+using treelobes::test::random_points;
 
 TEST(NeighbourGraph, SymmetricSortedRowsWithPowerWeights) {
     const auto points = random_points(500, 3);

@@ -2,6 +2,7 @@
 #include "core/error.hpp"
 #include "geometry/neighbour_graph.hpp"
 #include "geometry/shortest_paths.hpp"
+#include "support/point_sets.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,16 +12,7 @@
 #include <vector>
 
 using namespace treelobes;
-
-namespace {
-
-// Points every `step` metres from a to b (inclusive).
-void add_line(std::vector<Eigen::Vector3f>& p, const Eigen::Vector3f& a, const Eigen::Vector3f& b, float step) {
-    const int n = static_cast<int>(std::round((b - a).norm() / step));
-    for (int i = 0; i <= n; ++i) p.push_back(a + (b - a) * (static_cast<float>(i) / static_cast<float>(n)));
-}
-
-}  // namespace
+using treelobes::test::add_line;
 
 TEST(ShortestPaths, SingleSourceDistancesAndParents) {
     // An L: 0..1 m along x then 0..1 m along y, points 0.1 m apart.

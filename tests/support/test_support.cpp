@@ -7,7 +7,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -74,6 +80,47 @@ CommandResult run_cli(const std::string& arguments) {
 void write_text(const fs::path& path, const std::string& text) {
     std::ofstream out(path, std::ios::binary);
     out << text;
+}
+
+namespace {
+
+// An exclusive flock on a file, released (with the file closed) by the destructor.
+class FileLock {
+public:
+    explicit FileLock(const fs::path& path) : fd_(::open(path.c_str(), O_CREAT | O_RDWR | O_CLOEXEC, 0644)) {
+        if (fd_ < 0 || ::flock(fd_, LOCK_EX) != 0) throw std::runtime_error("cannot lock " + path.string());
+    }
+    ~FileLock() { ::close(fd_); }
+    FileLock(const FileLock&) = delete;
+    FileLock& operator=(const FileLock&) = delete;
+
+private:
+    int fd_;
+};
+
+}  // namespace
+
+fs::path shared_fixture(const std::string& name, const std::function<void(const fs::path&)>& make) {
+    const char* root = std::getenv("TREELOBES_SHARED_FIXTURES");
+    if (!root || !*root) {
+        static std::vector<std::unique_ptr<TempDir>> own;  // removed when the process ends
+        own.push_back(std::make_unique<TempDir>());
+        const fs::path dir = own.back()->path() / name;
+        fs::create_directories(dir);
+        make(dir);
+        return dir;
+    }
+    const fs::path dir = fs::path(root) / name;
+    fs::create_directories(root);
+    const FileLock lock(fs::path(root) / (name + ".lock"));
+    const fs::path made = dir / ".made";
+    if (!fs::exists(made)) {
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+        make(dir);
+        if (!::testing::Test::HasFailure()) write_text(made, "");
+    }
+    return dir;
 }
 
 }  // namespace treelobes::test

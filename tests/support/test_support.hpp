@@ -5,6 +5,7 @@
 #include "core/error.hpp"
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace treelobes::test {
@@ -69,5 +70,14 @@ inline std::string quoted(const std::filesystem::path& path) {
 
 // Writes text to a file (test fixtures).
 void write_text(const std::filesystem::path& path, const std::string& text);
+
+// A folder of data that the test processes of one ctest run share, made once by `make`.
+// ctest runs every TEST in a process of its own, so a suite's expensive fixture (a synthetic
+// survey and its batch run, say: 90 s under ASan) would otherwise be made again for each test.
+// With TREELOBES_SHARED_FIXTURES set (ctest sets it for every test and empties the folder first,
+// tests/CMakeLists.txt), the first process to ask makes <that folder>/<name> under a file lock
+// and the others wait for it and reuse it; a make that failed its test is not reused. Without the
+// variable (a test program run by hand) each process makes its own in a temporary folder.
+std::filesystem::path shared_fixture(const std::string& name, const std::function<void(const std::filesystem::path&)>& make);
 
 }  // namespace treelobes::test

@@ -33,7 +33,6 @@ namespace {
 constexpr int kTiles = 4;
 
 struct Reference {
-    TempDir dir;
     fs::path tiles, merged;
     double batch_seconds = 0;
 };
@@ -49,19 +48,20 @@ std::string merge_command(const std::vector<fs::path>& dirs, const fs::path& out
     return command + " --out '" + out.string() + "' >/dev/null";
 }
 
-// One unsharded batch and its merge, made once for the suite.
+// One unsharded batch and its merge, made once for the ctest run (test::shared_fixture).
 const Reference& reference() {
-    static Reference* made = [] {
-        auto* r = new Reference;
-        r->tiles = make_survey(r->dir.path(), kTiles, 3, 20.0);
-        const auto start = std::chrono::steady_clock::now();
-        EXPECT_EQ(shell(batch_command(r->tiles, r->dir / "single") + " >/dev/null"), 0);
-        r->batch_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        r->merged = r->dir / "single_merged";
-        EXPECT_EQ(shell(merge_command({r->dir / "single"}, r->merged)), 0);
-        return r;
+    static const Reference made = [] {
+        const fs::path dir = shared_fixture("survey_cli_reference", [](const fs::path& d) {
+            const fs::path tiles = make_survey(d, kTiles, 3, 20.0);
+            const auto start = std::chrono::steady_clock::now();
+            EXPECT_EQ(shell(batch_command(tiles, d / "single") + " >/dev/null"), 0);
+            write_text(d / "batch_seconds",
+                       std::to_string(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()));
+            EXPECT_EQ(shell(merge_command({d / "single"}, d / "single_merged")), 0);
+        });
+        return Reference{dir / "tiles", dir / "single_merged", std::stod(file_bytes(dir / "batch_seconds"))};
     }();
-    return *made;
+    return made;
 }
 
 }  // namespace

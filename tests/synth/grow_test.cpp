@@ -1,6 +1,7 @@
 // synth::grow: valid skeletons, determinism, natural variation, species character, leaf budget.
 #include "config/species_profile.hpp"
 #include "core/error.hpp"
+#include "support/species_profiles.hpp"
 #include "synth/grow.hpp"
 #include "synth/tree_mesh.hpp"
 
@@ -9,15 +10,11 @@
 #include <cmath>
 
 using namespace treelobes;
+using treelobes::test::species_profiles;
 
 namespace {
 
-const std::vector<SpeciesProfile>& library() {
-    static const std::vector<SpeciesProfile> profiles = load_species_profiles(default_species_file());
-    return profiles;
-}
-
-const SpeciesProfile& species(const std::string& name) { return find_species_profile(library(), name); }
+const SpeciesProfile& species(const std::string& name) { return find_species_profile(species_profiles(), name); }
 
 synth::GrowOptions small_budget() {
     synth::GrowOptions o;
@@ -41,7 +38,7 @@ double drooping_fraction(const synth::SyntheticTree& tree) {
 }  // namespace
 
 TEST(Grow, EverySpeciesGivesAValidTreeWithinItsRanges) {
-    for (const auto& p : library()) {
+    for (const auto& p : species_profiles()) {
         const synth::SyntheticTree tree = synth::grow(p, 7, small_budget());
         SCOPED_TRACE(p.entry.name);
         EXPECT_NO_THROW(tree.skeleton.validate(p.entry.name));

@@ -1,6 +1,7 @@
 // Simulated scans: labels, geometry of returns, occlusion, multiple returns, noise, determinism.
 #include "config/species_profile.hpp"
 #include "core/error.hpp"
+#include "support/species_profiles.hpp"
 #include "synth/scanner.hpp"
 #include "synth/tile.hpp"
 
@@ -12,20 +13,16 @@
 #include <cmath>
 
 using namespace treelobes;
+using treelobes::test::species_profiles;
 
 namespace {
-
-const std::vector<SpeciesProfile>& library() {
-    static const std::vector<SpeciesProfile> profiles = load_species_profiles(default_species_file());
-    return profiles;
-}
 
 synth::Scene one_tree(const std::string& name, double height, std::uint64_t seed = 1) {
     synth::GrowOptions o;
     o.height_m = height;
     o.max_leaves = 30000;
     synth::Scene scene;
-    scene.trees.push_back({synth::grow(find_species_profile(library(), name), seed, o), Eigen::Vector3d::Zero(), 1});
+    scene.trees.push_back({synth::grow(find_species_profile(species_profiles(), name), seed, o), Eigen::Vector3d::Zero(), 1});
     scene.ground = synth::make_ground(-6, -6, 6, 6, 0, 0, 0.02, 3);
     return scene;
 }
@@ -103,7 +100,7 @@ TEST(Scan, AlsRecordsMultipleReturnsThroughCrowns) {
     t.trees = 8;
     t.size_m = 30;
     t.grow.max_leaves = 10000;
-    const synth::Tile tile = synth::make_tile(library(), 4, t);
+    const synth::Tile tile = synth::make_tile(species_profiles(), 4, t);
     synth::AlsOptions o;
     o.pulse_density = 4;
     const PointCloud cloud = synth::scan_als(tile.scene, o, 4);

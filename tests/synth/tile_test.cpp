@@ -1,6 +1,7 @@
 // Forest tiles: placement without trunk overlap, truth table, ground.
 #include "config/species_profile.hpp"
 #include "core/error.hpp"
+#include "support/species_profiles.hpp"
 #include "synth/tile.hpp"
 
 #include <gtest/gtest.h>
@@ -8,13 +9,9 @@
 #include <sstream>
 
 using namespace treelobes;
+using treelobes::test::species_profiles;
 
 namespace {
-
-const std::vector<SpeciesProfile>& library() {
-    static const std::vector<SpeciesProfile> profiles = load_species_profiles(default_species_file());
-    return profiles;
-}
 
 synth::TileOptions small_tile() {
     synth::TileOptions t;
@@ -36,7 +33,7 @@ double collar(const synth::SyntheticTree& tree) {
 }  // namespace
 
 TEST(Tile, TrunksNeverOverlapAndTruthMatches) {
-    const synth::Tile tile = synth::make_tile(library(), 3, small_tile());
+    const synth::Tile tile = synth::make_tile(species_profiles(), 3, small_tile());
     ASSERT_EQ(tile.scene.trees.size(), 25u);
     ASSERT_EQ(tile.truth.size(), 25u);
     std::set<std::string> species;
@@ -61,7 +58,7 @@ TEST(Tile, GroundSlopesAndIsRough) {
     synth::TileOptions t = small_tile();
     t.trees = 0;
     t.slope_deg = 10;
-    const synth::Tile tile = synth::make_tile(library(), 8, t);
+    const synth::Tile tile = synth::make_tile(species_profiles(), 8, t);
     const auto& g = *tile.scene.ground;
     const auto [lo, hi] = std::minmax_element(g.z.begin(), g.z.end());
     EXPECT_GT(*hi - *lo, 40 * std::tan(10 * 3.14159265 / 180) * 0.5);  // at least half the slope's relief
@@ -72,7 +69,7 @@ TEST(Tile, TruthCsvHasOneRowPerTree) {
     t.trees = 4;
     t.species = {"pine", "oak"};
     t.origin = Eigen::Vector3d(600000, 5000000, 100);
-    const synth::Tile tile = synth::make_tile(library(), 1, t);
+    const synth::Tile tile = synth::make_tile(species_profiles(), 1, t);
     const std::string csv = synth::truth_csv(tile.truth);
     std::istringstream in(csv);
     std::string line;
@@ -93,7 +90,7 @@ TEST(Tile, OvercrowdedTilesFailWithAUsageError) {
     t.size_m = 6;
     t.species = {"oak"};
     try {
-        synth::make_tile(library(), 1, t);
+        synth::make_tile(species_profiles(), 1, t);
         FAIL();
     } catch (const Error& e) {
         EXPECT_EQ(e.code(), ExitCode::Usage);
@@ -101,5 +98,5 @@ TEST(Tile, OvercrowdedTilesFailWithAUsageError) {
     }
     t = small_tile();
     t.species = {"baobab"};
-    EXPECT_THROW(synth::make_tile(library(), 1, t), Error);
+    EXPECT_THROW(synth::make_tile(species_profiles(), 1, t), Error);
 }
