@@ -2,7 +2,7 @@
 //   .las               LAS 1.0-1.4, point formats 0-10 (core/las_io.cpp)
 //   .laz .copc.laz     LASzip-compressed LAS and COPC, decoded natively (core/laz_*.cpp, docs/laz.md)
 //   .ply               ASCII and binary PLY, any property order, scalar_* fields (core/ply_cloud_io.cpp)
-//   .pcd               PCL's PCD via pcl::io (core/pcd_io.cpp)
+//   .pcd               PCD: ascii, binary, binary_compressed; read by our parser, written by PCL (core/pcd_io.cpp)
 //   .xyz .txt .csv .pts .asc   delimited text: space, comma, semicolon or tab (core/text_cloud_io.cpp)
 //
 // Readers keep the file's coordinates exactly: the origin is chosen from the data (LAS: the

@@ -57,6 +57,8 @@ void check_ply_header(const fs::path& path, const std::string& name) {
     std::ifstream in(path, std::ios::binary);
     static const std::set<std::string> kPlyTypes{"char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
                                                  "int8", "uint8", "int16", "uint16", "int32", "uint32", "float32", "float64"};
+    std::error_code size_error;
+    const std::uintmax_t file_size = fs::file_size(path, size_error);
     std::string line;
     std::size_t read = 0;
     bool in_element = false;
@@ -84,7 +86,13 @@ void check_ply_header(const fs::path& path, const std::string& name) {
                 !is_number(word[2]))
                 bad("expected 'format ascii|binary_little_endian|binary_big_endian VERSION'");
         } else if (word[0] == "element") {
-            if (word.size() != 3 || word[2].find_first_not_of("0123456789") != std::string::npos) bad("expected 'element NAME COUNT'");
+            std::uint64_t count = 0;
+            const auto [end, error] = word.size() == 3 ? std::from_chars(word[2].data(), word[2].data() + word[2].size(), count)
+                                                       : std::from_chars_result{nullptr, std::errc::invalid_argument};
+            if (error != std::errc() || end != word[2].data() + word[2].size() || word[2][0] == '-') bad("expected 'element NAME COUNT'");
+            // Every item of an element takes at least one byte of the body, in any encoding. OpenMesh
+            // asked for 1.2 GB on a 1.3 kB file whose face count had 70 digits (fuzzing in CI).
+            if (!size_error && count > file_size) bad("element '" + word[1].substr(0, 32) + "' has more items than the file has bytes");
             in_element = true;
         } else if (word[0] == "property") {
             // OpenMesh wrote through a null pointer on a property before any element (fuzzing, 60 s with seed 1).

@@ -1,6 +1,7 @@
 // Writes the seed corpora of the fuzz targets (fuzz/seeds/<target>/) from the committed samples
 // in data/synthetic, config/ and lsystem/examples, through the project's own writers, so the
-// seeds are files the readers accept and every part of each format is present. The real LAS
+// seeds are files the readers accept and every part of each format is present (PCD also through
+// PCL's writer, for its ascii and binary_compressed encodings, which ours does not write). The real LAS
 // seeds (small idtrees/lidR tiles of ../shared/data) are added by scripts/fuzz.sh when present.
 //
 // Usage: fuzz_make_seeds SOURCE_DIR OUT_DIR
@@ -16,6 +17,8 @@
 #include "export/qsm.hpp"
 #include "lobes/tlobe_io.hpp"
 
+#include <pcl/io/pcd_io.h>
+#include <pcl/point_types.h>
 #include <zlib.h>
 
 #include <array>
@@ -52,6 +55,21 @@ TreeGraph first_nodes(const TreeGraph& tree, std::size_t count) {
     return out;
 }
 
+// The cloud's positions and intensities in PCD's other two encodings.
+void pcd_seeds_from_pcl(const PointCloud& cloud, const fs::path& out) {
+    pcl::PointCloud<pcl::PointXYZI> points;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        pcl::PointXYZI p;
+        p.x = cloud.positions[i].x();
+        p.y = cloud.positions[i].y();
+        p.z = cloud.positions[i].z();
+        p.intensity = cloud.intensity.empty() ? 0.0f : static_cast<float>(cloud.intensity[i]);
+        points.push_back(p);
+    }
+    pcl::io::savePCDFileASCII((out / "pcd/birch_ascii.pcd").string(), points);
+    pcl::io::savePCDFileBinaryCompressed((out / "pcd/birch_compressed.pcd").string(), points);
+}
+
 void cloud_seeds(const fs::path& source, const fs::path& out) {
     const PointCloud birch = thinned(read_las(source / "data/synthetic/birch_3.las"), 40);
     const PointCloud tile = thinned(read_las(source / "data/synthetic/tile/tile.las"), 40);
@@ -61,6 +79,7 @@ void cloud_seeds(const fs::path& source, const fs::path& out) {
     write_ply_cloud(birch, out / "ply_cloud/birch_ascii.ply", false);
     write_ply_cloud(tile, out / "ply_cloud/tile_binary.ply", true);
     write_pcd(birch, out / "pcd/birch.pcd");
+    pcd_seeds_from_pcl(birch, out);
     write_text_cloud(birch, out / "text_cloud/birch.xyz");
     write_text_cloud(tile, out / "text_cloud/tile.csv");
 }

@@ -1,4 +1,4 @@
-// PCD clouds (ascii and binary; core/pcd_io.cpp over PCL's reader).
+// PCD clouds in their three encodings: ascii, binary and binary_compressed (core/pcd_io.cpp).
 #include "core/cloud_io.hpp"
 #include "fuzz_support.hpp"
 

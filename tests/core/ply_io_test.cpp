@@ -301,6 +301,16 @@ TEST(Pcd, HeaderValueThatIsNotANumberIsBadInput) {
 
 // Found by the 60-second fuzz runs with seed 1: OpenMesh's PLY reader wrote through a null
 // pointer (SEGV) on a property declared before any element; unknown property types are refused too.
+TEST(MeshRead, PlyElementCountBeyondTheFileIsBadInputNotAnAllocation) {
+    EXPECT_EQ(error_code_of([&] { read_mesh(test::source_dir() / "tests/data/fuzz/ply_element_count_beyond_file.ply"); }),
+              ExitCode::InvalidInput);
+    TempDir dir;
+    write_text(dir / "many.ply",
+               "ply\nformat ascii 1.0\nelement vertex 3000\nproperty float x\nproperty float y\nproperty float z\n"
+               "end_header\n0 0 0\n");
+    EXPECT_EQ(error_code_of([&] { read_mesh(dir / "many.ply"); }), ExitCode::InvalidInput);
+}
+
 TEST(MeshRead, PlyPropertyBeforeAnyElementIsBadInputNotACrash) {
     EXPECT_EQ(error_code_of([&] { read_mesh(test::source_dir() / "tests/data/fuzz/ply_property_before_element.ply"); }),
               ExitCode::InvalidInput);
