@@ -205,7 +205,7 @@ std::vector<std::uint8_t> read_ascii_records(std::ifstream& in, const PcdHeader&
     std::vector<std::uint8_t> records;
     std::string line;
     std::size_t point = 0;
-    for (std::size_t number = 1; std::getline(in, line); ++number) {
+    while (std::getline(in, line)) {
         std::istringstream words(line);
         std::string word;
         if (!(words >> word)) continue;  // blank line
