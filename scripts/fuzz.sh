@@ -51,7 +51,9 @@ seeds=()
 real=${TREELOBES_REAL_DATA:-$(cd .. && pwd)/shared/data}
 if [ "$target" = las ] && [ -d "$real" ]; then
   mkdir -p "$corpus-real"
-  find "$real" -name '*.las' -size -8k 2>/dev/null | sort | head -40 | xargs -r cp -t "$corpus-real"
+  # Not `| head -40`: under pipefail, sort's SIGPIPE once head has its 40 lines fails the run.
+  mapfile -t small_tiles < <(find "$real" -name '*.las' -size -8k 2>/dev/null | sort)
+  [ ${#small_tiles[@]} -eq 0 ] || cp -t "$corpus-real" "${small_tiles[@]:0:40}"
   seeds+=("$corpus-real")
 fi
 # The LAZ target has no committed seeds: the real LAZ/COPC files under 64 kB are its seeds.
