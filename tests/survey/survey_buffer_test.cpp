@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <sstream>
 
 using namespace treelobes;
@@ -52,10 +53,11 @@ struct Plot {
     fs::path tiles, truth, single;
 };
 
-// The plot, its retiled squares and one run on the uncut plot, made once for the suite.
+// The plot, its retiled squares and one run on the uncut plot, made once for the suite (and its
+// folder removed when the process ends).
 const Plot& plot() {
-    static Plot* made = [] {
-        auto* p = new Plot;
+    static const std::unique_ptr<Plot> made = [] {
+        auto p = std::make_unique<Plot>();
         const std::string synth = cli() + " --log-level warn synth tile --trees 24 --size " + std::to_string(kPlotSize) +
                                   " --seed 7 --pulse-density 20 --max-leaves 2000 --origin 500000 5400000 300 --out '" +
                                   (p->dir / "plot").string() + "' >/dev/null";
