@@ -5,6 +5,7 @@
 // stored as .tlobe (and its skeleton as .dbf6) and synthesized back from the .tlobe; report.json
 // compares the rebuilt tree with the original (docs/rebuild.md).
 #include "apps/command.hpp"
+#include "apps/mesh_fidelity.hpp"
 #include "apps/option_table.hpp"
 #include "apps/reconstruction_flags.hpp"
 #include "apps/summary_values.hpp"
@@ -20,7 +21,6 @@
 #include "core/skeleton_io.hpp"
 #include "core/version.hpp"
 #include "encode/tree_file.hpp"
-#include "geometry/mesh_distance.hpp"
 #include "lobes/lobe_tree.hpp"
 #include "lobes/synthesis.hpp"
 #include "lobes/tlobe_io.hpp"
@@ -105,17 +105,6 @@ TriangleMesh faces_labelled(const TriangleMesh& mesh, const std::vector<std::uin
     return part;
 }
 
-std::pair<Eigen::Vector3d, Eigen::Vector3d> world_bounds(const TriangleMesh& mesh) {
-    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
-    for (const auto& face : mesh.faces)
-        for (int c : face) {
-            const Eigen::Vector3d p = mesh.origin + mesh.vertices[c].cast<double>();
-            lo = lo.cwiseMin(p);
-            hi = hi.cwiseMax(p);
-        }
-    return {lo, hi};
-}
-
 // The species: given, from the classifier (--model), or the documented default.
 struct SpeciesChoice {
     std::string reconstruction;  // empty: generic parameters
@@ -140,58 +129,6 @@ SpeciesChoice choose_species(const RebuildCliOptions& o, const PointCloud& sampl
     const auto best = static_cast<std::size_t>(std::max_element(p.begin(), p.end()) - p.begin());
     const std::string name = find_species(load_species_entries(default_species_file()), model.classes[best]).name;
     return {name, name, "classifier", p[best]};
-}
-
-json distance_json(const DistanceSummary& d, double diagonal) {
-    return {{"mean", rounded(d.mean, 4)},
-            {"median", rounded(d.median, 4)},
-            {"p95", rounded(d.p95, 4)},
-            {"max", rounded(d.max, 4)},
-            {"mean_of_diagonal", rounded(d.mean / diagonal, 5)},
-            {"p95_of_diagonal", rounded(d.p95 / diagonal, 5)},
-            {"max_of_diagonal", rounded(d.max / diagonal, 5)}};
-}
-
-// Metro-style comparison (Cignoni et al. 1998): both surfaces sampled alike, each sample's
-// distance to the other surface; the symmetric figures take the worse direction for the
-// percentile and the Hausdorff distance and the mean of both directions for the mean.
-json compare_surfaces(const TriangleMesh& original, const TriangleMesh& rebuilt, std::size_t samples, std::uint64_t seed, double diagonal) {
-    const std::vector<std::uint8_t> no_labels_a(original.faces.size(), 1), no_labels_b(rebuilt.faces.size(), 1);
-    const PointCloud on_original = synth::sample_surface(original, no_labels_a, samples, seed);
-    const PointCloud on_rebuilt = synth::sample_surface(rebuilt, no_labels_b, samples, seed + 1);
-    const DistanceSummary forward = summarise_distances(MeshDistance(rebuilt).distances(on_original));
-    const DistanceSummary backward = summarise_distances(MeshDistance(original).distances(on_rebuilt));
-    DistanceSummary symmetric;
-    symmetric.count = forward.count + backward.count;
-    symmetric.mean = 0.5 * (forward.mean + backward.mean);
-    symmetric.median = 0.5 * (forward.median + backward.median);
-    symmetric.p95 = std::max(forward.p95, backward.p95);
-    symmetric.max = std::max(forward.max, backward.max);
-    return {{"samples_per_surface", samples},
-            {"original_to_rebuilt", distance_json(forward, diagonal)},
-            {"rebuilt_to_original", distance_json(backward, diagonal)},
-            {"symmetric", distance_json(symmetric, diagonal)}};
-}
-
-// Silhouettes of the original and the rebuilt tree from the front, the side and the top, with
-// one camera per view framing the original.
-json silhouette_ious(const TriangleMesh& original, const TriangleMesh& rebuilt, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-    constexpr int kSize = 400;
-    render::View top;
-    top.forward = Eigen::Vector3d(0, 0, -1);
-    top.up = Eigen::Vector3d(0, 1, 0);
-    top.lo = lo;
-    top.hi = hi;
-    const std::pair<const char*, render::View> views[] = {
-            {"front", render::View::side(lo, hi, 0, 0)}, {"side", render::View::side(lo, hi, 90, 0)}, {"top", top}};
-    json ious = json::object();
-    for (const auto& [name, view] : views) {
-        render::Rasterizer a(kSize, kSize, view), b(kSize, kSize, view);
-        a.draw_mesh(original, {0, 0, 0, 255});
-        b.draw_mesh(rebuilt, {0, 0, 0, 255});
-        ious[name] = rounded(render::silhouette_iou(a.coverage(), b.coverage()), 4);
-    }
-    return ious;
 }
 
 // original | samples | rebuilt, one camera framing the original (side view, 10 degrees up).
@@ -248,10 +185,8 @@ void print_summary(const json& r) {
                 r["rebuilt"]["triangles"].get<std::size_t>(), f["symmetric"]["mean"].get<double>(),
                 100 * f["symmetric"]["mean_of_diagonal"].get<double>(), f["symmetric"]["p95"].get<double>(),
                 f["symmetric"]["max"].get<double>());
-    std::printf("  silhouette IoU front %.2f, side %.2f, top %.2f; leaf area %.1f -> %.1f m^2\n",
-                f["silhouette_iou"]["front"].get<double>(), f["silhouette_iou"]["side"].get<double>(),
-                f["silhouette_iou"]["top"].get<double>(), f["leaf_area"]["original_m2"].get<double>(),
-                f["leaf_area"]["rebuilt_m2"].get<double>());
+    print_silhouettes(f);
+    std::printf("  leaf area %.1f -> %.1f m^2\n", f["leaf_area"]["original_m2"].get<double>(), f["leaf_area"]["rebuilt_m2"].get<double>());
     std::printf("  %.1f s (%.1f s CPU), peak memory %.0f MB\n", r["seconds"]["total"].get<double>(), r["seconds"]["cpu"].get<double>(),
                 r["peak_memory_mb"].get<double>());
 }
@@ -340,8 +275,10 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     write_mesh(rebuilt_all, mesh_path);
 
     clock.start("compare", "comparing the rebuilt tree with the original");
-    json fidelity = compare_surfaces(original, rebuilt_all, o.compare_samples, o.seed, diagonal);
-    fidelity["silhouette_iou"] = silhouette_ious(original, rebuilt_all, lo, hi);
+    MeshFidelityOptions fidelity_options;
+    fidelity_options.samples = o.compare_samples;
+    fidelity_options.seed = o.seed;
+    json fidelity = mesh_fidelity(original, rebuilt_all, fidelity_options);
     const double rebuilt_leaf_area = rebuilt.leaves.area();
     fidelity["leaf_area"] = {{"original_m2", rounded(label_report.leaf_area, 3)},
                              {"rebuilt_m2", rounded(rebuilt_leaf_area, 3)},

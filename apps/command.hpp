@@ -80,6 +80,7 @@ void add_classify_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_export_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job);
+void add_compare_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_batch_command(CLI::App& app, const GlobalOptions& global, Job& job);
 void add_merge_command(CLI::App& app, const GlobalOptions& global, Job& job);

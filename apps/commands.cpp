@@ -15,6 +15,7 @@ void add_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     add_lobes_commands(app, global, job);
     add_export_command(app, global, job);
     add_rebuild_command(app, global, job);
+    add_compare_command(app, global, job);
     add_tile_command(app, global, job);
     add_batch_command(app, global, job);
     add_merge_command(app, global, job);

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace treelobes::render {
 
@@ -184,6 +185,82 @@ double silhouette_iou(const std::vector<bool>& a, const std::vector<bool>& b) {
         either += a[i] || b[i];
     }
     return either == 0 ? 1.0 : static_cast<double>(both) / static_cast<double>(either);
+}
+
+namespace {
+
+// The pixel offsets of a disc of radius `r`.
+std::vector<std::pair<int, int>> disc_offsets(int r) {
+    std::vector<std::pair<int, int>> offsets;
+    for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx)
+            if (dx * dx + dy * dy <= r * r) offsets.emplace_back(dx, dy);
+    return offsets;
+}
+
+// Dilation (`grow`) or erosion of a padded mask by a disc: a pixel is set after dilation when
+// any pixel of the disc around it is set, kept after erosion when all of them are.
+std::vector<bool> morph(const std::vector<bool>& mask, int width, int height, int r, bool grow) {
+    const auto disc = disc_offsets(r);
+    std::vector<bool> out(mask.size(), !grow);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            bool value = !grow;
+            for (const auto& [dx, dy] : disc) {
+                const int u = x + dx, v = y + dy;
+                const bool set = u >= 0 && v >= 0 && u < width && v < height && mask[static_cast<std::size_t>(v) * width + u];
+                if (set == grow) {
+                    value = grow;
+                    break;
+                }
+            }
+            out[static_cast<std::size_t>(y) * width + x] = value;
+        }
+    return out;
+}
+
+// Sets every unset pixel that no path of unset pixels joins to the border.
+void fill_holes(std::vector<bool>& mask, int width, int height) {
+    std::vector<bool> outside(mask.size(), false);
+    std::vector<std::size_t> stack;
+    auto visit = [&](int x, int y) {
+        const std::size_t i = static_cast<std::size_t>(y) * width + x;
+        if (mask[i] || outside[i]) return;
+        outside[i] = true;
+        stack.push_back(i);
+    };
+    for (int x = 0; x < width; ++x) visit(x, 0), visit(x, height - 1);
+    for (int y = 0; y < height; ++y) visit(0, y), visit(width - 1, y);
+    while (!stack.empty()) {
+        const std::size_t i = stack.back();
+        stack.pop_back();
+        const int x = static_cast<int>(i % width), y = static_cast<int>(i / width);
+        if (x > 0) visit(x - 1, y);
+        if (x + 1 < width) visit(x + 1, y);
+        if (y > 0) visit(x, y - 1);
+        if (y + 1 < height) visit(x, y + 1);
+    }
+    for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = !outside[i];
+}
+
+}  // namespace
+
+std::vector<bool> crown_outline(const std::vector<bool>& mask, int width, int height, int closing_px) {
+    if (width <= 0 || height <= 0 || mask.size() != static_cast<std::size_t>(width) * height || closing_px < 0)
+        throw Error(ExitCode::Internal, "crown_outline: mask and size disagree");
+    // Padded by the disc's radius, so that the closing does not depend on the frame's edge.
+    const int pad = closing_px, pw = width + 2 * pad, ph = height + 2 * pad;
+    std::vector<bool> padded(static_cast<std::size_t>(pw) * ph, false);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            padded[static_cast<std::size_t>(y + pad) * pw + x + pad] = mask[static_cast<std::size_t>(y) * width + x];
+    if (closing_px > 0) padded = morph(morph(padded, pw, ph, closing_px, true), pw, ph, closing_px, false);
+    fill_holes(padded, pw, ph);
+    std::vector<bool> out(mask.size());
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            out[static_cast<std::size_t>(y) * width + x] = padded[static_cast<std::size_t>(y + pad) * pw + x + pad];
+    return out;
 }
 
 }  // namespace treelobes::render

@@ -66,6 +66,13 @@ private:
 // the outlines of two models drawn with the same view (`treelobes rebuild`).
 double silhouette_iou(const std::vector<bool>& a, const std::vector<bool>& b);
 
+// The crown's outline as one would draw it around a silhouette (width x height, row-major): a
+// morphological closing with a disc of `closing_px` pixels (gaps between leaves and twigs
+// narrower than the disc are bridged), then every hole not open to the image border filled.
+// Two crowns of the same shape but other leaf and twig placement have nearly the same outline,
+// where their raw silhouettes share few pixels (docs/rebuild.md).
+std::vector<bool> crown_outline(const std::vector<bool>& mask, int width, int height, int closing_px);
+
 // Multiplies an RGB colour by a light factor in [0, 1] (alpha unchanged).
 Rgba shade(Rgba colour, double light);
 

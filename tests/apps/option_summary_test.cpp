@@ -81,6 +81,8 @@ const Row kRows[] = {
          "rebuild {in}/palm/palm_3_mesh.obj --out {out} --species palm --samples 20000 --compare-samples 2000 --max-triangles 20000 "
          "--image-height 160",
          "report.json", "/options", R"({"samples": 20000, "image_height": 160, "species": "palm"})"},
+        {"compare", "--json compare {in}/palm/palm_3_mesh.obj {in}/palm/palm_3_mesh.obj --compare-samples 2000 --silhouette-px 64", "",
+         "/options", R"({"compare_samples": 2000, "silhouette_px": 64, "crown_closing_px": 8})"},
         {"tile", "tile {data}/tile/tile.las --out {out} --map-size 300 --min-tree-points 30", "summary.json", "/options",
          R"({"map_size": 300, "mode": "auto", "min_tree_points": 30})"},
         {"batch", "--json batch {in}/tiles --out {out} --max-memory 8G --map-size 300", "", "/options", R"({"max_memory": "8G"})"},

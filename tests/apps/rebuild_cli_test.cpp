@@ -62,7 +62,11 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
         const double iou = report["fidelity"]["silhouette_iou"][view].get<double>();
         EXPECT_GT(iou, 0.1) << view;  // overlapping outlines (the palm's synthesized fronds are far larger: docs/rebuild.md)
         EXPECT_LE(iou, 1.0) << view;
+        const double crown = report["fidelity"]["crown_silhouette_iou"][view].get<double>();
+        EXPECT_GT(crown, 0.1) << view;
+        EXPECT_LE(crown, 1.0) << view;
     }
+    EXPECT_EQ(report["fidelity"]["crown_closing_px"], 8);
     EXPECT_GT(report["fidelity"]["leaf_area"]["original_m2"].get<double>(), 0);
     EXPECT_GT(report["rebuilt"]["triangles"].get<int>(), 0);
     EXPECT_LE(report["rebuilt"]["triangles"].get<int>(), 20000);

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 using namespace treelobes;
 using namespace treelobes::render;
 
@@ -57,4 +59,59 @@ TEST(Render, PointsAndSkeletonDrawWhereExpected) {
     int dark = 0;
     for (int y = 0; y < 50; ++y) dark += r.image().at(25, y)[0] == 0 || r.image().at(24, y)[0] == 0;
     EXPECT_GT(dark, 40);
+}
+
+namespace {
+
+// A width x height mask with the pixels where `inside(x, y)` holds.
+template <class Inside>
+std::vector<bool> mask_of(int width, int height, Inside inside) {
+    std::vector<bool> mask(static_cast<std::size_t>(width) * height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) mask[static_cast<std::size_t>(y) * width + x] = inside(x, y);
+    return mask;
+}
+
+bool in_disc(int x, int y, int cx, int cy, int r) { return (x - cx) * (x - cx) + (y - cy) * (y - cy) <= r * r; }
+
+std::size_t count(const std::vector<bool>& mask) { return static_cast<std::size_t>(std::count(mask.begin(), mask.end(), true)); }
+
+}  // namespace
+
+// A crown drawn as scattered leaves (every third pixel of a disc) and the same disc with the
+// leaves shifted by a pixel: as drawn they share no pixel, as crown outlines they are one disc
+// (less a rim narrower than the spacing of the leaves, which the closing cannot reach beyond).
+TEST(CrownOutline, BridgesGapsBetweenLeavesAndFillsTheCrown) {
+    const int size = 100;
+    const auto leaves = [&](int shift) {
+        return mask_of(size, size, [&](int x, int y) { return in_disc(x, y, 50, 50, 30) && (x + shift) % 3 == 0 && y % 3 == 0; });
+    };
+    const auto a = leaves(0), b = leaves(1);
+    EXPECT_EQ(silhouette_iou(a, b), 0.0);
+    const auto crown_a = crown_outline(a, size, size, 3), crown_b = crown_outline(b, size, size, 3);
+    EXPECT_GT(silhouette_iou(crown_a, crown_b), 0.9);
+    for (int y = 0; y < size; ++y)
+        for (int x = 0; x < size; ++x) {
+            const bool inner = in_disc(x, y, 50, 50, 27), outer = !in_disc(x, y, 50, 50, 30);
+            if (inner || outer) {
+                EXPECT_EQ(crown_a[y * size + x], inner) << x << "," << y;
+            }
+        }
+    EXPECT_EQ(crown_outline(a, size, size, 0), a) << "no closing and no enclosed hole: the mask as it is";
+}
+
+// An enclosed hole is filled whatever the closing; a notch open to the border is not, nor is the
+// space between two crowns farther apart than the closing disc.
+TEST(CrownOutline, FillsEnclosedHolesButKeepsOpenGapsAndSeparateCrowns) {
+    const int size = 80;
+    const auto ring = mask_of(size, size, [](int x, int y) { return in_disc(x, y, 40, 40, 30) && !in_disc(x, y, 40, 40, 20); });
+    const auto filled = crown_outline(ring, size, size, 0);
+    EXPECT_TRUE(filled[40 * size + 40]);
+    EXPECT_EQ(count(filled), count(mask_of(size, size, [](int x, int y) { return in_disc(x, y, 40, 40, 30); })));
+
+    const auto two = mask_of(size, size, [](int x, int y) { return in_disc(x, y, 15, 40, 10) || in_disc(x, y, 65, 40, 10); });
+    const auto outline = crown_outline(two, size, size, 5);
+    EXPECT_FALSE(outline[40 * size + 40]) << "30 px apart: two crowns, not one";
+    EXPECT_EQ(count(outline), count(two));
+    EXPECT_THROW(crown_outline(two, size, size - 1, 5), Error);
 }
