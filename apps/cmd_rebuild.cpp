@@ -370,6 +370,7 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
                      {"polygons_split", named.report.polygons_split},
                      {"degenerate_faces_dropped", named.report.degenerate_faces},
                      {"normals_ignored", named.report.normals_ignored},
+                     {"primitives_skipped", named.report.primitives_skipped},
                      {"named_parts", named.names.size()},
                      {"origin", {original.origin.x(), original.origin.y(), original.origin.z()}},
                      {"bbox_diagonal_m", rounded(diagonal, 4)},
