@@ -86,7 +86,7 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, Job& job) {
                                        "How close mesh B is to mesh A: surface distances, silhouette and crown-outline IoU (front, side, "
                                        "top), leaf areas");
     auto table = std::make_shared<OptionTable>(sub);
-    sub->add_option("a", o->first, "Reference mesh (.obj, .ply, .off, .stl); distances are also given in fractions of its diagonal")
+    sub->add_option("a", o->first, "Reference mesh (.obj, .glb, .ply, .off, .stl); distances are also given in fractions of its diagonal")
             ->required();
     sub->add_option("b", o->second, "Mesh compared with it")->required();
     table->add("--compare-samples", o->fidelity.samples, "Samples per surface for the distances")->check(CLI::Range(1000, 10000000));

@@ -307,6 +307,7 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
                      {"polygons_split", named.report.polygons_split},
                      {"degenerate_faces_dropped", named.report.degenerate_faces},
                      {"normals_ignored", named.report.normals_ignored},
+                     {"primitives_skipped", named.report.primitives_skipped},
                      {"named_parts", named.names.size()},
                      {"origin", {original.origin.x(), original.origin.y(), original.origin.z()}},
                      {"bbox_diagonal_m", rounded(diagonal, 4)},
@@ -386,9 +387,11 @@ void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     o->synthesis.max_triangles = 200000;
     o->flags.species = "auto";
     CLI::App* sub = app.add_subcommand(
-            "rebuild", "A heavy polygonal tree (OBJ/PLY/OFF/STL) in, a light lobe-based tree (.tlobe, .dbf6) out, with a fidelity report");
+            "rebuild",
+            "A heavy polygonal tree (OBJ/glb/PLY/OFF/STL) in, a light lobe-based tree (.tlobe, .dbf6) out, with a fidelity report");
     auto table = std::make_shared<OptionTable>(sub);
-    sub->add_option("mesh", o->input, "Tree model: .obj (materials/groups name bark and leaves), .ply, .off, .stl")->required();
+    sub->add_option("mesh", o->input, "Tree model: .obj or .glb (material/group names tell bark from leaves), .ply, .off, .stl")
+            ->required();
     table->add("--out", o->out, "Output folder: <stem>.tlobe, .dbf6, _rebuilt.ply, _skeleton.ply, _samples.ply, _compare.png, report.json")
             ->required();
     add_species_flags(*table, o->flags, "Lobe diameter factor f_s of Eq. 2 (default 1.0, or the species')", o->stage);

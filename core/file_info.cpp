@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "core/mesh_io.hpp"
 #include "core/georef_sidecar.hpp"
+#include "core/glb_container.hpp"
 #include "core/ply_format.hpp"
 #include "core/qsm_io.hpp"
 #include "core/atomic_file.hpp"
@@ -142,35 +143,10 @@ FileInfo describe_qsm(const fs::path& path) {
     return info;
 }
 
-std::uint32_t little_endian_u32(const std::string& bytes, std::size_t at) {
-    std::uint32_t v = 0;
-    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(k)]);
-    return v;
-}
-
-// The JSON chunk of a .glb (glTF 2.0 §4.4), after checking the header and chunk lengths.
-nlohmann::json glb_json(const fs::path& path) {
-    const std::string name = path.string();
-    const std::string bytes = read_file(path);
-    if (bytes.size() < 20 || little_endian_u32(bytes, 0) != 0x46546C67) throw Error::input(name, "not a glTF binary (no glTF header)");
-    if (little_endian_u32(bytes, 4) != 2)
-        throw Error::input(name, "glTF binary version " + std::to_string(little_endian_u32(bytes, 4)) + ", expected 2");
-    if (little_endian_u32(bytes, 8) != bytes.size())
-        throw Error::input(name, "glTF binary length does not match the file size (truncated?)");
-    const std::size_t json_length = little_endian_u32(bytes, 12);
-    if (little_endian_u32(bytes, 16) != 0x4E4F534A || 20 + json_length > bytes.size())
-        throw Error::input(name, "glTF binary has no valid JSON chunk");
-    try {
-        return nlohmann::json::parse(bytes.substr(20, json_length));
-    } catch (const nlohmann::json::exception& e) {
-        throw Error::input(name, std::string("glTF JSON chunk: ") + e.what());
-    }
-}
-
 // Counts and bounds of what the default scene shows (LOD 0), back in our z-up frame, plus the
 // origin of the georef sidecar.
 FileInfo describe_glb(const fs::path& path) {
-    const nlohmann::json doc = glb_json(path);
+    const nlohmann::json doc = parse_glb_json(read_glb_container(path), path.string());
     FileInfo info;
     info.kind = "mesh";
     info.format = "glb";

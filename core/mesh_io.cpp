@@ -1,5 +1,5 @@
-// Mesh files: OBJ through core/obj_mesh_io.cpp (face names), PLY, OFF, STL and OM through
-// OpenMesh. Points are read in double precision so georeferenced meshes keep their precision;
+// Mesh files: OBJ through core/obj_mesh_io.cpp and glb through core/glb_mesh_io.cpp (face
+// names), PLY, OFF, STL and OM through OpenMesh. Points are read in double precision so georeferenced meshes keep their precision;
 // the origin is moved into TriangleMesh::origin.
 #include "core/mesh_io.hpp"
 
@@ -7,6 +7,7 @@
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
+#include "core/glb_mesh_io.hpp"
 #include "core/obj_mesh_io.hpp"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -34,7 +35,9 @@ struct DoubleTraits : OpenMesh::DefaultTraits {
 };
 using PolyMesh = OpenMesh::PolyMesh_ArrayKernelT<DoubleTraits>;
 
-bool is_mesh_extension(const std::string& ext) { return ext == "ply" || ext == "obj" || ext == "off" || ext == "stl" || ext == "om"; }
+bool is_mesh_extension(const std::string& ext) {
+    return ext == "ply" || ext == "obj" || ext == "off" || ext == "stl" || ext == "om" || ext == "glb";
+}
 
 // OpenMesh reports problems on its own error stream; we turn them into one Error line.
 void silence_openmesh() {
@@ -203,8 +206,10 @@ NamedMesh read_named_mesh(const fs::path& path) {
     if (fs::is_directory(path, ec)) throw Error::input(name, "is a directory, expected a mesh file");
     if (fs::file_size(path, ec) == 0) throw Error::input(name, "empty file");
     const std::string ext = file_extension(path);
-    if (!is_mesh_extension(ext)) throw Error::input(name, "unknown mesh format (expected .obj, .ply, .off, .stl)");
-    return ext == "obj" ? read_obj(path) : read_with_openmesh(path);
+    if (!is_mesh_extension(ext)) throw Error::input(name, "unknown mesh format (expected .obj, .glb, .ply, .off, .stl)");
+    if (ext == "obj") return read_obj(path);
+    if (ext == "glb") return read_glb(path);
+    return read_with_openmesh(path);
 }
 
 TriangleMesh read_mesh(const fs::path& path) { return read_named_mesh(path).mesh; }

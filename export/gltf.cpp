@@ -1,6 +1,7 @@
 #include "export/gltf.hpp"
 
 #include "core/error.hpp"
+#include "core/glb_container.hpp"
 #include "core/version.hpp"
 #include "render/image.hpp"
 #include "render/leaf_texture.hpp"
@@ -21,7 +22,6 @@ constexpr int kArrayBuffer = 34962, kElementArrayBuffer = 34963;
 constexpr int kFloat = 5126, kUnsignedInt = 5125;
 constexpr int kLinear = 9729, kLinearMipmapLinear = 9987, kClampToEdge = 33071;
 constexpr int kLeafTextureSize = 64;
-constexpr std::uint32_t kGlbMagic = 0x46546C67, kJsonChunk = 0x4E4F534A, kBinChunk = 0x004E4942;
 
 // Our z-up frame to glTF's y-up frame.
 Eigen::Vector3f y_up(const Eigen::Vector3f& p) { return {p.x(), p.z(), -p.y()}; }
@@ -152,10 +152,10 @@ std::string assemble_glb(const json& document, std::string bin) {
     put_u32(out, 2);
     put_u32(out, static_cast<std::uint32_t>(12 + 8 + text.size() + 8 + bin.size()));
     put_u32(out, static_cast<std::uint32_t>(text.size()));
-    put_u32(out, kJsonChunk);
+    put_u32(out, kGlbJsonChunk);
     out += text;
     put_u32(out, static_cast<std::uint32_t>(bin.size()));
-    put_u32(out, kBinChunk);
+    put_u32(out, kGlbBinChunk);
     out += bin;
     return out;
 }

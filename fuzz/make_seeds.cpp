@@ -119,7 +119,7 @@ void skeleton_and_mesh_seeds(const fs::path& source, const fs::path& out) {
     }
     stl << "endsolid palm\n";
     write_bytes(out / "mesh/palm.stl", std::string(1, '\2') + stl.str());
-    // The mesh seeds carry the format-selecting first byte of mesh_fuzz.cpp (obj, off, stl, ply).
+    // The mesh seeds carry the format-selecting first byte of mesh_fuzz.cpp (obj, off, stl, ply, glb).
     const char* extensions[] = {"obj", "off", "ply"};
     const char selector[] = {0, 1, 3};
     for (int k = 0; k < 3; ++k) {
@@ -129,6 +129,9 @@ void skeleton_and_mesh_seeds(const fs::path& source, const fs::path& out) {
         const std::string body((std::istreambuf_iterator<char>(in)), {});
         write_bytes(file, std::string(1, selector[k]) + body);
     }
+    // glb through the export's writer: the faces as one tree's bark (with normals, a material, a node).
+    const exporting::GltfTree tree{"palm", mesh.origin, {{mesh, {}, {}}}, {}, ""};
+    write_bytes(out / "mesh/palm.glb", std::string(1, '\4') + exporting::glb_bytes({tree}, mesh.origin));
 }
 
 encode::StoredTree stored_code(const TreeGraph& tree, encode::Coder coder, int lods) {

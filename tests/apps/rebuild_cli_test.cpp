@@ -1,8 +1,10 @@
-// `treelobes rebuild` end to end on a small leafy synthetic tree exported as OBJ with bark and
-// leaf materials: every output, a sane report, the comparison PNG's size; broken meshes exit 2
-// with one line, bad options exit 1.
+// `treelobes rebuild` end to end on a small leafy synthetic tree exported as OBJ (and as glb)
+// with bark and leaf materials: every output, a sane report, the comparison PNG's size; broken
+// meshes exit 2 with one line, bad options exit 1.
 #include "core/atomic_file.hpp"
+#include "core/mesh_io.hpp"
 #include "render/image.hpp"
+#include "support/glb_builder.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -133,6 +135,42 @@ TEST(RebuildCli, SameInputSameOutputs) {
     ASSERT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(b.path()) + args + " --threads 1").exit_code, 0);
     for (const char* file : {"palm_3_mesh.tlobe", "palm_3_mesh.dbf6", "palm_3_mesh_rebuilt.ply", "palm_3_mesh_compare.png"})
         EXPECT_EQ(read_file(a / file), read_file(b / file)) << file;
+}
+
+// The palm as another tool might write it in glTF: y-up, one u32-indexed primitive per OBJ
+// material ("bark", "leaf"), sharing one POSITION accessor.
+TEST(RebuildCli, GlbModelIsLabelledByItsMaterialNames) {
+    TempDir in, out;
+    const NamedMesh palm = read_named_mesh(small_tree_obj(in));
+    ASSERT_FALSE(palm.face_names.empty());
+    test::GlbBuilder glb;
+    std::vector<Eigen::Vector3f> y_up;
+    for (const Eigen::Vector3f& v : palm.mesh.vertices) y_up.emplace_back(v.x(), v.z(), -v.y());
+    const int positions = glb.positions(y_up);
+    nlohmann::json primitives = nlohmann::json::array();
+    for (std::uint32_t n = 0; n < palm.names.size(); ++n) {
+        std::vector<std::uint32_t> indices;
+        for (std::size_t f = 0; f < palm.mesh.faces.size(); ++f)
+            if (palm.face_names[f] == n)
+                for (int corner : palm.mesh.faces[f]) indices.push_back(static_cast<std::uint32_t>(corner));
+        glb.doc["materials"].push_back({{"name", palm.names[n].material}});
+        primitives.push_back({{"attributes", {{"POSITION", positions}}},
+                              {"indices", glb.accessor(indices, test::GlbBuilder::kUnsignedInt, "SCALAR")},
+                              {"material", n}});
+    }
+    glb.doc["nodes"] = {{{"name", "palm"}, {"mesh", glb.mesh("palm", primitives)}}};
+    glb.doc["scenes"][0]["nodes"] = {0};
+    test::write_text(in / "palm.glb", glb.bytes());
+
+    const auto r = run_cli("rebuild " + quoted(in / "palm.glb") + " --out " + quoted(out.path()) + " --species palm" + kFastRebuild);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto report = nlohmann::json::parse(read_file(out / "report.json"));
+    EXPECT_EQ(report["input_mesh"]["format"], "glb");
+    EXPECT_EQ(report["input_mesh"]["triangles"].get<std::size_t>(), palm.mesh.faces.size());
+    const auto& labels = report["input_mesh"]["labels"];
+    EXPECT_GT(labels["leaf_by_name"].get<int>(), 1000);
+    EXPECT_GT(labels["wood_by_name"].get<int>(), 1000);
+    EXPECT_EQ(labels["wood_by_geometry"].get<int>() + labels["leaf_by_geometry"].get<int>(), 0);
 }
 
 TEST(RebuildCli, BrokenMeshesExitTwoWithOneLine) {

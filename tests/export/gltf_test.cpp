@@ -1,6 +1,9 @@
 // glTF 2.0 binary of trees: structure (LOD nodes with MSFT_lod, materials, georeferenced node
-// translations) and the Khronos glTF-Validator's verdict: no errors, no warnings.
+// translations), the Khronos glTF-Validator's verdict (no errors, no warnings) and the triangles
+// core/glb_mesh_io.cpp reads back.
 #include "core/atomic_file.hpp"
+#include "core/georef_sidecar.hpp"
+#include "core/mesh_io.hpp"
 #include "export/gltf.hpp"
 #include "export/tree_geometry.hpp"
 #include "render/image.hpp"
@@ -107,6 +110,39 @@ TEST(Gltf, TwoTreesWithLobesAreValidAndPlacedRelativeToTheSceneOrigin) {
     // The lobe tree's foliage: both octahedra (8 triangles each) at every LOD.
     const auto& foliage = doc["meshes"][doc["nodes"][0]["mesh"].get<int>()]["primitives"][1];
     EXPECT_EQ(doc["accessors"][foliage["indices"].get<int>()]["count"], 2 * 8 * 3);
+}
+
+// core/glb_mesh_io.cpp reads our export back: the same triangles, in the same order, at the
+// same world coordinates (the scene origin comes from the georef sidecar), named by material.
+TEST(Gltf, ReadBackGivesTheExportedTriangles) {
+    test::TempDir dir;
+    const Eigen::Vector3d a(500000, 5400000, 300), b(500010.5, 5400004.25, 301);
+    const std::vector<GltfTree> trees{gltf_tree(tree_with_lobes(a), 1), gltf_tree({"t2", test::sample_tree(b), {}, "", {}}, 1)};
+    write_file_atomically(dir / "two.glb", glb_bytes(trees, a));
+    write_georef_sidecar(dir / "two.glb", a, {});
+    const NamedMesh back = read_named_mesh(dir / "two.glb");
+    EXPECT_EQ(back.report.format, "glb");
+    EXPECT_EQ(back.report.degenerate_faces, 0u);
+
+    std::size_t face = 0;
+    for (const GltfTree& tree : trees)
+        for (const TriangleMesh* part : {&tree.lods[0].wood, &tree.lods[0].foliage})
+            for (const auto& f : part->faces) {
+                ASSERT_LT(face, back.mesh.faces.size());
+                for (int k = 0; k < 3; ++k) {
+                    const Eigen::Vector3d expected = tree.origin + part->vertices[static_cast<std::size_t>(f[k])].cast<double>();
+                    const Eigen::Vector3d got =
+                            back.mesh.origin + back.mesh.vertices[static_cast<std::size_t>(back.mesh.faces[face][k])].cast<double>();
+                    ASSERT_LT((got - expected).norm(), 1e-4)
+                            << "face " << face << ": " << got.transpose() << " vs " << expected.transpose();
+                }
+                const FaceNames& names = back.names[back.face_names[face]];
+                EXPECT_EQ(names.material, part == &tree.lods[0].wood ? "bark" : tree.name == "oak" ? "foliage" : "leaves");
+                EXPECT_EQ(names.group, tree.name);
+                EXPECT_EQ(names.object, tree.name);
+                ++face;
+            }
+    EXPECT_EQ(face, back.mesh.faces.size());
 }
 
 TEST(Gltf, TheValidatorRejectsABrokenFile) {
