@@ -11,6 +11,7 @@
 #include "core/log.hpp"
 #include "core/mesh_io.hpp"
 #include "core/version.hpp"
+#include "render/image.hpp"
 #include "synth/mesh_labels.hpp"
 
 #include <nlohmann/json.hpp>
@@ -26,7 +27,7 @@ namespace {
 using json = nlohmann::json;
 
 struct CompareCliOptions {
-    std::string first, second;
+    std::string first, second, png;
     MeshFidelityOptions fidelity;
 };
 
@@ -67,7 +68,9 @@ void print_summary(const json& r) {
 int run_compare(const CompareCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const LabelledMesh a = read_labelled(o.first), b = read_labelled(o.second);
     log_info("compare: distances and silhouettes");
-    json fidelity = mesh_fidelity(a.named.mesh, b.named.mesh, o.fidelity);
+    render::Image crowns;
+    json fidelity = mesh_fidelity(a.named.mesh, b.named.mesh, o.fidelity, o.png.empty() ? nullptr : &crowns);
+    if (!o.png.empty()) render::write_png(crowns, o.png);
     fidelity["leaf_area_ratio"] = a.labels.leaf_area > 0 ? json(rounded(b.labels.leaf_area / a.labels.leaf_area, 4)) : json();
     const json report = {{"treelobes", kVersion},      {"command", "compare"},        {"options", table.json()},
                          {"a", mesh_json(o.first, a)}, {"b", mesh_json(o.second, b)}, {"fidelity", fidelity}};
@@ -91,6 +94,7 @@ void add_compare_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     sub->add_option("b", o->second, "Mesh compared with it")->required();
     table->add("--compare-samples", o->fidelity.samples, "Samples per surface for the distances")->check(CLI::Range(1000, 10000000));
     table->add("--seed", o->fidelity.seed, "Random seed of the surface samples");
+    table->add("--png", o->png, "Also draw the crown outlines of both meshes (front, side, top; both / A only / B only) to this PNG");
     table->add("--silhouette-px", o->fidelity.silhouette_px, "Side of the square silhouette masks, pixels")->check(CLI::Range(32, 4096));
     table->add("--crown-closing-px", o->fidelity.crown_closing_px,
                "Crown outline: gaps narrower than this (pixels of the mask) are closed before holes are filled")

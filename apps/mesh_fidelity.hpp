@@ -5,6 +5,7 @@
 #pragma once
 
 #include "core/triangle_mesh.hpp"
+#include "render/image.hpp"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -26,8 +27,11 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> world_bounds(const TriangleMesh& mes
 
 // `original_to_rebuilt`, `rebuilt_to_original`, `symmetric` distances (m and fractions of the
 // original's bounding-box diagonal), `silhouette_iou` and `crown_silhouette_iou` per view
-// (front, side, top; one orthographic camera per view framing the original).
-nlohmann::json mesh_fidelity(const TriangleMesh& original, const TriangleMesh& rebuilt, const MeshFidelityOptions& options);
+// (front, side, top; one orthographic camera per view framing the original). With `crowns`, also
+// the picture of the crown outlines: one panel per view, each pixel coloured by which outline
+// holds it (both, the original's only, the rebuilt's only), the IoU above, a legend below.
+nlohmann::json mesh_fidelity(const TriangleMesh& original, const TriangleMesh& rebuilt, const MeshFidelityOptions& options,
+                             render::Image* crowns = nullptr);
 
 // The silhouette lines of the one-screen summaries (stdout).
 void print_silhouettes(const nlohmann::json& fidelity);

@@ -473,12 +473,7 @@ private:
         // Our exports store coordinates relative to the scene origin kept in the sidecar.
         const auto sidecar = read_georef_sidecar(path_);
         result_.mesh.origin = (sidecar ? sidecar->origin : Eigen::Vector3d::Zero()) + local_origin_;
-        bool named = false;
-        for (const FaceNames& n : result_.names) named = named || !n.empty();
-        if (named)
-            result_.face_names = std::move(face_names_);
-        else
-            result_.names.clear();
+        result_.adopt_face_names(std::move(face_names_));
         return std::move(result_);
     }
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace treelobes {
@@ -36,6 +37,17 @@ struct NamedMesh {
     std::vector<FaceNames> names;           // distinct name combinations, in order of first use
     std::vector<std::uint32_t> face_names;  // per face an index into `names`; empty when the file names no face
     MeshReadReport report;
+
+    // Takes the readers' per-face name indices when some name is not empty; otherwise the file
+    // names no face, and `names` and `face_names` are left empty.
+    void adopt_face_names(std::vector<std::uint32_t>&& per_face) {
+        bool named = false;
+        for (const FaceNames& n : names) named = named || !n.empty();
+        if (named)
+            face_names = std::move(per_face);
+        else
+            names.clear();
+    }
 };
 
 // Polygons are fan-triangulated, faces with a repeated corner dropped, non-manifold edges kept

@@ -172,12 +172,7 @@ private:
         auto& vertices = result_.mesh.vertices;
         vertices.reserve(positions_.size());
         for (const auto& p : positions_) vertices.push_back((p - result_.mesh.origin).cast<float>());
-        bool named = false;
-        for (const auto& n : result_.names) named = named || !n.empty();
-        if (named)
-            result_.face_names = std::move(face_names_);
-        else
-            result_.names.clear();
+        result_.adopt_face_names(std::move(face_names_));
         return std::move(result_);
     }
 

@@ -39,6 +39,9 @@ struct LobeTree {
     double beta = 1.5, gamma = 1.5, fs = 1.0;  // Livny et al. 2011, Table 1 parameters used
     double alpha_factor = 5.0;
     double root_diameter = 0.0;  // d_root (metres)
+    // The tree's one-sided leaf area (m^2) when it is known, 0 when not: `treelobes rebuild`
+    // stores the original mesh's, and synthesis then sizes the leaf blades to give it back.
+    double leaf_area_m2 = 0.0;
     std::vector<Lobe> lobes;
 
     // Seed point p_i of a lobe: position, thickness (d at p_i) and direction.

@@ -57,6 +57,20 @@ void add_leaf(TriangleMesh& mesh, const Eigen::Vector3f& base, const Eigen::Vect
     mesh.faces.push_back({i, i + 2, i + 3});
 }
 
+// Sizes every leaf blade (the four vertices of add_leaf) about its base so that the blades'
+// area is `target`: the tree's stored leaf area (a rebuilt model's original) instead of the area
+// that the species' patches and the triangle budget happen to give.
+void scale_leaves_to_area(TriangleMesh& leaves, double target, LeafShape shape) {
+    const double area = leaves.area();
+    if (!(area > 0)) return;
+    const auto s = static_cast<float>(std::sqrt(target / area));
+    for (std::size_t i = 0; i + 3 < leaves.vertices.size(); i += 4) {
+        Eigen::Vector3f* blade = &leaves.vertices[i];
+        const Eigen::Vector3f base = shape == LeafShape::Needle ? Eigen::Vector3f(0.5f * (blade[0] + blade[1])) : blade[0];
+        for (int k = 0; k < 4; ++k) blade[k] = base + s * (blade[k] - base);
+    }
+}
+
 std::size_t prefix(double fraction, std::size_t n) {
     return std::min(n, static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(n))));
 }
@@ -212,6 +226,7 @@ SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textu
                 ++out.leaf_count;
             }
         }
+    if (tree.leaf_area_m2 > 0) scale_leaves_to_area(out.leaves, tree.leaf_area_m2, textured.library.leaf_shape);
     return out;
 }
 

@@ -18,6 +18,10 @@
 //   - the leaves of every patch in their random library order (stochastic pruning: a prefix
 //     of ceil(f n) leaves is kept and enlarged by sqrt(n / kept) so the leaf area stays)
 // and a reduced mesh keeps the first fraction f of each list.
+//
+// A tree that stores its leaf area (LobeTree::leaf_area_m2 > 0: a `treelobes rebuild` of a mesh
+// with leaves) gets its leaf blades sized about their bases to give exactly that area, at every
+// level of detail; otherwise the blades keep the sizes of the species' patches.
 #pragma once
 
 #include "config/species_profile.hpp"

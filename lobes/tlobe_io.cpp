@@ -18,6 +18,7 @@ namespace {
 constexpr std::array<char, 4> kMagic{'T', 'L', 'O', 'B'};
 constexpr std::size_t kHeaderSize = 20;
 constexpr std::size_t kMaxPayload = std::size_t{1} << 30;  // 1 GiB: anything larger is not a .tlobe
+constexpr double kMaxLeafArea = 1e7;                       // m^2: a tree with more leaf area than 10 km^2 is a corrupt field
 // Deflate cannot expand data by more than about 1032:1 (zlib's technical details), so a
 // header claiming more is refused before the payload buffer is allocated.
 constexpr std::uint64_t kMaxInflateRatio = 1032;
@@ -112,6 +113,7 @@ std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const st
         encode_mesh(lobe.mesh, quantum, w);
         encode_occupancy(*occupancy[i], quantum, w);
     }
+    w.f32(static_cast<float>(tree.leaf_area_m2));  // since 3.1
     return w.bytes();
 }
 
@@ -184,10 +186,10 @@ LobeTree decode_tlobe(std::string_view file, const std::string& name) {
                    packed_size) != Z_OK ||
         unpacked != raw_size)
         throw Error::input(name, "corrupt .tlobe payload (inflate failed)");
-    return decode_tlobe_payload(raw, name);
+    return decode_tlobe_payload(raw, name, minor);
 }
 
-LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name) {
+LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int minor) {
     ByteReader in(raw, name);
     LobeTree tree;
     Eigen::Vector3d origin;
@@ -216,7 +218,12 @@ LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name) {
         lobe.mesh = decode_mesh(in, quantum);
         lobe.occupancy = decode_occupancy(in, quantum);
     }
-    if (!in.at_end()) in.fail("trailing bytes after the last lobe");
+    if (minor >= 1) {
+        tree.leaf_area_m2 = in.f32();
+        if (!(tree.leaf_area_m2 >= 0 && tree.leaf_area_m2 < kMaxLeafArea)) in.fail("invalid leaf area");
+    }
+    // A later minor version appends fields this build does not know: they are skipped.
+    if (minor <= kTlobeMinorVersion && !in.at_end()) in.fail("trailing bytes after the last field");
     return tree;
 }
 

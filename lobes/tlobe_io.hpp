@@ -18,7 +18,7 @@
 namespace treelobes::lobes {
 
 inline constexpr std::uint8_t kTlobeMajorVersion = 3;
-inline constexpr std::uint8_t kTlobeMinorVersion = 0;
+inline constexpr std::uint8_t kTlobeMinorVersion = 1;  // 3.1 appended the leaf area
 
 struct TlobeOptions {
     double quantum = 0.005;            // metres: grid of skeleton positions and lobe vertices
@@ -39,7 +39,8 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {})
 LobeTree decode_tlobe(std::string_view bytes, const std::string& name);
 // The inflated payload behind the header, size and CRC checks (what decode_tlobe parses once
 // they pass; fuzz/ feeds it directly so that mutations reach the parser). Same errors.
-LobeTree decode_tlobe_payload(std::string_view payload, const std::string& name);
+// `minor`: the header's minor version, which says which appended fields the payload holds.
+LobeTree decode_tlobe_payload(std::string_view payload, const std::string& name, int minor = kTlobeMinorVersion);
 
 void write_tlobe(const LobeTree& tree, const std::filesystem::path& path, const TlobeOptions& options = {});
 LobeTree read_tlobe(const std::filesystem::path& path);

@@ -1,6 +1,7 @@
 // `treelobes compare A B`: a mesh against itself is identical by every figure; the same tree with
 // its leaves drawn again keeps its crown outline while its raw silhouette changes, and another
 // tree of the species does not; broken meshes exit 2 with one line, bad options exit 1.
+#include "render/image.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -33,6 +34,18 @@ nlohmann::json compare(const std::filesystem::path& a, const std::filesystem::pa
 
 const char* kViews[] = {"front", "side", "top"};
 
+// Pixels of the crown picture's panels in the colour of one outline only (original only, rebuilt
+// only); the legend strip below them (26 px) holds a key of each colour.
+std::size_t one_sided_pixels(const render::Image& image) {
+    std::size_t n = 0;
+    for (int y = 0; y < image.height - 26; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            const render::Rgba c = image.at(x, y);
+            n += (c == render::Rgba{230, 120, 20, 255} || c == render::Rgba{40, 100, 200, 255});
+        }
+    return n;
+}
+
 }  // namespace
 
 TEST(CompareCli, AMeshAgainstItselfIsIdentical) {
@@ -50,9 +63,13 @@ TEST(CompareCli, AMeshAgainstItselfIsIdentical) {
         EXPECT_EQ(f["silhouette_iou"][view].get<double>(), 1.0) << view;
         EXPECT_EQ(f["crown_silhouette_iou"][view].get<double>(), 1.0) << view;
     }
-    const auto text = run_cli("compare " + quoted(mesh) + " " + quoted(mesh) + " --compare-samples 3000");
+    const auto text = run_cli("compare " + quoted(mesh) + " " + quoted(mesh) + " --compare-samples 3000 --silhouette-px 100 --png " +
+                              quoted(dir / "crowns.png"));
     ASSERT_EQ(text.exit_code, 0) << text.err;
     EXPECT_NE(text.out.find("crown outline IoU   front 1.00, side 1.00, top 1.00"), std::string::npos) << text.out;
+    const render::Image crowns = render::read_png(dir / "crowns.png");
+    EXPECT_EQ(crowns.width, 3 * 100);
+    EXPECT_EQ(one_sided_pixels(crowns), 0u) << "one crown over itself: every pixel in both";
 }
 
 // The oracle of docs/rebuild.md in small: with other leaves on the same branches the crown
@@ -62,7 +79,11 @@ TEST(CompareCli, RedrawnLeavesKeepTheCrownOutlineAnotherTreeDoesNot) {
     TempDir dense, sparse, other;
     const auto a = small_birch(dense, 3, 1.0);
     const auto releafed = compare(a, small_birch(sparse, 3, 0.5));
-    const auto different = compare(a, small_birch(other, 4, 1.0));
+    const auto b = small_birch(other, 4, 1.0);
+    const auto different = compare(a, b);
+    ASSERT_EQ(run_cli("compare " + quoted(a) + " " + quoted(b) + " --compare-samples 1000 --png " + quoted(other / "crowns.png")).exit_code,
+              0);
+    EXPECT_GT(one_sided_pixels(render::read_png(other / "crowns.png")), 1000u) << "two trees: outlines of their own";
     ASSERT_FALSE(releafed.is_null());
     ASSERT_FALSE(different.is_null());
     EXPECT_NEAR(releafed["fidelity"]["leaf_area_ratio"].get<double>(), 1.0, 0.1);
@@ -99,4 +120,5 @@ TEST(CompareCli, BrokenMeshesExitTwoWithOneLineBadOptionsOne) {
     EXPECT_EQ(run_cli("compare " + quoted(dir / "absent.obj") + " " + quoted(good)).exit_code, 2);
     EXPECT_EQ(run_cli("compare " + quoted(good) + " " + quoted(good) + " --silhouette-px 8").exit_code, 1);
     EXPECT_EQ(run_cli("compare " + quoted(good)).exit_code, 1);
+    EXPECT_EQ(run_cli("compare " + quoted(good) + " " + quoted(good) + " --png " + quoted(dir / "absent/crowns.png")).exit_code, 2);
 }

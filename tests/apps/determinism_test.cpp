@@ -96,6 +96,10 @@ const Command kCommands[] = {
         {"render", "render {data}/palm_1.las {data}/palm_1_skeleton.ply --out {out}/preview.png"},
         {"convert", "convert {data}/palm_1.las --out {out}/palm_1.ply --json"},
         {"tile", "tile {data}/tile/tile.las --out {out}/tile --json --min-tree-points 30"},  // every segment modelled: exit 0
+        {"rebuild",
+         "rebuild {data}/palm_1_mesh.ply --out {out} --species palm --samples 20000 --compare-samples 2000 --max-triangles 20000 "
+         "--image-height 160 --json"},
+        {"compare", "compare {data}/palm_1_mesh.ply {data}/palm_1_mesh.ply --compare-samples 2000 --png {out}/crowns.png --json"},
         {"export_glb", "export {data}/birch_3_skeleton.ply --format glb --out {out}/birch.glb --json"},
         {"export_qsm", "export {data}/birch_3_skeleton.ply --format qsm-csv --out {out}/birch.csv --json"},
 };

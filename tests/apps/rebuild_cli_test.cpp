@@ -40,7 +40,7 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     const auto report = nlohmann::json::parse(read_file(out / "report.json"));
     EXPECT_EQ(nlohmann::json::parse(r.out), report);
     for (const char* file : {"palm_3_mesh.tlobe", "palm_3_mesh.dbf6", "palm_3_mesh_rebuilt.ply", "palm_3_mesh_skeleton.ply",
-                             "palm_3_mesh_samples.ply", "palm_3_mesh_compare.png"})
+                             "palm_3_mesh_samples.ply", "palm_3_mesh_compare.png", "palm_3_mesh_crowns.png"})
         EXPECT_GT(std::filesystem::file_size(out / file), 0u) << file;
 
     const auto& labels = report["input_mesh"]["labels"];
@@ -70,6 +70,8 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     }
     EXPECT_EQ(report["fidelity"]["crown_closing_px"], 8);
     EXPECT_GT(report["fidelity"]["leaf_area"]["original_m2"].get<double>(), 0);
+    // The .tlobe stores the original's leaf area and the synthesized blades are sized to it.
+    EXPECT_NEAR(report["fidelity"]["leaf_area"]["ratio"].get<double>(), 1.0, 0.01);
     EXPECT_GT(report["rebuilt"]["triangles"].get<int>(), 0);
     EXPECT_LE(report["rebuilt"]["triangles"].get<int>(), 20000);
     EXPECT_GT(report["seconds"]["total"].get<double>(), 0);
@@ -78,6 +80,9 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     EXPECT_EQ(png.height, 160);
     EXPECT_EQ(png.width % 3, 0);  // three panels of one size
     EXPECT_GE(png.width, 3 * 40);
+    const render::Image crowns = render::read_png(out / "palm_3_mesh_crowns.png");
+    EXPECT_EQ(crowns.width, 3 * 400);  // three 400 px masks: front, side, top
+    EXPECT_GT(crowns.height, 400);     // the IoU above and the legend below
 }
 
 // --species auto: without --model the documented default (generic reconstruction parameters,
@@ -133,7 +138,8 @@ TEST(RebuildCli, SameInputSameOutputs) {
     const std::string args = " --scan tls --samples 8000 --compare-samples 2000 --max-triangles 8000 --image-height 100";
     ASSERT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(a.path()) + args).exit_code, 0);
     ASSERT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(b.path()) + args + " --threads 1").exit_code, 0);
-    for (const char* file : {"palm_3_mesh.tlobe", "palm_3_mesh.dbf6", "palm_3_mesh_rebuilt.ply", "palm_3_mesh_compare.png"})
+    for (const char* file :
+         {"palm_3_mesh.tlobe", "palm_3_mesh.dbf6", "palm_3_mesh_rebuilt.ply", "palm_3_mesh_compare.png", "palm_3_mesh_crowns.png"})
         EXPECT_EQ(read_file(a / file), read_file(b / file)) << file;
 }
 

@@ -236,6 +236,29 @@ TEST(Synthesis, LodKeepsThickestEdgesAndLeafArea) {
     EXPECT_EQ(error_code_of([&] { synthesized_mesh(tree, textured, 1.5, o); }), ExitCode::Usage);
 }
 
+// A stored leaf area (a rebuilt model's original) sizes the blades to give it exactly, at every
+// level of detail, about the blades' bases; the twigs and the blades' number and places stay.
+TEST(Synthesis, StoredLeafAreaSizesTheBlades) {
+    LobeTree tree = boxed_tree();
+    SynthesisOptions o;
+    o.texturing.fill_cell = 0.2;
+    const TexturedTree textured = texture_tree(tree, species("lagerstroemia"), o);
+    const SynthesizedMesh natural = synthesized_mesh(tree, textured, 1.0, o);
+    ASSERT_GT(natural.leaves.area(), 0);
+    for (const double factor : {0.25, 3.0}) {
+        tree.leaf_area_m2 = factor * natural.leaves.area();
+        for (const double lod : {1.0, 0.5}) {
+            const SynthesizedMesh sized = synthesized_mesh(tree, textured, lod, o);
+            EXPECT_NEAR(sized.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2) << factor << " at LOD " << lod;
+            EXPECT_EQ(sized.wood.faces.size(), synthesized_mesh(boxed_tree(), textured, lod, o).wood.faces.size());
+        }
+        const SynthesizedMesh sized = synthesized_mesh(tree, textured, 1.0, o);
+        ASSERT_EQ(sized.leaves.vertices.size(), natural.leaves.vertices.size());
+        for (std::size_t i = 0; i < sized.leaves.vertices.size(); i += 4)  // broad leaves: the base is a blade's first vertex
+            EXPECT_EQ(sized.leaves.vertices[i], natural.leaves.vertices[i]);
+    }
+}
+
 TEST(Synthesis, LeafyPatchesAreThinnedToTheTriangleBudget) {
     const LobeTree tree = boxed_tree();
     SynthesisOptions o;

@@ -7,7 +7,9 @@
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -50,6 +52,39 @@ LobeTree sample_tree() {
         t.lobes.push_back(lobe);
     }
     return t;
+}
+
+// The file `bytes` with minor version `minor` and its payload changed by `edit`: inflated,
+// edited, deflated, and the header's sizes and CRC-32 made right again (docs/tlobe.md).
+template <class Edit>
+std::string rewritten(const std::string& bytes, int minor, Edit edit) {
+    const auto u32 = [&](std::size_t at) {
+        std::uint32_t v = 0;
+        for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(bytes[at + k]);
+        return v;
+    };
+    std::string payload(u32(8), '\0');
+    uLongf size = payload.size();
+    EXPECT_EQ(uncompress(reinterpret_cast<Bytef*>(payload.data()), &size, reinterpret_cast<const Bytef*>(bytes.data() + 20),
+                         static_cast<uLong>(bytes.size() - 20)),
+              Z_OK);
+    edit(payload);
+    uLongf packed = compressBound(static_cast<uLong>(payload.size()));
+    std::string file(20 + packed, '\0');
+    compress(reinterpret_cast<Bytef*>(file.data() + 20), &packed, reinterpret_cast<const Bytef*>(payload.data()),
+             static_cast<uLong>(payload.size()));
+    file.resize(20 + packed);
+    std::copy(bytes.begin(), bytes.begin() + 8, file.begin());
+    file[5] = static_cast<char>(minor);
+    const auto put = [&](std::size_t at, std::uint32_t v) {
+        for (int k = 0; k < 4; ++k) file[at + k] = static_cast<char>((v >> (8 * k)) & 0xff);
+    };
+    put(8, static_cast<std::uint32_t>(payload.size()));
+    put(12, static_cast<std::uint32_t>(packed));
+    uLong crc = crc32(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(file.data()), 16);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(file.data() + 20), static_cast<uInt>(packed));
+    put(16, static_cast<std::uint32_t>(crc));
+    return file;
 }
 
 }  // namespace
@@ -120,7 +155,7 @@ TEST(Tlobe, DetectsCorruptionTruncationAndForeignFiles) {
     for (const int major : {kTlobeMajorVersion - 1, kTlobeMajorVersion + 1}) {
         std::string other = bytes;
         other[4] = static_cast<char>(major);
-        const std::string version = "version " + std::to_string(major) + ".0";
+        const std::string version = "version " + std::to_string(major) + "." + std::to_string(kTlobeMinorVersion);
         try {
             decode_tlobe(other, "other.tlobe");
             ADD_FAILURE() << version << " accepted";
@@ -129,6 +164,34 @@ TEST(Tlobe, DetectsCorruptionTruncationAndForeignFiles) {
             EXPECT_NE(std::string(e.what()).find(version), std::string::npos) << e.what();
             EXPECT_NE(std::string(e.what()).find("treelobes lobes"), std::string::npos) << e.what();
         }
+    }
+}
+
+// Version 3.1 appends the tree's leaf area: it round-trips; a 3.0 file (without it) reads as
+// leaf area unknown (0), a file written by the 3.0 writer among them; a later minor version's
+// appended fields are skipped, while bytes a known version does not define are refused, and so is
+// a leaf area that no tree has.
+TEST(Tlobe, LeafAreaSinceMinorVersionOne) {
+    LobeTree t = sample_tree();
+    t.leaf_area_m2 = 117.5;
+    const std::string bytes = encode_tlobe(t);
+    EXPECT_EQ(bytes[5], 1);
+    EXPECT_EQ(decode_tlobe(bytes, "t.tlobe").leaf_area_m2, 117.5);
+    const auto drop_leaf_area = [](std::string& payload) { payload.resize(payload.size() - 4); };
+    const LobeTree old = decode_tlobe(rewritten(bytes, 0, drop_leaf_area), "old.tlobe");
+    EXPECT_EQ(old.leaf_area_m2, 0.0);
+    EXPECT_EQ(old.lobes.size(), 2u);
+    const LobeTree seed = read_tlobe(test::source_dir() / "tests/data/tlobe/lagerstroemia_v3_0.tlobe");
+    EXPECT_EQ(seed.leaf_area_m2, 0.0);
+    EXPECT_FALSE(seed.lobes.empty());
+
+    const auto append = [](std::string& payload) { payload += "more"; };
+    EXPECT_EQ(decode_tlobe(rewritten(bytes, 2, append), "newer.tlobe").leaf_area_m2, 117.5);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 1, append), "x"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 0, [](std::string&) {}), "x"); }), ExitCode::InvalidInput);
+    for (const float bad : {-1.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+        const auto overwrite = [bad](std::string& payload) { std::memcpy(payload.data() + payload.size() - 4, &bad, 4); };
+        EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 1, overwrite), "x"); }), ExitCode::InvalidInput) << bad;
     }
 }
 
