@@ -54,7 +54,7 @@ json mesh_json(const std::string& path, const LabelledMesh& m) {
             {"wood_area_m2", rounded(m.labels.wood_area, 3)}};
 }
 
-void print_summary(const json& r) {
+void print_comparison(const json& r) {
     const json& f = r["fidelity"];
     std::printf("%s (A) against %s (B)\n", r["a"]["path"].get<std::string>().c_str(), r["b"]["path"].get<std::string>().c_str());
     std::printf("  triangles %zu / %zu, leaf area %.1f / %.1f m^2\n", r["a"]["triangles"].get<std::size_t>(),
@@ -77,7 +77,7 @@ int run_compare(const CompareCliOptions& o, const OptionTable& table, const Glob
     if (global.json)
         std::cout << report.dump(2) << "\n";
     else
-        print_summary(report);
+        print_comparison(report);
     return 0;
 }
 

@@ -69,7 +69,7 @@ render::Image outline_panel(const std::vector<bool>& original, const std::vector
 }
 
 // The three panels side by side over a legend of the colours.
-render::Image with_legend(const std::vector<render::Image>& panels) {
+render::Image with_colour_key(const std::vector<render::Image>& panels) {
     const render::Image row = render::side_by_side(panels);
     const int line = render::text_height(kTextScale), height = row.height + 2 * kMargin + line;
     render::Image image(row.width, height, kWhite);
@@ -113,7 +113,7 @@ void add_silhouettes(json& fidelity, const TriangleMesh& original, const Triangl
         std::snprintf(label, sizeof label, "%s  CROWN IOU %.2f", name, iou);
         if (picture) panels.push_back(outline_panel(crown_a, crown_b, size, label));
     }
-    if (picture) *picture = with_legend(panels);
+    if (picture) *picture = with_colour_key(panels);
     fidelity["silhouette_px"] = size;
     fidelity["silhouette_iou"] = drawn;
     fidelity["crown_closing_px"] = options.crown_closing_px;
