@@ -47,7 +47,9 @@ public:
                                    {"type", type}};
         if (normalized) accessor["normalized"] = true;
         doc["accessors"].push_back(accessor);
-        doc["buffers"] = {{{"byteLength", bin.size()}}};
+        // Updated in place: nlohmann-json 3.11.2 leaked the array it replaced when this was
+        // assigned a new initializer list on every call (LeakSanitizer, clang 14).
+        doc["buffers"][0]["byteLength"] = bin.size();
         return static_cast<int>(doc["accessors"].size()) - 1;
     }
 
