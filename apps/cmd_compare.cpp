@@ -42,6 +42,7 @@ LabelledMesh read_labelled(const std::string& path) {
     if (m.named.mesh.faces.empty()) throw Error::input(path, "the mesh has no triangles");
     const auto [lo, hi] = world_bounds(m.named.mesh);
     if (!((hi - lo).norm() > 0)) throw Error::input(path, "the mesh has no extent (every vertex at one place)");
+    if (!(m.named.mesh.area() > 0)) throw Error::input(path, "every triangle has zero area: no surface to compare");
     synth::label_faces(m.named, {}, &m.labels);
     return m;
 }

@@ -103,7 +103,7 @@ TEST(CompareCli, BrokenMeshesExitTwoWithOneLineBadOptionsOne) {
     const std::pair<const char*, const char*> cases[] = {
             {"truncated.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2"}, {"nan.obj", "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n"},
             {"no_triangles.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n"},   {"empty.obj", ""},
-            {"point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n"},
+            {"point.obj", "v 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 2 3\n"}, {"flat.obj", "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n"},
     };
     for (const auto& [name, text] : cases) {
         test::write_text(dir / name, text);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <random>
 
 using namespace treelobes;
 using namespace treelobes::render;
@@ -114,4 +115,65 @@ TEST(CrownOutline, FillsEnclosedHolesButKeepsOpenGapsAndSeparateCrowns) {
     EXPECT_FALSE(outline[40 * size + 40]) << "30 px apart: two crowns, not one";
     EXPECT_EQ(count(outline), count(two));
     EXPECT_THROW(crown_outline(two, size, size - 1, 5), Error);
+}
+
+namespace {
+
+// Closing by a disc of radius r the slow way, every pixel of the disc tried, on the mask padded
+// by r (pixels beyond the padded frame unset), then cropped: what crown_outline closes.
+std::vector<bool> closed_by_trying_the_disc(const std::vector<bool>& mask, int width, int height, int r) {
+    const int pw = width + 2 * r, ph = height + 2 * r;
+    const auto at = [&](const std::vector<bool>& m, int x, int y) {
+        return x >= 0 && y >= 0 && x < pw && y < ph && m[static_cast<std::size_t>(y) * pw + x];
+    };
+    std::vector<bool> padded(static_cast<std::size_t>(pw) * ph), grown(padded.size()), closed(padded.size());
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            padded[static_cast<std::size_t>(y + r) * pw + x + r] = mask[static_cast<std::size_t>(y) * width + x];
+    for (int pass = 0; pass < 2; ++pass)
+        for (int y = 0; y < ph; ++y)
+            for (int x = 0; x < pw; ++x) {
+                bool any = false, all = true;
+                for (int dy = -r; dy <= r; ++dy)
+                    for (int dx = -r; dx <= r; ++dx)
+                        if (dx * dx + dy * dy <= r * r) {
+                            const bool set = at(pass == 0 ? padded : grown, x + dx, y + dy);
+                            any = any || set;
+                            all = all && set;
+                        }
+                (pass == 0 ? grown : closed)[static_cast<std::size_t>(y) * pw + x] = pass == 0 ? any : all;
+            }
+    std::vector<bool> out(mask.size());
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) out[static_cast<std::size_t>(y) * width + x] = closed[static_cast<std::size_t>(y + r) * pw + x + r];
+    return out;
+}
+
+}  // namespace
+
+// The distance-transform closing gives exactly the closing by trying every pixel of the disc, on
+// random masks of several densities and radii, crowns touching the frame included.
+TEST(CrownOutline, ClosingEqualsTryingEveryPixelOfTheDisc) {
+    std::mt19937 random(7);
+    const int width = 47, height = 31;
+    for (const double density : {0.05, 0.2, 0.5})
+        for (const int r : {1, 2, 4, 9}) {
+            std::bernoulli_distribution set(density);
+            std::vector<bool> mask(static_cast<std::size_t>(width) * height);
+            for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = set(random);
+            EXPECT_EQ(crown_outline(mask, width, height, r),
+                      crown_outline(closed_by_trying_the_disc(mask, width, height, r), width, height, 0))
+                    << "density " << density << ", radius " << r;
+        }
+}
+
+// The largest mask and disc the CLI allows (4096 px, 256 px) in one pass over the pixels: trying
+// every pixel of the disc would take hours here.
+TEST(CrownOutline, LargestMaskAndDiscTheCliAllows) {
+    const int size = 4096;
+    const auto two = mask_of(size, size, [](int x, int y) { return in_disc(x, y, 1400, 2048, 600) || in_disc(x, y, 2700, 2048, 600); });
+    const auto outline = crown_outline(two, size, size, 256);
+    EXPECT_TRUE(outline[static_cast<std::size_t>(2048) * size + 2050])
+            << "a 100 px gap between two large crowns is bridged by a 256 px disc";
+    EXPECT_FALSE(outline[static_cast<std::size_t>(100) * size + 100]);
 }
