@@ -29,6 +29,10 @@ struct Lobe {
                                                   // reconstruction dropped as outliers; not stored: the .tlobe
                                                   // keeps their occupancy, on a grid sized to the file budget
     Occupancy occupancy;                          // read from a .tlobe (empty when the file had no room for it)
+    // Share of cluster C_i's points that lie on leaves, when the input labels wood and leaves
+    // (the `wood` attribute of `treelobes rebuild`'s samples); -1 = unknown. Synthesis draws a
+    // lobe's leaves in proportion to it, so that bare twigs stay bare.
+    float leaf_share = -1.0f;
     double volume() const { return mesh.signed_volume(); }
     double area() const { return mesh.area(); }
 };

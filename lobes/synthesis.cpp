@@ -71,6 +71,28 @@ void scale_leaves_to_area(TriangleMesh& leaves, double target, LeafShape shape) 
     }
 }
 
+// Per lobe, a factor on the number of leaves drawn, when the lobes know their leaf share
+// (lobe_tree.hpp): the share over the tree's mean share (weighted by the patch leaves each lobe
+// holds), so the tree keeps its number of leaves (and of triangles) while the leaves move from
+// the lobes the input saw as bare twigs to the leafy ones. Empty when no lobe knows its share.
+std::vector<double> lobe_leaf_weights(const LobeTree& tree, const TexturedTree& textured) {
+    std::vector<double> leaves(tree.lobes.size(), 0.0);
+    double known_leaves = 0, known_share = 0;
+    for (std::size_t l = 0; l < tree.lobes.size(); ++l) {
+        for (const auto& inst : textured.lobes[l].instances)
+            leaves[l] += static_cast<double>(textured.library.patches[inst.patch].leaves.size());
+        if (tree.lobes[l].leaf_share < 0) continue;
+        known_leaves += leaves[l];
+        known_share += leaves[l] * tree.lobes[l].leaf_share;
+    }
+    if (!(known_leaves > 0)) return {};
+    const double mean_share = known_share / known_leaves;
+    std::vector<double> weight(tree.lobes.size(), 1.0);
+    for (std::size_t l = 0; l < tree.lobes.size(); ++l)
+        if (tree.lobes[l].leaf_share >= 0) weight[l] = mean_share > 0 ? tree.lobes[l].leaf_share / mean_share : 0.0;
+    return weight;
+}
+
 std::size_t prefix(double fraction, std::size_t n) {
     return std::min(n, static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(n))));
 }
@@ -207,8 +229,9 @@ SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textu
         std::nth_element(thickness.begin(), thickness.begin() + static_cast<std::ptrdiff_t>(kept - 1), thickness.end(), std::greater<>());
         min_thickness = thickness[kept - 1];
     }
-    for (const auto& lobe : textured.lobes)
-        for (const auto& inst : lobe.instances) {
+    const std::vector<double> leaf_weight = lobe_leaf_weights(tree, textured);
+    for (std::size_t l = 0; l < textured.lobes.size(); ++l)
+        for (const auto& inst : textured.lobes[l].instances) {
             const Patch& patch = textured.library.patches[inst.patch];
             for (const auto& s : patch.segments) {
                 if (s.thickness_a * inst.scale < min_thickness) continue;
@@ -216,9 +239,17 @@ SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textu
                           std::max(0.5f * s.thickness_b * inst.scale, kMinTwigRadius), o.twig_sides);
                 ++out.twig_segments;
             }
-            // Stochastic pruning: a prefix of the shuffled leaves, enlarged to keep the leaf area.
-            const std::size_t kept = kept_leaves(fraction * textured.leaf_share, patch.leaves.size());
-            const float enlarge = kept > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(kept)) : 1.0f;
+            // Stochastic pruning: a prefix of the shuffled leaves, enlarged to keep the leaf area
+            // of the level of detail.
+            const std::size_t pruned = kept_leaves(fraction * textured.leaf_share, patch.leaves.size());
+            const float enlarge = pruned > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(pruned)) : 1.0f;
+            // Weighted counts are rounded down: the tree's leaves then never exceed the unweighted
+            // (rounded up) count that the triangle budget was spent on.
+            const std::size_t kept =
+                    leaf_weight.empty() ? pruned
+                                        : std::min(patch.leaves.size(),
+                                                   static_cast<std::size_t>(std::floor(fraction * textured.leaf_share * leaf_weight[l] *
+                                                                                       static_cast<double>(patch.leaves.size()))));
             for (std::size_t i = 0; i < kept; ++i) {
                 const PatchLeaf& leaf = patch.leaves[i];
                 add_leaf(out.leaves, inst.apply(leaf.base), inst.rotation * leaf.direction, inst.rotation * leaf.normal,

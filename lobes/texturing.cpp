@@ -290,6 +290,7 @@ public:
                 continue;
             }
             add(best.instance);
+            if (o_.reseed_every > 0 && texture_.instances.size() % static_cast<std::size_t>(o_.reseed_every) == 0) reseed(seed);
         }
         texture_.filled = static_cast<double>(filled_count_) / fill_total_;
         texture_.budget_spent = !affordable();
@@ -314,26 +315,35 @@ private:
     // With a tight budget (big crowns) the patches reach more of the lobe before it runs out;
     // with a loose one the lobe ends as dense as before.
     Refill refill_queue(const DockingPoint& seed) {
-        const bool filled_enough = static_cast<double>(filled_count_) / fill_total_ >= o_.fill_target ||
-                                   texture_.reseeds >= static_cast<std::size_t>(o_.max_reseeds_per_cell * fill_total_) || twigs_.empty();
-        while (!filled_enough && fill_cursor_ < fill_order_.size() && filled_[fill_order_[fill_cursor_]]) ++fill_cursor_;
-        if (filled_enough || fill_cursor_ == fill_order_.size()) {
-            if (layer_ >= kPatchesPerCell || deferred_.empty()) return Refill::Done;
-            ++layer_;
-            for (auto& pending : deferred_) queue_.push(std::move(pending));
-            deferred_.clear();
-            return Refill::Again;
-        }
-        // Re-seeding grows from the placed twig point nearest to the empty cell.
+        if (reseed(seed)) return Refill::Reseeded;
+        if (!filled_enough() && fill_cursor_ < fill_order_.size()) return Refill::Again;  // a cell at the twig point itself
+        if (layer_ >= kPatchesPerCell || deferred_.empty()) return Refill::Done;
+        ++layer_;
+        for (auto& pending : deferred_) queue_.push(std::move(pending));
+        deferred_.clear();
+        return Refill::Again;
+    }
+
+    bool filled_enough() const {
+        return static_cast<double>(filled_count_) / fill_total_ >= o_.fill_target ||
+               texture_.reseeds >= static_cast<std::size_t>(o_.max_reseeds_per_cell * fill_total_) || twigs_.empty();
+    }
+
+    // A new docking point on the placed twig nearest to the next empty target cell, pointing
+    // into it; false when the lobe is filled enough or no empty cell is left.
+    bool reseed(const DockingPoint& seed) {
+        if (filled_enough()) return false;
+        while (fill_cursor_ < fill_order_.size() && filled_[fill_order_[fill_cursor_]]) ++fill_cursor_;
+        if (fill_cursor_ == fill_order_.size()) return false;
         const Eigen::Vector3f empty_cell = fill_grid_.cell_centre(fill_order_[fill_cursor_++]);
         const Eigen::Vector3f from = twigs_.point(twigs_.nearest(empty_cell));
         const Eigen::Vector3f dir = empty_cell - from;
-        if (dir.norm() < 1e-5f) return Refill::Again;
+        if (dir.norm() < 1e-5f) return false;
         // As thick as a twig must be to reach the empty cell, never thicker than the seed.
         const float thickness = std::clamp(dir.norm() / kPatchReach, 0.002f, std::max(seed.thickness, 0.002f));
         queue_.push({{from, dir.normalized(), thickness}, true, created_++});
         ++texture_.reseeds;
-        return Refill::Reseeded;
+        return true;
     }
 
     // Patch selection: of the patches that fit the remaining budget, the candidates with the

@@ -18,7 +18,9 @@
 // The triangle budget is a hard bound: a patch is placed only when its triangles fit.
 // Patches without docking points end a path. When the queue runs dry while part of the lobe is
 // still empty, a new docking point is taken on the placed twig nearest to the empty region
-// (pointing into it; empty cells on the lobe surface first), until the lobe is filled (`fill_target`) or the patch budget is spent.
+// (pointing into it; empty cells on the lobe surface first), until the lobe is filled (`fill_target`) or the patch budget is spent;
+// such re-seeds are also interleaved with the queue (`reseed_every`), so that a budget too small
+// for the whole lobe is spread over it rather than spent around the seed.
 // With the lobe's occupancy (lobes/occupancy.hpp, the cells that held scan points), only the
 // fill cells that overlap occupied cells are to be filled: fitting scores, dropping of
 // redundant docking points, re-seeding and the fill target all count those cells, and the fill
@@ -79,6 +81,11 @@ struct TexturingOptions {
                                         // (texture_tree sets it to 2 per budgeted patch)
     double fill_target = 0.95;          // fraction of lobe cells reached by twigs or leaves
     double max_reseeds_per_cell = 2.0;  // extra docking points for empty regions, per lobe cell
+    // While the queue still holds docking points, one re-seed into the next empty region after
+    // this many placed patches (0 = only when the queue runs dry). A lobe whose budget runs out
+    // before it is filled then has its patches spread over all of it instead of a dense ball
+    // around the seed: a tall conifer lobe was cut 3-5 m below its top (docs/rebuild.md).
+    int reseed_every = 2;
 };
 
 struct PatchInstance {

@@ -76,6 +76,16 @@ TreeGraph decode_skeleton(ByteReader& in, double quantum, double diameter_quantu
     return skeleton;
 }
 
+// A lobe's leaf share in one byte: 0..kLeafShareSteps for 0..1, kUnknownLeafShare when unknown.
+constexpr std::uint8_t kLeafShareSteps = 254, kUnknownLeafShare = 255;
+
+std::uint8_t encode_leaf_share(float share) {
+    if (!(share >= 0)) return kUnknownLeafShare;
+    return static_cast<std::uint8_t>(std::lround(std::min(share, 1.0f) * kLeafShareSteps));
+}
+
+float decode_leaf_share(std::uint8_t code) { return code == kUnknownLeafShare ? -1.0f : static_cast<float>(code) / kLeafShareSteps; }
+
 void check_options(const TlobeOptions& o) {
     if (!(o.quantum > 0 && o.quantum <= 1) || !(o.diameter_quantum > 0 && o.diameter_quantum <= 1))
         throw Error::usage("tlobe: quanta must be in (0, 1] metres");
@@ -113,7 +123,8 @@ std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const st
         encode_mesh(lobe.mesh, quantum, w);
         encode_occupancy(*occupancy[i], quantum, w);
     }
-    w.f32(static_cast<float>(tree.leaf_area_m2));  // since 3.1
+    w.f32(static_cast<float>(tree.leaf_area_m2));                                  // since 3.1
+    for (const Lobe& lobe : tree.lobes) w.u8(encode_leaf_share(lobe.leaf_share));  // since 3.2
     return w.bytes();
 }
 
@@ -222,6 +233,8 @@ LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int
         tree.leaf_area_m2 = in.f32();
         if (!(tree.leaf_area_m2 >= 0 && tree.leaf_area_m2 < kMaxLeafArea)) in.fail("invalid leaf area");
     }
+    if (minor >= 2)
+        for (Lobe& lobe : tree.lobes) lobe.leaf_share = decode_leaf_share(in.u8());
     // A later minor version appends fields this build does not know: they are skipped.
     if (minor <= kTlobeMinorVersion && !in.at_end()) in.fail("trailing bytes after the last field");
     return tree;

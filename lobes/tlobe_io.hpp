@@ -18,7 +18,7 @@
 namespace treelobes::lobes {
 
 inline constexpr std::uint8_t kTlobeMajorVersion = 3;
-inline constexpr std::uint8_t kTlobeMinorVersion = 1;  // 3.1 appended the leaf area
+inline constexpr std::uint8_t kTlobeMinorVersion = 2;  // 3.1 appended the leaf area, 3.2 the lobes' leaf shares
 
 struct TlobeOptions {
     double quantum = 0.005;            // metres: grid of skeleton positions and lobe vertices

@@ -129,3 +129,29 @@ TEST(LobeTree, DroppedPointsNearTheCrownJoinTheLobeOccupancy) {
     EXPECT_EQ(extra, on.dropped_points_attached);
     EXPECT_EQ(on.dropped_points_attached, 6u);
 }
+
+// With wood/leaf labels on the points (the `wood` attribute of a sampled mesh), each lobe records
+// the share of its cluster's points on leaves; without them the share is unknown (-1).
+TEST(LobeTree, LobesRecordTheirLeafShareFromWoodLabels) {
+    PointCloud cloud = trunk_and_crown();
+    const Built unlabelled = build(cloud, 1.0);
+    for (const Lobe& lobe : unlabelled.tree.lobes) EXPECT_LT(lobe.leaf_share, 0.0f);
+    // The crown ball's upper half is leaf (0), everything else wood (1).
+    ExtraAttribute& wood = cloud.add_extra("wood", AttributeType::UInt8, 1.0);
+    for (std::size_t i = 0; i < cloud.size(); ++i) wood.values[i] = cloud.positions[i].z() > 3.8f ? 0.0 : 1.0;
+    const Built labelled = build(cloud, 1.0);
+    ASSERT_EQ(labelled.tree.lobes.size(), unlabelled.tree.lobes.size());
+    double leaf = 0, all = 0;
+    for (const Lobe& lobe : labelled.tree.lobes) {
+        EXPECT_GE(lobe.leaf_share, 0.0f);
+        EXPECT_LE(lobe.leaf_share, 1.0f);
+        std::size_t above = 0;
+        for (const auto& p : lobe.cluster_points) above += p.z() > 3.8f ? 1 : 0;
+        leaf += lobe.leaf_share * static_cast<double>(lobe.points);
+        all += static_cast<double>(lobe.points);
+        if (lobe.cluster_points.size() == lobe.points) {
+            EXPECT_FLOAT_EQ(lobe.leaf_share, static_cast<float>(above) / static_cast<float>(lobe.points));
+        }
+    }
+    EXPECT_NEAR(leaf / all, 0.5, 0.15);
+}

@@ -320,3 +320,66 @@ TEST(Synthesis, TriangleBudgetIsAHardBound) {
         }
     EXPECT_GE(spent, 3) << runs;  // the bound was binding (palm fills the box below every budget)
 }
+
+// A tall, narrow lobe (a conifer's crown: 1 x 1 x 8 m) on a budget that fills a quarter of it.
+// Growing only from the seed at its foot, the patches stay in its lower part; with re-seeds
+// interleaved into the queue (the default) they reach its top quarter too.
+TEST(Texturing, ReseedsSpreadATightBudgetOverATallLobe) {
+    const PatchLibrary lib = build_patch_library(species("pine"));
+    const TriangleMesh tall = box({-0.5f, -0.5f, 2}, {0.5f, 0.5f, 10});
+    const DockingPoint seed{{0, 0, 2}, {0, 0, 1}, 0.03f};
+    const auto top_quarter_share = [&](int reseed_every) {
+        TexturingOptions o;
+        o.fill_cell = 0.1;
+        o.reseed_every = reseed_every;
+        o.max_triangles = 20000;
+        const LobeTexture t = texture_lobe(tall, seed, lib, o, 0);
+        EXPECT_TRUE(t.budget_spent) << reseed_every;
+        std::size_t top = 0, all = 0;
+        for (const auto& inst : t.instances)
+            for (const auto& s : lib.patches[inst.patch].segments) {
+                top += inst.apply(s.b).z() > 8 ? 1 : 0;
+                ++all;
+            }
+        return static_cast<double>(top) / static_cast<double>(std::max<std::size_t>(all, 1));
+    };
+    const double from_seed_only = top_quarter_share(0), spread = top_quarter_share(TexturingOptions{}.reseed_every);
+    EXPECT_LT(from_seed_only, 0.05) << spread;
+    EXPECT_GT(spread, 0.1) << from_seed_only;
+}
+
+// Lobes that know their leaf share (a rebuilt mesh's wood/leaf labels): a bare lobe draws no
+// leaves, the leafy one draws the leaves the bare one gave up, and the tree keeps at most its
+// number of leaves (the triangle budget holds); unknown shares draw as before.
+TEST(Synthesis, LobeLeafSharesMoveLeavesToTheLeafyLobes) {
+    LobeTree tree = boxed_tree();  // lobe 0: x in -1..1, seeded at (0, 0, 2)
+    tree.skeleton.add_node({2.5f, 0, 2}, 0.03f, 1);
+    Lobe second = tree.lobes[0];  // lobe 1: x in 1.5..3.5, seeded at (2.5, 0, 2)
+    second.mesh = box({1.5f, -1, 1.9f}, {3.5f, 1, 3.4f});
+    second.seed_node = 3;
+    tree.lobes.push_back(second);
+    SynthesisOptions o;
+    o.texturing.fill_cell = 0.2;
+    o.max_triangles = 100000;
+    const TexturedTree textured = texture_tree(tree, species("mahogany"), o);
+    ASSERT_LT(textured.leaf_share, 0.5);  // thinned leaves: room to draw more in a leafy lobe
+    const auto leaves_between = [](const SynthesizedMesh& mesh, float lo, float hi) {
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < mesh.leaves.vertices.size(); i += 4) {  // a broad blade's first vertex is its base
+            const float x = mesh.leaves.vertices[i].x();
+            n += x >= lo && x < hi ? 1 : 0;
+        }
+        return n;
+    };
+    const SynthesizedMesh unknown = synthesized_mesh(tree, textured, 1.0, o);
+    tree.lobes[0].leaf_share = 0.0f;
+    tree.lobes[1].leaf_share = 0.9f;
+    const SynthesizedMesh shared = synthesized_mesh(tree, textured, 1.0, o);
+    EXPECT_GT(leaves_between(unknown, -10, 0), 100u);
+    EXPECT_EQ(leaves_between(shared, -10, 0), 0u);  // lobe 0's left half: bare
+    EXPECT_GT(leaves_between(shared, 1.25f, 10), leaves_between(unknown, 1.25f, 10) * 3 / 2);
+    EXPECT_LE(shared.leaf_count, unknown.leaf_count);
+    EXPECT_GT(shared.leaf_count, unknown.leaf_count * 8 / 10);
+    EXPECT_LE(shared.triangles(), o.max_triangles);
+    EXPECT_EQ(shared.wood.faces.size(), unknown.wood.faces.size());
+}

@@ -175,24 +175,51 @@ TEST(Tlobe, LeafAreaSinceMinorVersionOne) {
     LobeTree t = sample_tree();
     t.leaf_area_m2 = 117.5;
     const std::string bytes = encode_tlobe(t);
-    EXPECT_EQ(bytes[5], 1);
+    EXPECT_EQ(bytes[5], 2);
     EXPECT_EQ(decode_tlobe(bytes, "t.tlobe").leaf_area_m2, 117.5);
-    const auto drop_leaf_area = [](std::string& payload) { payload.resize(payload.size() - 4); };
-    const LobeTree old = decode_tlobe(rewritten(bytes, 0, drop_leaf_area), "old.tlobe");
+    const std::size_t shares = t.lobes.size();  // 3.2's bytes after the leaf area
+    const auto to_minor_1 = [shares](std::string& payload) { payload.resize(payload.size() - shares); };
+    const auto to_minor_0 = [shares](std::string& payload) { payload.resize(payload.size() - shares - 4); };
+    const LobeTree old = decode_tlobe(rewritten(bytes, 0, to_minor_0), "old.tlobe");
     EXPECT_EQ(old.leaf_area_m2, 0.0);
     EXPECT_EQ(old.lobes.size(), 2u);
+    EXPECT_EQ(decode_tlobe(rewritten(bytes, 1, to_minor_1), "3.1.tlobe").leaf_area_m2, 117.5);
     const LobeTree seed = read_tlobe(test::source_dir() / "tests/data/tlobe/lagerstroemia_v3_0.tlobe");
     EXPECT_EQ(seed.leaf_area_m2, 0.0);
     EXPECT_FALSE(seed.lobes.empty());
 
     const auto append = [](std::string& payload) { payload += "more"; };
-    EXPECT_EQ(decode_tlobe(rewritten(bytes, 2, append), "newer.tlobe").leaf_area_m2, 117.5);
-    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 1, append), "x"); }), ExitCode::InvalidInput);
-    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 0, [](std::string&) {}), "x"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(decode_tlobe(rewritten(bytes, 3, append), "newer.tlobe").leaf_area_m2, 117.5);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 2, append), "x"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 1, [](std::string&) {}), "x"); }), ExitCode::InvalidInput);
     for (const float bad : {-1.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
         const auto overwrite = [bad](std::string& payload) { std::memcpy(payload.data() + payload.size() - 4, &bad, 4); };
-        EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 1, overwrite), "x"); }), ExitCode::InvalidInput) << bad;
+        EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, 1, [&](std::string& p) { to_minor_1(p), overwrite(p); }), "x"); }),
+                  ExitCode::InvalidInput)
+                << bad;
     }
+}
+
+// Version 3.2 appends each lobe's leaf share (one byte): known shares round-trip within half a
+// step of 1/254 (0 and 1 exactly), unknown ones (-1) stay unknown, and 3.0 and 3.1 files read as
+// unknown.
+TEST(Tlobe, LobeLeafSharesSinceMinorVersionTwo) {
+    LobeTree t = sample_tree();
+    t.lobes[0].leaf_share = 0.0f;
+    t.lobes[1].leaf_share = 0.873f;
+    const std::string bytes = encode_tlobe(t);
+    LobeTree back = decode_tlobe(bytes, "t.tlobe");
+    EXPECT_EQ(back.lobes[0].leaf_share, 0.0f);
+    EXPECT_NEAR(back.lobes[1].leaf_share, 0.873f, 0.5f / 254);
+    t.lobes[0].leaf_share = 1.0f;
+    t.lobes[1].leaf_share = -1.0f;
+    back = decode_tlobe(encode_tlobe(t), "t.tlobe");
+    EXPECT_EQ(back.lobes[0].leaf_share, 1.0f);
+    EXPECT_LT(back.lobes[1].leaf_share, 0.0f);
+    const auto to_minor_1 = [&](std::string& payload) { payload.resize(payload.size() - t.lobes.size()); };
+    for (const Lobe& lobe : decode_tlobe(rewritten(bytes, 1, to_minor_1), "3.1.tlobe").lobes) EXPECT_LT(lobe.leaf_share, 0.0f);
+    for (const Lobe& lobe : read_tlobe(test::source_dir() / "tests/data/tlobe/lagerstroemia_v3_0.tlobe").lobes)
+        EXPECT_LT(lobe.leaf_share, 0.0f);
 }
 
 // Points of a lobe: a dense 0.3 m ball in one corner of the lobe and a thin vertical line.
