@@ -4,8 +4,8 @@
 // Crown: the nodes at or above the crown base (the height of the lowest fork where a lateral
 // carrying at least `crown_branch_fraction` of the tree's skeleton length leaves the trunk; the
 // whole tree when there is none), each widened by its radius, plus every lobe vertex. Crown
-// diameter: the mean of the crown's extents along x and y (the two-axis mean of field
-// inventories); crown hull: their convex hull.
+// diameter: the diameter of the circle with the area of their convex hull seen from above (as
+// the tile's measures from points, forestry/measures.hpp); crown hull: their convex hull.
 #pragma once
 
 #include "core/triangle_mesh.hpp"

@@ -4,11 +4,7 @@
 #include "geometry/grid_thinning.hpp"
 #include "geometry/ransac_fit.hpp"
 #include "geometry/alpha_shape.hpp"
-
-#include <boost/geometry.hpp>
-#include <boost/geometry/geometries/multi_point.hpp>
-#include <boost/geometry/geometries/point_xy.hpp>
-#include <boost/geometry/geometries/polygon.hpp>
+#include "geometry/convex_hull.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -85,18 +81,6 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
     return m;
 }
 
-double projected_hull_area(std::span<const Eigen::Vector3f> points) {
-    namespace bg = boost::geometry;
-    using Point = bg::model::d2::point_xy<double>;
-    bg::model::multi_point<Point> cloud;
-    cloud.reserve(points.size());
-    for (const auto& p : points) cloud.emplace_back(p.x(), p.y());
-    if (cloud.size() < 3) return 0.0;
-    bg::model::polygon<Point> hull;
-    bg::convex_hull(cloud, hull);
-    return std::abs(bg::area(hull));
-}
-
 CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
                            const CrownOptions& options) {
     check_sizes(points, height_above_ground, "measure_crown");
@@ -116,7 +100,7 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
     const double area = projected_hull_area(points);
     if (area > 0) {
         m.projected_area = area;
-        m.diameter = 2.0 * std::sqrt(area / std::numbers::pi);
+        m.diameter = equal_area_diameter(area);
     }
 
     std::vector<Eigen::Vector3f> crown;

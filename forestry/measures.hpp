@@ -69,10 +69,6 @@ struct CrownMeasure {
 CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
                            const CrownOptions& options = {});
 
-// Area of the convex hull of points seen from above (square metres; 0 for fewer than 3 points
-// or collinear ones).
-double projected_hull_area(std::span<const Eigen::Vector3f> points);
-
 // Volume of the skeleton's branches as truncated cones between each node and its parent
 // (cubic metres), from the node radii.
 double woody_volume(const TreeGraph& skeleton);

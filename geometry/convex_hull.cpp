@@ -5,8 +5,14 @@
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/convex_hull_3.h>
+#include <boost/geometry.hpp>
+#include <boost/geometry/geometries/multi_point.hpp>
+#include <boost/geometry/geometries/point_xy.hpp>
+#include <boost/geometry/geometries/polygon.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <map>
 
 namespace treelobes {
@@ -133,5 +139,19 @@ TriangleMesh convex_hull(const std::vector<Eigen::Vector3f>& points, const Eigen
     if (mesh.faces.size() < 4 || !(mesh.signed_volume() > 1e-12)) return TriangleMesh{origin, {}, {}};  // flat or collinear input
     return mesh;
 }
+
+double projected_hull_area(std::span<const Eigen::Vector3f> points) {
+    namespace bg = boost::geometry;
+    using Point = bg::model::d2::point_xy<double>;
+    bg::model::multi_point<Point> cloud;
+    cloud.reserve(points.size());
+    for (const auto& p : points) cloud.emplace_back(p.x(), p.y());
+    if (cloud.size() < 3) return 0.0;
+    bg::model::polygon<Point> hull;
+    bg::convex_hull(cloud, hull);
+    return std::abs(bg::area(hull));
+}
+
+double equal_area_diameter(double area) { return area > 0 ? 2.0 * std::sqrt(area / std::numbers::pi) : 0.0; }
 
 }  // namespace treelobes

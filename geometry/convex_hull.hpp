@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include <span>
 #include <vector>
 
 namespace treelobes {
@@ -20,5 +21,14 @@ namespace treelobes {
 // are found again (coplanar neighbours joined with CGAL's exact orientation test) and each facet is
 // fanned from its lexicographically smallest corner; vertices are sorted by coordinates.
 TriangleMesh convex_hull(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& origin);
+
+// Area of the convex hull of the points seen from above (x, y; square metres): a crown's
+// projected area. 0 for fewer than 3 points or collinear ones.
+double projected_hull_area(std::span<const Eigen::Vector3f> points);
+
+// Diameter of the circle of the given area: the crown diameter of every treelobes measure (the
+// tile's trees.csv from points, the exports from a skeleton and its lobes), so that one tree
+// gets one crown diameter whichever output a user reads.
+double equal_area_diameter(double area);
 
 }  // namespace treelobes

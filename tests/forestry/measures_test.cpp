@@ -125,10 +125,5 @@ TEST(WoodyVolume, FrustaOfTheSkeleton) {
     EXPECT_NEAR(woody_volume(skeleton), frustum + cylinder, 1e-6);
 }
 
-TEST(ProjectedArea, SquareOfPoints) {
-    const std::vector<Eigen::Vector3f> points{{0, 0, 1}, {2, 0, 3}, {2, 2, 0}, {0, 2, 5}, {1, 1, 9}};
-    EXPECT_NEAR(projected_hull_area(points), 4.0, 1e-9);
-}
-
 }  // namespace
 }  // namespace treelobes::forestry

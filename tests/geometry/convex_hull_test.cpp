@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+#include <numbers>
+#include <vector>
 
 using namespace treelobes;
 
@@ -57,4 +60,13 @@ TEST(ConvexHull, SameBytesForAnyPointOrderAndHeapLayout) {
 TEST(ConvexHull, FlatOrTooFewPointsGiveAnEmptyMesh) {
     EXPECT_TRUE(convex_hull({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {}).faces.empty());
     EXPECT_TRUE(convex_hull({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0.5f, 0.5f, 0}}, {}).faces.empty());
+}
+
+TEST(ProjectedHull, AreaOfASquareSeenFromAboveAndItsEqualAreaDiameter) {
+    const std::vector<Eigen::Vector3f> points{{0, 0, 1}, {2, 0, 3}, {2, 2, 0}, {0, 2, 5}, {1, 1, 9}};
+    EXPECT_NEAR(projected_hull_area(points), 4.0, 1e-9);
+    EXPECT_NEAR(equal_area_diameter(std::numbers::pi), 2.0, 1e-12);
+    EXPECT_NEAR(equal_area_diameter(projected_hull_area(points)), 4.0 / std::sqrt(std::numbers::pi), 1e-9);
+    EXPECT_EQ(projected_hull_area(std::vector<Eigen::Vector3f>{{0, 0, 0}, {1, 1, 1}}), 0.0);
+    EXPECT_EQ(equal_area_diameter(0.0), 0.0);
 }
