@@ -58,6 +58,8 @@ struct TileCliOptions {
     std::string input;
     std::string out;
     std::string mode = "auto";
+    std::string stand = "broadleaf";
+    std::optional<float> max_crown_radius;  // metres; unset = the stand's
     bool use_input_segmentation = false;
     bool overwrite = false;
     std::string model;
@@ -317,6 +319,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     auto mark = start;
     json seconds = json::object();
     o.segment.mode = parse_scan_mode(o.mode);
+    o.segment = with_stand_type(o.segment, parse_stand_type(o.stand));
+    if (o.max_crown_radius) o.segment.max_crown_radius = *o.max_crown_radius;
     o.trees.reconstruct.preprocess.outlier_test = parse_outlier_test(o.outlier_test);
     o.trees.reconstruct.preprocess.ground = GroundMode::Keep;  // the terrain stage removed the ground already
     std::optional<classify::JointBoostModel> model;
@@ -531,6 +535,13 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
                "Segmentation: als (canopy height model, treetops, crowns), tls (stems, plot-wide shortest "
                "paths) or auto (from the point density)")
             ->check(CLI::IsMember({"auto", "als", "tls"}));
+    table->add("--stand", o->stand,
+               "Airborne crowns: broadleaf (broad crowns, many maxima merged) or conifer (every treetop a tree, crowns at most 3.5 m "
+               "from their top: dense conifer stands)")
+            ->check(CLI::IsMember({"broadleaf", "conifer"}));
+    table->add("--max-crown-radius", o->max_crown_radius,
+               "Airborne: no crown reaches farther from its treetop, metres (default: the stand's, 15 broadleaf, 3.5 conifer)")
+            ->check(PositiveNumber);
     table->add_flag("--use-input-segmentation", o->use_input_segmentation,
                     "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
     table->add("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");

@@ -7,7 +7,7 @@
 #      40 x 40 m) and crowded ones (30 on 80 x 80 m, 12 on 30 x 30 m: the synth tile relaxes its
 #      spacing and broad crowns interpenetrate), with the input's ground class and with the ground
 #      filtered afresh (--ignore-classification);
-#   2. lidR/MixedConifer.las against lidR's treeID (defaults and the conifer setting);
+#   2. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
 #   3. treels/pine_plot.las: stems found, with their positions and diameters;
 #   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
 #      2 x 2 and 4 x 4 copies side by side) and the TLS tiles.
@@ -75,11 +75,10 @@ for s in 1 2 3; do row "TLS crowded, seed $s" "$WORK/tls_crowded_$s/tile.las" --
 echo
 echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
 header "setting"
-CONIFER=(--set min_top_prominence=0 --set chm_smoothing=0)
-row "defaults" "$DATA/lidr/MixedConifer.las" --reference treeID
-row "conifer (no crown merging/smoothing)" "$DATA/lidr/MixedConifer.las" --reference treeID "${CONIFER[@]}"
-echo "matching table (conifer setting):"
-python3 - "$("$EVAL" "$DATA/lidr/MixedConifer.las" --reference treeID "${CONIFER[@]}")" <<'PY'
+row "--stand broadleaf (default)" "$DATA/lidr/MixedConifer.las" --reference treeID
+row "--stand conifer" "$DATA/lidr/MixedConifer.las" --reference treeID --stand conifer
+echo "matching table (--stand conifer):"
+python3 - "$("$EVAL" "$DATA/lidr/MixedConifer.las" --reference treeID --stand conifer)" <<'PY'
 import json, sys
 d = json.loads(sys.argv[1])
 print("| height (lidR tree) | lidR trees | found | matched |")

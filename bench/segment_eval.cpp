@@ -2,7 +2,7 @@
 // against per-point reference labels (synthetic truth or another tool's segmentation), for
 // bench/segment_bench.sh and docs/segment.md.
 //
-//   segment_eval CLOUD [--mode auto|als|tls] [--reference ATTRIBUTE] [--min-height M]
+//   segment_eval CLOUD [--mode auto|als|tls] [--stand broadleaf|conifer] [--reference ATTRIBUTE] [--min-height M]
 //                [--ignore-classification] [--replicate N] [--trees] [--set name=value ...] [--dump FILE]
 //
 // Scores with score_segmentation (segment/segmentation_score.hpp: a reference tree and a found
@@ -128,7 +128,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
 int run(int argc, char** argv) {
     if (argc < 2)
         throw Error::usage(
-                "usage: segment_eval CLOUD [--mode auto|als|tls] [--reference ATTRIBUTE] [--min-height M] "
+                "usage: segment_eval CLOUD [--mode auto|als|tls] [--stand broadleaf|conifer] [--reference ATTRIBUTE] [--min-height M] "
                 "[--ignore-classification] [--replicate N] [--trees] [--set name=value] [--dump FILE]");
     const std::string path = argv[1];
     SegmentOptions segment_options;
@@ -146,6 +146,8 @@ int run(int argc, char** argv) {
         };
         if (flag == "--mode")
             segment_options.mode = parse_scan_mode(value());
+        else if (flag == "--stand")
+            segment_options = with_stand_type(segment_options, parse_stand_type(value()));
         else if (flag == "--reference")
             reference_name = value();
         else if (flag == "--min-height")

@@ -623,6 +623,20 @@ ScanMode parse_scan_mode(std::string_view text) {
     throw Error::usage("unknown scan mode '" + std::string(text) + "': expected auto, als or tls");
 }
 
+StandType parse_stand_type(std::string_view text) {
+    if (text == "broadleaf") return StandType::Broadleaf;
+    if (text == "conifer") return StandType::Conifer;
+    throw Error::usage("unknown stand type '" + std::string(text) + "': expected broadleaf or conifer");
+}
+
+SegmentOptions with_stand_type(SegmentOptions options, StandType stand) {
+    const SegmentOptions broadleaf;
+    options.min_top_prominence = stand == StandType::Conifer ? 0.0f : broadleaf.min_top_prominence;
+    options.chm_smoothing = stand == StandType::Conifer ? 0.0f : broadleaf.chm_smoothing;
+    options.max_crown_radius = stand == StandType::Conifer ? 3.5f : broadleaf.max_crown_radius;
+    return options;
+}
+
 TreeSegmentation segment_trees(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options) {
     check_options(options);
     if (terrain.height_above_ground.size() != cloud.size() || terrain.is_ground.size() != cloud.size())

@@ -181,9 +181,12 @@ TEST(TileCli, UsageErrors) {
     EXPECT_EQ(run_cli("tile " + quoted(small_tile())).exit_code, 1);  // no --out
     EXPECT_EQ(run_cli(run_tile(dir / "o", "--mode xyz")).exit_code, 1);
     EXPECT_EQ(run_cli(run_tile(dir / "o", "--dtm-cell nan")).exit_code, 1);
+    EXPECT_EQ(run_cli(run_tile(dir / "o", "--stand palm")).exit_code, 1);
+    EXPECT_EQ(run_cli(run_tile(dir / "o", "--max-crown-radius 0")).exit_code, 1);
     const auto help = run_cli("tile --help");
     EXPECT_EQ(help.exit_code, 0);
     EXPECT_NE(help.out.find("--use-input-segmentation"), std::string::npos);
+    EXPECT_NE(help.out.find("--stand"), std::string::npos);
 }
 
 TEST(TileCli, InputSegmentationNeedsATreeIdAttribute) {

@@ -183,3 +183,23 @@ TEST(SegmentTrees, ScanModeNames) {
     EXPECT_STREQ(scan_mode_name(ScanMode::Terrestrial), "tls");
     EXPECT_EQ(test::error_code_of([] { parse_scan_mode("mls"); }), ExitCode::Usage);
 }
+
+// The stand presets set the airborne settings and nothing else: broadleaf is the defaults,
+// conifer takes every window maximum on the unsmoothed CHM with crowns at most 3.5 m wide.
+TEST(SegmentTrees, StandPresets) {
+    SegmentOptions custom;
+    custom.min_tree_height = 4.0f;
+    custom.max_crown_radius = 9.0f;
+    const SegmentOptions conifer = with_stand_type(custom, parse_stand_type("conifer"));
+    EXPECT_EQ(conifer.min_top_prominence, 0.0f);
+    EXPECT_EQ(conifer.chm_smoothing, 0.0f);
+    EXPECT_EQ(conifer.max_crown_radius, 3.5f);
+    EXPECT_EQ(conifer.min_tree_height, 4.0f);
+    const SegmentOptions broadleaf = with_stand_type(conifer, parse_stand_type("broadleaf"));
+    const SegmentOptions defaults;
+    EXPECT_EQ(broadleaf.min_top_prominence, defaults.min_top_prominence);
+    EXPECT_EQ(broadleaf.chm_smoothing, defaults.chm_smoothing);
+    EXPECT_EQ(broadleaf.max_crown_radius, defaults.max_crown_radius);
+    EXPECT_EQ(broadleaf.min_tree_height, 4.0f);
+    EXPECT_EQ(test::error_code_of([] { parse_stand_type("palm"); }), ExitCode::Usage);
+}

@@ -1,0 +1,52 @@
+// `treelobes tile` on a real airborne plot (label `real`): lidR's MixedConifer.las with the
+// conifer stand preset, end to end from the command line, against the treeID lidR published.
+#include "core/cloud_io.hpp"
+#include "segment/segmentation_score.hpp"
+#include "support/test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace treelobes;
+using treelobes::test::real_data;
+using treelobes::test::run_cli;
+
+namespace {
+
+// An extra attribute as tree ids (lidR's no-data 1.797e308 and non-positive values: 0).
+std::vector<std::int32_t> ids_of(const PointCloud& cloud, const std::string& name) {
+    const ExtraAttribute* attribute = cloud.extra(name);
+    std::vector<std::int32_t> ids(cloud.size(), 0);
+    if (attribute == nullptr) return ids;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const double v = attribute->values[i];
+        if (std::isfinite(v) && v > 0 && v < 1e9) ids[i] = static_cast<std::int32_t>(v);
+    }
+    return ids;
+}
+
+// F1 of the tile's treeID against lidR's (kept as treeID_input) for trees above 5 m.
+double f1_against_lidr(const std::string& flags) {
+    test::TempDir dir;
+    const auto result =
+            run_cli("tile '" + real_data("lidr/MixedConifer.las").string() + "' --out '" + (dir / "out").string() + "' " + flags);
+    // 3: some small crowns fail the per-tree pipeline (failures.jsonl); the points keep their ids.
+    EXPECT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.exit_code << result.err;
+    const PointCloud points = read_point_cloud(dir / "out" / "points.las");
+    const ExtraAttribute* height = points.extra("HeightAboveGround");
+    EXPECT_NE(height, nullptr);
+    if (height == nullptr) return 0;
+    const std::vector<float> above(height->values.begin(), height->values.end());
+    return score_segmentation(ids_of(points, "treeID_input"), ids_of(points, "treeID"), above, 5.0f).f1;
+}
+
+}  // namespace
+
+TEST(TileReal, MixedConiferWithTheConiferStandAgreesWithLidR) {
+    if (real_data("lidr/MixedConifer.las").empty()) return;
+    EXPECT_GE(f1_against_lidr("--stand conifer"), 0.85);                       // measured 0.865
+    EXPECT_LT(f1_against_lidr("--stand conifer --max-crown-radius 15"), 0.7);  // the radius is what matters
+}
