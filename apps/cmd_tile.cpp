@@ -40,6 +40,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <numeric>
 #include <optional>
 #include <set>
@@ -297,7 +298,27 @@ std::map<int, std::string> survey_ids(const std::vector<forestry::TreeInput>& tr
     return by_tree;
 }
 
-json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::BufferedTile& buffered) {
+// The airborne segmentation's reach (segment_trees.hpp) when the tile's trees come from one;
+// null for terrestrial plots and the input's labels.
+std::optional<float> segmentation_reach(const TileCliOptions& o, const TreeSegmentation& segmentation) {
+    if (o.use_input_segmentation || segmentation.mode_used != ScanMode::Airborne) return std::nullopt;
+    return airborne_reach(o.segment);
+}
+
+// A buffer narrower than the segmentation's reach: trees near the tile's edges may come out
+// otherwise than from the uncut survey. Said once per process (a batch runs many tiles).
+void warn_if_buffer_is_narrow(const TileCliOptions& o, std::optional<float> reach) {
+    static std::once_flag said;
+    if (o.buffer <= 0 || !reach || o.buffer >= *reach) return;
+    std::call_once(said, [&] {
+        log_warn("--buffer " + summary_value(o.buffer).dump() + " m is narrower than the airborne segmentation's reach (" +
+                 summary_value(*reach).dump() +
+                 " m, twice --max-crown-radius): crowns near the tile's edges may differ from a run on the uncut survey "
+                 "(docs/survey.md)");
+    });
+}
+
+json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::BufferedTile& buffered, std::optional<float> reach) {
     if (!plan.core) return nullptr;
     json read = json::array();
     for (const fs::path& file : buffered.neighbours_read) read.push_back(file.filename().string());
@@ -311,7 +332,9 @@ json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::
               {"from", c.source},
               {"half_open", c.half_open}}},
             {"neighbours_read", read},
-            {"neighbours_skipped", buffered.neighbours_skipped}};
+            {"neighbours_skipped", buffered.neighbours_skipped},
+            {"segmentation_reach_m", summary_value(reach)},
+            {"wide_enough", reach ? json(o.buffer >= *reach) : json(nullptr)}};
 }
 
 int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
@@ -357,6 +380,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         segmentation = segment_trees(cloud, terrain, o.segment);
         for (const auto& tree : segmentation.trees) bases[tree.id] = tree.base.cast<double>();
     }
+    const std::optional<float> reach = segmentation_reach(o, segmentation);
+    if (plan.core) warn_if_buffer_is_narrow(o, reach);
     std::vector<forestry::TreeInput> trees = forestry::split_trees(cloud, segmentation.tree_id, terrain.height_above_ground, bases);
     const std::size_t trees_in_buffer = plan.core ? keep_core_trees(trees, segmentation.tree_id, *plan.core, cloud.origin) : 0;
     const std::map<int, std::string> global_ids = survey_ids(trees, cloud.origin);
@@ -476,7 +501,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                           {"input", o.input},
                           {"out", o.out},
                           {"options", options},
-                          {"buffer", buffer_json(o, plan, buffered)},
+                          {"buffer", buffer_json(o, plan, buffered, reach)},
                           {"counts",
                            {{"points", buffered.own_points},
                             {"buffer_points", cloud.size() - buffered.own_points},

@@ -629,6 +629,8 @@ StandType parse_stand_type(std::string_view text) {
     throw Error::usage("unknown stand type '" + std::string(text) + "': expected broadleaf or conifer");
 }
 
+float airborne_reach(const SegmentOptions& options) { return 2.0f * options.max_crown_radius; }
+
 SegmentOptions with_stand_type(SegmentOptions options, StandType stand) {
     const SegmentOptions broadleaf;
     options.min_top_prominence = stand == StandType::Conifer ? 0.0f : broadleaf.min_top_prominence;
