@@ -249,6 +249,7 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     const TreeReconstruction reconstruction = reconstruct_tree(samples, o.stage, o.input);
     clock.start("lobes", "building the lobes");
     lobes::LobeReport lobe_report;
+    o.lobes.leaf_label_attribute = "wood";  // the samples' labels from the mesh's own materials: each lobe keeps its leaf share
     lobes::LobeTree tree = lobes::build_lobe_tree(samples, reconstruction, o.stage, species.reconstruction, o.lobes, &lobe_report);
     tree.leaf_area_m2 = label_report.leaf_area;  // the light tree gives the original's leaf area back
     clock.start("encode", "encoding .tlobe and .dbf6");

@@ -103,9 +103,9 @@ std::size_t attach_dropped_points(const PointCloud& cloud, const std::vector<int
     return count;
 }
 
-// Share of the points labelled leaf (the `wood` attribute is 0), -1 when the cloud has no labels.
-float leaf_share(const PointCloud& cloud, const std::vector<int>& points) {
-    const ExtraAttribute* wood = cloud.extra("wood");
+// Share of the points labelled leaf (`attribute` is 0), -1 without labels.
+float leaf_share(const PointCloud& cloud, const std::string& attribute, const std::vector<int>& points) {
+    const ExtraAttribute* wood = attribute.empty() ? nullptr : cloud.extra(attribute);
     if (wood == nullptr || points.empty()) return -1.0f;
     const auto leaves = std::count_if(points.begin(), points.end(), [&](int i) { return wood->values[static_cast<std::size_t>(i)] == 0; });
     return static_cast<float>(leaves) / static_cast<float>(points.size());
@@ -179,7 +179,7 @@ LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, c
         lobe.seed_node = new_index[cluster.seed_node];
         lobe.seed_direction = seed_direction(tree, cluster, points);
         lobe.points = cluster.points.size();
-        lobe.leaf_share = leaf_share(cloud, cluster.points);
+        lobe.leaf_share = leaf_share(cloud, o.leaf_label_attribute, cluster.points);
         lobe.cluster_points.reserve(cluster.points.size());
         for (int i : cluster.points) lobe.cluster_points.push_back(points[i]);
     });

@@ -30,7 +30,7 @@ struct Lobe {
                                                   // keeps their occupancy, on a grid sized to the file budget
     Occupancy occupancy;                          // read from a .tlobe (empty when the file had no room for it)
     // Share of cluster C_i's points that lie on leaves, when the input labels wood and leaves
-    // (the `wood` attribute of `treelobes rebuild`'s samples); -1 = unknown. Synthesis draws a
+    // (LobeOptions::leaf_label_attribute); -1 = unknown. Synthesis draws a
     // lobe's leaves in proportion to it, so that bare twigs stay bare.
     float leaf_share = -1.0f;
     double volume() const { return mesh.signed_volume(); }
@@ -63,6 +63,10 @@ struct LobeOptions {
     double simplify_tolerance = 0.02;     // metres: collapses below this error always happen
     double dropped_point_reach = 0.0;     // metres: outliers this close to a cluster join its occupancy (0 = off:
                                           // the larger occupancy takes coarser cells, docs/lobes.md)
+    // Per-point attribute of the input's own wood/leaf labels (0 = leaf), from which each lobe
+    // records its leaf share; empty = none. `treelobes rebuild` names the labels of the mesh's
+    // materials; a synthetic scan's `wood` attribute is the generator's truth and is not used.
+    std::string leaf_label_attribute;
 };
 
 struct LobeReport {

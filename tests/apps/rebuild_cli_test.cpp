@@ -3,6 +3,7 @@
 // meshes exit 2 with one line, bad options exit 1.
 #include "core/atomic_file.hpp"
 #include "core/mesh_io.hpp"
+#include "lobes/tlobe_io.hpp"
 #include "render/image.hpp"
 #include "support/glb_builder.hpp"
 #include "support/test_support.hpp"
@@ -72,6 +73,13 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     EXPECT_GT(report["fidelity"]["leaf_area"]["original_m2"].get<double>(), 0);
     // The .tlobe stores the original's leaf area and the synthesized blades are sized to it.
     EXPECT_NEAR(report["fidelity"]["leaf_area"]["ratio"].get<double>(), 1.0, 0.01);
+    // ... and every lobe's leaf share, from the samples' labels of the mesh's materials.
+    const lobes::LobeTree stored = lobes::read_tlobe(out / "palm_3_mesh.tlobe");
+    ASSERT_FALSE(stored.lobes.empty());
+    for (const lobes::Lobe& lobe : stored.lobes) {
+        EXPECT_GE(lobe.leaf_share, 0.0f);
+        EXPECT_LE(lobe.leaf_share, 1.0f);
+    }
     EXPECT_GT(report["rebuilt"]["triangles"].get<int>(), 0);
     EXPECT_LE(report["rebuilt"]["triangles"].get<int>(), 20000);
     EXPECT_GT(report["seconds"]["total"].get<double>(), 0);

@@ -41,11 +41,11 @@ struct Built {
     LobeReport report;
 };
 
-Built build(const PointCloud& cloud, double fs) {
+Built build(const PointCloud& cloud, double fs, const LobeOptions& lobe_options = {}) {
     ReconstructOptions ro;
     ro.allometry.fs = fs;
     Built b{reconstruct_tree(cloud, ro, "trunk_and_crown"), {}, {}};
-    b.tree = build_lobe_tree(cloud, b.reconstruction, ro, "test", {}, &b.report);
+    b.tree = build_lobe_tree(cloud, b.reconstruction, ro, "test", lobe_options, &b.report);
     return b;
 }
 
@@ -130,8 +130,9 @@ TEST(LobeTree, DroppedPointsNearTheCrownJoinTheLobeOccupancy) {
     EXPECT_EQ(on.dropped_points_attached, 6u);
 }
 
-// With wood/leaf labels on the points (the `wood` attribute of a sampled mesh), each lobe records
-// the share of its cluster's points on leaves; without them the share is unknown (-1).
+// With wood/leaf labels on the points named as the input's own (LobeOptions::leaf_label_attribute),
+// each lobe records the share of its cluster's points on leaves; labels not named (a synthetic
+// scan's truth) are not used, and without labels the share is unknown (-1).
 TEST(LobeTree, LobesRecordTheirLeafShareFromWoodLabels) {
     PointCloud cloud = trunk_and_crown();
     const Built unlabelled = build(cloud, 1.0);
@@ -139,7 +140,10 @@ TEST(LobeTree, LobesRecordTheirLeafShareFromWoodLabels) {
     // The crown ball's upper half is leaf (0), everything else wood (1).
     ExtraAttribute& wood = cloud.add_extra("wood", AttributeType::UInt8, 1.0);
     for (std::size_t i = 0; i < cloud.size(); ++i) wood.values[i] = cloud.positions[i].z() > 3.8f ? 0.0 : 1.0;
-    const Built labelled = build(cloud, 1.0);
+    for (const Lobe& lobe : build(cloud, 1.0).tree.lobes) EXPECT_LT(lobe.leaf_share, 0.0f);  // not named: not used
+    LobeOptions named;
+    named.leaf_label_attribute = "wood";
+    const Built labelled = build(cloud, 1.0, named);
     ASSERT_EQ(labelled.tree.lobes.size(), unlabelled.tree.lobes.size());
     double leaf = 0, all = 0;
     for (const Lobe& lobe : labelled.tree.lobes) {
