@@ -190,6 +190,7 @@ std::optional<forestry::TreeOutcome> finished_tree(const TileOutputs& out, const
     forestry::TreeOutcome outcome;
     outcome.id = tree.id;
     outcome.ok = true;
+    outcome.modelled = true;
     outcome.measures = row->measures;
     outcome.skeleton = read_skeleton_ply(out.tree_file(tree.id, kSkeletonSuffix));
     lobes = row->lobes;
@@ -445,8 +446,9 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
             continue;
         }
         row_of[i] = rows.size();
-        rows.push_back({outcome.measures, {}, std::nullopt, lobe_counts[i], global_ids.at(outcome.id)});
+        rows.push_back({outcome.measures, {}, std::nullopt, lobe_counts[i], outcome.modelled, global_ids.at(outcome.id)});
         stems.push_back({outcome.id, outcome.measures.position});
+        if (!outcome.modelled) continue;
         encode::ForestTree placed;
         placed.skeleton = outcome.skeleton;
         const Eigen::Vector3d root = placed.skeleton.origin + placed.skeleton.nodes[0].position.cast<double>();
@@ -457,7 +459,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     }
     if (model) assign_species(rows, outcomes, row_of, *model, o.voting);
     for (std::size_t i : todo_index)  // after the tree's files: a record marks a finished tree
-        if (row_of[i] != SIZE_MAX)
+        if (row_of[i] != SIZE_MAX && rows[row_of[i]].modelled)
             write_file_atomically(out.tree_file(outcomes[i].id, kRecordSuffix), forestry::tree_record(rows[row_of[i]], cloud.origin, key));
     seconds["species"] = rounded(lap_seconds(mark));
 
@@ -494,8 +496,11 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
 
     json dbh = json::object();
     const std::string dbh_text = dbh_counts(rows, dbh);
-    std::size_t tree_points = 0;
-    for (const auto& row : rows) tree_points += row.measures.points;
+    std::size_t tree_points = 0, modelled = 0;
+    for (const auto& row : rows) {
+        tree_points += row.measures.points;
+        modelled += row.modelled ? 1 : 0;
+    }
     const json summary = {{"treelobes", kVersion},
                           {"command", "tile"},
                           {"input", o.input},
@@ -512,6 +517,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                             {"tree_points", tree_points},
                             {"trees_found", outcomes.size()},
                             {"trees", rows.size()},
+                            {"trees_modelled", modelled},
+                            {"trees_measured_only", rows.size() - modelled},
                             {"trees_reused", reused},
                             {"trees_failed", failures.size()},
                             {"dbh", dbh}}},
@@ -533,9 +540,12 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         std::cout << summary.dump(2) << "\n";
     } else {
         const std::string failure_note = failures.empty() ? "" : " (" + out.failures.string() + ")";
-        std::printf("%s: %zu points, %zu ground (%s); %s segmentation: %zu trees found, %zu modelled, %zu failed%s\n", o.input.c_str(),
-                    cloud.size(), terrain.ground_points, terrain.ground_source.c_str(), options["mode_used"].get<std::string>().c_str(),
-                    outcomes.size(), rows.size(), failures.size(), failure_note.c_str());
+        std::printf(
+                "%s: %zu points, %zu ground (%s); %s segmentation: %zu trees found, %zu modelled, %zu measured only (fewer than %zu "
+                "points), %zu failed%s\n",
+                o.input.c_str(), cloud.size(), terrain.ground_points, terrain.ground_source.c_str(),
+                options["mode_used"].get<std::string>().c_str(), outcomes.size(), modelled, rows.size() - modelled, o.trees.min_points,
+                failures.size(), failure_note.c_str());
         std::printf("DBH: %s; %.1f s, peak memory %.0f MB\n", dbh_text.c_str(), seconds["total"].get<double>(), peak_memory_mb());
         std::printf("trees: %s and %s; picture: %s\n", out.csv.string().c_str(), out.geojson.string().c_str(), out.map.string().c_str());
     }
@@ -575,7 +585,8 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
             ->check(CLI::Range(1.0, 100.0));
     table->add("--dtm-cell", o->terrain.cell_size, "DTM cell size, metres")->check(PositiveNumber);
     table->add("--min-tree-height", o->segment.min_tree_height, "Lower tops are not trees, metres above ground")->check(PositiveNumber);
-    table->add("--min-tree-points", o->trees.min_points, "Trees with fewer points fail (listed in failures.jsonl)")
+    table->add("--min-tree-points", o->trees.min_points,
+               "Trees with fewer points are measured (a row in trees.csv) but not modelled (no skeleton, lobes or DBF6)")
             ->check(CLI::Range(10, 100000000));
     table->add("--outlier-test", o->outlier_test, "Outlier test of the per-tree reconstruction: auto, global, local")
             ->check(CLI::IsMember({"auto", "global", "local"}));

@@ -4,10 +4,11 @@
 #   - one run of the uncut plot (the reference),
 #   - a batch without a buffer (trees cut by an edge come out in pieces, one per tile),
 #   - a batch with --buffer BUFFER, as 4 shards under GNU parallel -j1 and -j2 (--threads 1 each),
-# each merged; pieces and duplicates counted against the plot's labels (tree_id = the true id with
-# --use-input-segmentation), the buffered merges compared with the reference (ids, bases) and with
-# each other (bytes); the wall times of -j1 and -j2 with the load average of the machine around
-# them. MODE=als runs the same with a fresh airborne segmentation instead of the plot's labels.
+# each merged; trees modelled and measured only, true trees absent, pieces and duplicates counted
+# against the plot's labels (tree_id = the true id with --use-input-segmentation), the buffered
+# merges compared with the reference (ids, bases) and with each other (bytes); the wall times of
+# -j1 and -j2 with the load average of the machine around them. MODE=als runs the same with a
+# fresh airborne segmentation instead of the plot's labels.
 #   bench/survey_buffer_bench.sh [WORKDIR] [TREES] [PLOT] [TILE] [BUFFER]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -65,12 +66,15 @@ def repeated(table):
 by_id = {r["global_id"]: r for r in single}
 print(f"true trees {len(truth)}; per {tile:.0f} m square: {sorted(per_square.values(), reverse=True)[:4]}; crowns across an inner edge: {crossing}")
 print(f"points in the tiles: {points}; tiles: {len(glob.glob('tiles/*.las'))}")
-print("| run | trees merged | true trees in pieces | extra pieces | same id and base (1 cm) as the uncut plot |")
-print("|---|---|---|---|---|")
+def absent(table):  # true trees without a row (with labels: trees no pulse reached, or lost)
+    return len(truth) - len({r["tree_id"] for r in table}) if labels else "n/a"
+print("| run | trees merged | modelled / measured only | true trees absent | true trees in pieces | extra pieces | same id and base (1 cm) as the uncut plot |")
+print("|---|---|---|---|---|---|---|")
 for name, table in [("uncut plot, one tile run", single), ("tiles, no buffer", nobuffer), ("tiles, buffer, parallel -j1", j1), ("tiles, buffer, parallel -j2", j2)]:
     cut, extra = repeated(table)
     ids = sum(1 for r in table if r["global_id"] in by_id and all(abs(float(r[a]) - float(by_id[r["global_id"]][a])) <= 0.01 for a in "xyz"))
-    print(f"| {name} | {len(table)} | {cut} | {extra} | {ids} |")
+    modelled = sum(1 for r in table if r["model"] == "ok")
+    print(f"| {name} | {len(table)} | {modelled} / {len(table) - modelled} | {absent(table)} | {cut} | {extra} | {ids} |")
 identical = all(filecmp.cmp(f"j1_merged/{f}", f"j2_merged/{f}", shallow=False) for f in ["trees.csv", "trees.geojson", "survey.forest", "summary.json"])
 print(f"-j1 and -j2 merges byte-identical: {identical}")
 print("| run | wall time (s) | load average before | after |")

@@ -46,6 +46,9 @@ DbhQuality parse_quality(const std::string& name) {
     throw Error::input("tree record", "unknown DBH quality '" + name + "'");
 }
 
+// Whether the tree has a model, or why not.
+const char* model_name(const TreeRow& row) { return row.modelled ? "ok" : "too_few_points"; }
+
 // The values a user reads, rounded for the tables (the record keeps full precision).
 json row_properties(const TreeRow& row, const Eigen::Vector3d& origin) {
     const TreeMeasures& m = row.measures;
@@ -62,7 +65,8 @@ json row_properties(const TreeRow& row, const Eigen::Vector3d& origin) {
             {"species", row.species.empty() ? json(nullptr) : json(row.species)},
             {"species_confidence", value_or_null(row.species_confidence, 3)},
             {"points", m.points},
-            {"lobes", row.lobes}};
+            {"lobes", row.modelled ? json(row.lobes) : json(nullptr)},
+            {"model", model_name(row)}};
 }
 
 }  // namespace
@@ -126,15 +130,15 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
 std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin) {
     std::string csv =
             "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
-            "woody_volume_m3,species,species_confidence,points,lobes\n";
+            "woody_volume_m3,species,species_confidence,points,lobes,model\n";
     for (const TreeRow& row : rows) {
         const TreeMeasures& m = row.measures;
         const Eigen::Vector3d p = origin + m.position;
         csv += row.global_id + "," + std::to_string(m.id) + "," + fixed(p.x(), 3) + "," + fixed(p.y(), 3) + "," + fixed(p.z(), 3) + "," +
                fixed(m.height, 2) + "," + cell(m.dbh.diameter, 3) + "," + dbh_quality_name(m.dbh.quality) + "," +
                cell(m.crown.base_height, 2) + "," + cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," +
-               cell(m.crown.volume, 2) + "," + fixed(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," +
-               std::to_string(m.points) + "," + std::to_string(row.lobes) + "\n";
+               cell(m.crown.volume, 2) + "," + cell(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," +
+               std::to_string(m.points) + "," + (row.modelled ? std::to_string(row.lobes) : std::string()) + "," + model_name(row) + "\n";
     }
     return csv;
 }
@@ -174,7 +178,7 @@ std::string tree_record(const TreeRow& row, const Eigen::Vector3d& origin, const
                          {"projected_area", optional_json(m.crown.projected_area)},
                          {"volume", optional_json(m.crown.volume)},
                          {"volume_failure", m.crown.volume_failure}}},
-                       {"woody_volume", m.woody_volume},
+                       {"woody_volume", optional_json(m.woody_volume)},
                        {"species_probabilities", m.species_probabilities}};
     record["options_key"] = options_key;
     return record.dump(1) + "\n";
@@ -189,7 +193,8 @@ std::optional<TreeRow> read_tree_record(const std::string& text, const std::stri
         TreeMeasures& m = row.measures;
         m.id = record.at("tree_id").get<int>();
         m.points = record.at("points").get<std::size_t>();
-        row.lobes = record.at("lobes").get<std::size_t>();
+        row.modelled = record.at("model").get<std::string>() == "ok";
+        if (row.modelled) row.lobes = record.at("lobes").get<std::size_t>();
         const auto position = e.at("position_local").get<std::vector<double>>();
         m.position = {position.at(0), position.at(1), position.at(2)};
         m.height = e.at("height").get<double>();
@@ -208,7 +213,7 @@ std::optional<TreeRow> read_tree_record(const std::string& text, const std::stri
         m.crown.projected_area = optional_from(crown.at("projected_area"));
         m.crown.volume = optional_from(crown.at("volume"));
         m.crown.volume_failure = crown.at("volume_failure").get<std::string>();
-        m.woody_volume = e.at("woody_volume").get<double>();
+        m.woody_volume = optional_from(e.at("woody_volume"));
         m.species_probabilities = e.at("species_probabilities").get<std::vector<double>>();
         return row;
     } catch (const json::exception&) {

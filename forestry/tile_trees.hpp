@@ -35,6 +35,7 @@ struct TreeRow {
     std::string species;                       // voted species; empty without a model
     std::optional<double> species_confidence;  // the tree's own probability of that species
     std::size_t lobes = 0;
+    bool modelled = true;   // false: measured only, too few points for a model (no lobes, no woody volume, no files)
     std::string global_id;  // the tree's id across a survey (from its stem base; set by the caller)
 };
 

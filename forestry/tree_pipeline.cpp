@@ -40,18 +40,34 @@ std::vector<double> species_probabilities(const PointCloud& cloud, const TreePip
     return options.model->probabilities(row.row(0));
 }
 
+// The measures that need only the tree's points (everything but the woody volume).
+TreeMeasures measure_tree(const TreeInput& tree, const TreePipelineOptions& options) {
+    TreeMeasures m;
+    m.id = tree.id;
+    m.points = tree.points.size();
+    m.height = *std::max_element(tree.height_above_ground.begin(), tree.height_above_ground.end());
+    m.dbh = measure_dbh(tree.points.positions, tree.height_above_ground, tree.base, options.dbh);
+    m.position = stem_position(tree, m.dbh);
+    m.crown = measure_crown(tree.points.positions, tree.height_above_ground, m.position, options.crown);
+    return m;
+}
+
 }  // namespace
 
 TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& options, TreeProducts& products) {
     const std::string name = tree_name(tree.id);
     if (tree.points.size() != tree.height_above_ground.size())
         throw Error(ExitCode::Internal, name + ": one height above ground per point expected");
-    if (tree.points.size() < options.min_points)
-        throw Error::input(name, std::to_string(tree.points.size()) + " points, fewer than the " + std::to_string(options.min_points) +
-                                         " a tree model needs (--min-tree-points)");
+    if (tree.points.empty()) throw Error(ExitCode::Internal, name + ": a tree without points");
     TreeOutcome outcome;
     outcome.id = tree.id;
+    outcome.ok = true;
     auto mark = Clock::now();
+    if (tree.points.size() < options.min_points) {  // measured only: too few points for a model
+        outcome.measures = measure_tree(tree, options);
+        outcome.seconds.emplace_back("measures", seconds_since(mark));
+        return outcome;
+    }
 
     const TreeReconstruction reconstruction = reconstruct_tree(tree.points, options.reconstruct, name);
     outcome.seconds.emplace_back("reconstruct", seconds_since(mark));
@@ -68,22 +84,16 @@ TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& optio
     products.dbf6 = encode::write_tree_file_bytes(stored);
     outcome.seconds.emplace_back("dbf6", seconds_since(mark));
 
-    TreeMeasures& m = outcome.measures;
-    m.id = tree.id;
-    m.points = tree.points.size();
-    m.height = *std::max_element(tree.height_above_ground.begin(), tree.height_above_ground.end());
-    m.dbh = measure_dbh(tree.points.positions, tree.height_above_ground, tree.base, options.dbh);
-    m.position = stem_position(tree, m.dbh);
-    m.crown = measure_crown(tree.points.positions, tree.height_above_ground, m.position, options.crown);
-    m.woody_volume = woody_volume(reconstruction.skeleton);
+    outcome.measures = measure_tree(tree, options);
+    outcome.measures.woody_volume = woody_volume(reconstruction.skeleton);
     outcome.seconds.emplace_back("measures", seconds_since(mark));
 
     if (options.model) {
-        m.species_probabilities = species_probabilities(tree.points, options, name);
+        outcome.measures.species_probabilities = species_probabilities(tree.points, options, name);
         outcome.seconds.emplace_back("species", seconds_since(mark));
     }
     outcome.skeleton = reconstruction.skeleton;
-    outcome.ok = true;
+    outcome.modelled = true;
     return outcome;
 }
 
@@ -113,7 +123,7 @@ std::vector<TreeOutcome> process_trees(std::span<const TreeInput> trees, const T
         outcome.id = trees[i].id;
         {
             const std::lock_guard lock(report);
-            if (done) done(outcome, outcome.ok ? &products : nullptr);
+            if (done) done(outcome, outcome.modelled ? &products : nullptr);
         }
         outcomes[i] = std::move(outcome);
     });

@@ -2,7 +2,9 @@
 // (reconstruct/reconstruct_tree.hpp), lobes and the .tlobe bytes (lobes/), the DBF6 tree file
 // (encode/), the forestry measures (forestry/measures.hpp) and, with a model, species
 // probabilities (classify/). Each tree runs in its own error boundary: a tree that fails is
-// reported with its reason and the others go on. Trees run in parallel (TBB); every tree's
+// reported with its reason and the others go on. A tree with fewer points than a model needs
+// (`min_points`: the top of a small tree seen through the canopy) is measured but not modelled,
+// so an inventory still lists it. Trees run in parallel (TBB); every tree's
 // results depend only on its own points and the options, so outputs are deterministic.
 #pragma once
 
@@ -23,6 +25,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <span>
 #include <string>
 #include <utility>
@@ -49,7 +52,7 @@ struct TreePipelineOptions {
     BranchMeshOptions mesh;
     DbhOptions dbh;
     CrownOptions crown;
-    std::size_t min_points = 50;                       // smaller trees fail ("too few points")
+    std::size_t min_points = 50;                       // smaller trees are measured, not modelled
     const classify::JointBoostModel* model = nullptr;  // species probabilities when set
     classify::FeatureOptions features;
 };
@@ -60,7 +63,7 @@ struct TreeMeasures {
     double height = 0;                  // metres: highest point above the terrain
     DbhMeasure dbh;
     CrownMeasure crown;
-    double woody_volume = 0;  // cubic metres, from the skeleton's cylinders
+    std::optional<double> woody_volume;  // cubic metres, from the skeleton's cylinders (none without a model)
     std::size_t points = 0;
     std::vector<double> species_probabilities;  // per model class; empty without a model
 };
@@ -76,8 +79,9 @@ struct TreeProducts {
 
 struct TreeOutcome {
     int id = 0;
-    bool ok = false;
-    std::string failure;  // the reason when !ok
+    bool ok = false;        // measured (and modelled unless too small)
+    bool modelled = false;  // skeleton, lobes and DBF6 made (ok and at least min_points points)
+    std::string failure;    // the reason when !ok
     ExitCode failure_code = ExitCode::Ok;
     TreeMeasures measures;                                // valid when ok
     TreeGraph skeleton;                                   // kept for the tile's .forest
@@ -88,7 +92,7 @@ struct TreeOutcome {
 TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& options, TreeProducts& products);
 
 // All trees, in parallel. `done` is called once per tree as soon as it finishes (from worker
-// threads, one call at a time), with the outcome and, for trees that succeeded, their products.
+// threads, one call at a time), with the outcome and, for trees that were modelled, their products.
 // Outcomes are returned in the order of `trees`.
 using TreeDone = std::function<void(const TreeOutcome&, const TreeProducts*)>;
 std::vector<TreeOutcome> process_trees(std::span<const TreeInput> trees, const TreePipelineOptions& options, const TreeDone& done);

@@ -1,6 +1,6 @@
 // End-to-end: `treelobes tile` on a small synthetic tile (outputs present and consistent with
-// each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, failures.jsonl
-// with exit 3) and on bad tiles (empty, all ground, one tree, no CRS, NaN coordinates).
+// each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, trees too small
+// for a model measured only, failures.jsonl with exit 3) and on bad tiles (empty, all ground, one tree, no CRS, NaN coordinates).
 #include "core/cloud_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -155,23 +156,85 @@ TEST(TileCli, ResumeKeepsFinishedOutputsAndOverwriteRedoesThemIdentically) {
         EXPECT_EQ(slurp(dir / "a" / file), slurp(dir / "b" / file)) << file;
 }
 
+// The number of points of each labelled tree of the small tile.
+std::map<int, std::size_t> tree_sizes(const PointCloud& cloud) {
+    std::map<int, std::size_t> sizes;
+    for (double id : cloud.extra("treeID")->values)
+        if (id > 0) ++sizes[static_cast<int>(id)];
+    return sizes;
+}
+
+std::vector<std::string> csv_cells(const std::string& line) {
+    std::vector<std::string> cells;
+    std::stringstream in(line + ",");  // the trailing comma keeps an empty last cell
+    for (std::string cell; std::getline(in, cell, ',');) cells.push_back(cell);
+    return cells;
+}
+
+// The row of trees.csv (its lines) whose tree_id is `tree_id`, by column name; empty when none.
+std::map<std::string, std::string> csv_row(const std::vector<std::string>& lines, int tree_id) {
+    const std::vector<std::string> header = csv_cells(lines.at(0));
+    for (std::size_t k = 1; k < lines.size(); ++k) {
+        const std::vector<std::string> cells = csv_cells(lines[k]);
+        if (cells.size() != header.size() || cells[1] != std::to_string(tree_id)) continue;
+        std::map<std::string, std::string> row;
+        for (std::size_t i = 0; i < header.size(); ++i) row[header[i]] = cells[i];
+        return row;
+    }
+    return {};
+}
+
+TEST(TileCli, ATreeTooSmallForAModelIsMeasuredNotModelled) {
+    TempDir dir;
+    const auto sizes = tree_sizes(read_point_cloud(small_tile()));
+    const auto smallest = std::min_element(sizes.begin(), sizes.end(), [](auto& a, auto& b) { return a.second < b.second; });
+    const std::size_t limit = smallest->second + 1;
+    const auto r = run_cli(run_tile(dir / "out", "--use-input-segmentation --min-tree-points " + std::to_string(limit)));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("1 measured only"), std::string::npos) << r.out;
+    EXPECT_FALSE(fs::exists(dir / "out" / "failures.jsonl"));
+    const auto lines = lines_of(slurp(dir / "out" / "trees.csv"));
+    EXPECT_EQ(lines.size(), sizes.size() + 1);  // header + every tree
+    auto row = csv_row(lines, smallest->first);
+    EXPECT_EQ(row["model"], "too_few_points");
+    EXPECT_EQ(row["points"], std::to_string(smallest->second));
+    EXPECT_FALSE(row["height_m"].empty());
+    EXPECT_TRUE(row["lobes"].empty() && row["woody_volume_m3"].empty());
+    char name[32];
+    std::snprintf(name, sizeof name, "tree_%04d.tlobe", smallest->first);
+    EXPECT_FALSE(fs::exists(dir / "out" / "trees" / name));
+    EXPECT_EQ(encode::ForestReader(dir / "out" / "tile.forest").size(), sizes.size() - 1);
+    const auto summary = nlohmann::json::parse(slurp(dir / "out" / "summary.json"));
+    EXPECT_EQ(summary["counts"]["trees"], sizes.size());
+    EXPECT_EQ(summary["counts"]["trees_measured_only"], 1);
+    EXPECT_EQ(summary["counts"]["trees_modelled"], sizes.size() - 1);
+    for (const auto& [id, n] : sizes) {
+        if (id == smallest->first) continue;
+        EXPECT_EQ(csv_row(lines, id)["model"], "ok") << id;
+    }
+}
+
 TEST(TileCli, ATreeThatFailsIsListedAndTheOthersGoOn) {
     TempDir dir;
-    const PointCloud input = read_point_cloud(small_tile());
-    std::map<int, std::size_t> sizes;
-    for (double id : input.extra("treeID")->values)
-        if (id > 0) ++sizes[static_cast<int>(id)];
-    std::vector<std::size_t> counts;
-    for (const auto& [id, n] : sizes) counts.push_back(n);
-    std::sort(counts.begin(), counts.end());
-    const std::size_t limit = counts.front() + 1;  // the smallest tree is too small
-    const auto r = run_cli(run_tile(dir / "out", "--use-input-segmentation --min-tree-points " + std::to_string(limit)));
+    PointCloud cloud = read_point_cloud(small_tile());
+    const auto sizes = tree_sizes(cloud);
+    const int broken = sizes.rbegin()->first;  // its points all moved to one spot: no skeleton can be built
+    const auto& ids = cloud.extra("treeID")->values;
+    std::optional<Eigen::Vector3f> spot;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        if (static_cast<int>(ids[i]) == broken) {
+            if (!spot) spot = cloud.positions[i];
+            cloud.positions[i] = *spot;
+        }
+    write_point_cloud(cloud, dir / "broken.las");
+    const auto r = run_cli("tile " + quoted(dir / "broken.las") + " --use-input-segmentation --out " + quoted(dir / "out"));
     EXPECT_EQ(r.exit_code, 3) << r.err;
     const auto failures = lines_of(slurp(dir / "out" / "failures.jsonl"));
     ASSERT_EQ(failures.size(), 1u);
     const auto failure = nlohmann::json::parse(failures[0]);
-    EXPECT_NE(failure["reason"].get<std::string>().find("--min-tree-points"), std::string::npos);
-    EXPECT_EQ(sizes.at(failure["tree_id"].get<int>()), counts.front());
+    EXPECT_EQ(failure["tree_id"], broken);
+    EXPECT_EQ(failure["exit_code"], 2);
+    EXPECT_NE(failure["reason"].get<std::string>().find("too few points"), std::string::npos) << failure.dump();
     EXPECT_EQ(lines_of(slurp(dir / "out" / "trees.csv")).size(), sizes.size());  // header + the others
     EXPECT_EQ(encode::ForestReader(dir / "out" / "tile.forest").size(), sizes.size() - 1);
 }
