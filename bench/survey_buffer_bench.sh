@@ -4,6 +4,7 @@
 #   - one run of the uncut plot (the reference),
 #   - a batch without a buffer (trees cut by an edge come out in pieces, one per tile),
 #   - a batch with --buffer BUFFER, as 4 shards under GNU parallel -j1 and -j2 (--threads 1 each),
+#     and as a Slurm job array of 4 tasks on a one-node cluster of this machine (when root),
 # each merged; trees modelled and measured only, true trees absent, pieces and duplicates counted
 # against the plot's labels (tree_id = the true id with --use-input-segmentation), the buffered
 # merges compared with the reference (ids, bases) and with each other (bytes); the wall times of
@@ -39,9 +40,18 @@ load_j2_before=$(load)
 t_j2=$(seconds parallel -j2 "$cli" --log-level error --threads 1 batch tiles --out j2 --shard {}/4 --buffer "$buffer" --tile-size "$tile" $options ::: 0 1 2 3)
 load_j2_after=$(load)
 merge j2_merged j2
+# The same batch as a Slurm job array on a one-node cluster of this machine (needs root, slurm-wlm, munge).
+slurm_ran=no
+if command -v slurmctld >/dev/null && [[ $(id -u) == 0 ]]; then
+  mkdir -p jobs
+  PATH="$(dirname "$cli"):$PATH" "$root/tests/survey/local_slurm_cluster.sh" "$work/cluster" sh -c \
+    "cd '$work/jobs' && sbatch --array=0-3 --wait --mem=1G --export=ALL,TILES='$work/tiles',OUT='$work/slurm',MAX_MEMORY=900M,TILE_OPTIONS='--buffer $buffer --tile-size $tile $options' '$root/scripts/slurm/batch.sbatch' >/dev/null" >/dev/null 2>&1 || true
+  merge slurm_merged slurm
+  slurm_ran=yes
+fi
 
-python3 - "$plot" "$tile" "$t_single" "$t_nobuffer" "$t_j1" "$t_j2" "$load_j1_before" "$load_j1_after" "$load_j2_before" "$load_j2_after" "$options" <<'PY'
-import csv, filecmp, glob, json, math, struct, sys
+python3 - "$plot" "$tile" "$t_single" "$t_nobuffer" "$t_j1" "$t_j2" "$load_j1_before" "$load_j1_after" "$load_j2_before" "$load_j2_after" "$options" "$slurm_ran" <<'PY'
+import csv, filecmp, glob, json, math, os, struct, sys
 from collections import Counter
 plot, tile = float(sys.argv[1]), float(sys.argv[2])
 t_single, t_nobuffer, t_j1, t_j2 = (float(v) for v in sys.argv[3:7])
@@ -75,8 +85,15 @@ for name, table in [("uncut plot, one tile run", single), ("tiles, no buffer", n
     ids = sum(1 for r in table if r["global_id"] in by_id and all(abs(float(r[a]) - float(by_id[r["global_id"]][a])) <= 0.01 for a in "xyz"))
     modelled = sum(1 for r in table if r["model"] == "ok")
     print(f"| {name} | {len(table)} | {modelled} / {len(table) - modelled} | {absent(table)} | {cut} | {extra} | {ids} |")
-identical = all(filecmp.cmp(f"j1_merged/{f}", f"j2_merged/{f}", shallow=False) for f in ["trees.csv", "trees.geojson", "survey.forest", "summary.json"])
-print(f"-j1 and -j2 merges byte-identical: {identical}")
+merged_files = ["trees.csv", "trees.geojson", "survey.forest", "summary.json"]
+def same_bytes(a, b):
+    return all(filecmp.cmp(f"{a}/{f}", f"{b}/{f}", shallow=False) for f in merged_files)
+print(f"-j1 and -j2 merges byte-identical: {same_bytes('j1_merged', 'j2_merged')}")
+if sys.argv[12] == "yes":
+    slurm = rows("slurm_merged") if os.path.exists("slurm_merged/trees.csv") else []
+    print(f"Slurm job array (--array=0-3): {len(slurm)} trees merged; byte-identical to -j1: {bool(slurm) and same_bytes('j1_merged', 'slurm_merged')}")
+else:
+    print("Slurm job array: not run (needs root, slurm-wlm and munge)")
 print("| run | wall time (s) | load average before | after |")
 print("|---|---|---|---|")
 print(f"| uncut plot, tile --threads 1 | {t_single} | | |")

@@ -20,19 +20,22 @@ step "info: the sample's scans"
 "$BIN" info "$SAMPLE"/*.las "$SAMPLE/tile/tile.las"
 
 step "tile: a forest tile in, every tree out"
-# Exit 3 means the tile is done but some trees were not modelled (listed in failures.jsonl).
+# Exit 3 means the tile is done but some trees failed (listed in failures.jsonl).
 status=0
 "$BIN" tile "$SAMPLE/tile/tile.las" --out "$OUT/tile" || status=$?
 ((status == 0 || status == 3)) || exit "$status"
 echo
 echo "trees found (from $OUT/tile/trees.csv; heights in metres above the ground; an airborne scan"
-echo "does not see stems, so DBH is 'not_visible' rather than guessed):"
+echo "does not see stems, so DBH is 'not_visible' rather than guessed; a tree with too few points"
+echo "for a model is measured only, without a woody volume):"
 awk -F, 'NR == 1 { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", "tree", "x", "y", "height", "DBH", "crown_d", "crown_m3", "wood_m3", "points"; next }
-         { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $2, $3, $4, $6, ($7 == "" ? $8 : $7 " m"), $10, $12, $13, $16 }' \
+         { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $2, $3, $4, $6, ($7 == "" ? $8 : $7 " m"), $10, $12, ($18 == "ok" ? $13 : "-"), $16 }' \
     "$OUT/tile/trees.csv"
-echo "$(($(wc -l <"$OUT/tile/trees.csv") - 1)) trees modelled; the tile holds $(($(wc -l <"$SAMPLE/tile/truth.csv") - 1)) true trees ($SAMPLE/tile/truth.csv)"
+modelled=$(awk -F, 'NR > 1 && $18 == "ok"' "$OUT/tile/trees.csv" | wc -l)
+listed=$(($(wc -l <"$OUT/tile/trees.csv") - 1))
+echo "$listed trees: $modelled modelled, $((listed - modelled)) measured only (fewer than 50 points); the tile holds $(($(wc -l <"$SAMPLE/tile/truth.csv") - 1)) true trees ($SAMPLE/tile/truth.csv)"
 if [[ -f "$OUT/tile/failures.jsonl" ]]; then
-    echo "$(wc -l <"$OUT/tile/failures.jsonl") segments not modelled (too few points for a tree model): $OUT/tile/failures.jsonl"
+    echo "$(wc -l <"$OUT/tile/failures.jsonl") trees failed: $OUT/tile/failures.jsonl"
 fi
 echo "picture: $OUT/tile/top_view.png (each tree in its colour, stems as dots with their ids)"
 echo "also: $OUT/tile/points.las (treeID, HeightAboveGround), trees.geojson, tile.forest, trees/ (per tree skeleton, mesh, .tlobe, .dbf6)"
