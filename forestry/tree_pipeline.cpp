@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <mutex>
+#include <optional>
 
 namespace treelobes::forestry {
 
@@ -40,13 +41,45 @@ std::vector<double> species_probabilities(const PointCloud& cloud, const TreePip
     return options.model->probabilities(row.row(0));
 }
 
+// The terrain under `xy`: the median of z - HAG over the tree's points within 1 m horizontally
+// (each point's HAG is taken from the DTM beneath it); nullopt when there are none.
+std::optional<double> terrain_under(const TreeInput& tree, const Eigen::Vector2d& xy) {
+    std::vector<double> ground;
+    for (std::size_t i = 0; i < tree.points.size(); ++i) {
+        const Eigen::Vector3f& p = tree.points.positions[i];
+        if ((p.head<2>().cast<double>() - xy).norm() <= 1.0) ground.push_back(static_cast<double>(p.z() - tree.height_above_ground[i]));
+    }
+    if (ground.empty()) return std::nullopt;
+    const auto mid = ground.begin() + static_cast<std::ptrdiff_t>(ground.size() / 2);
+    std::nth_element(ground.begin(), mid, ground.end());
+    return *mid;
+}
+
+// Height as foresters measure it: the top above the ground at the stem base. Where the stem was
+// seen (a DBH circle), that is the top's z minus the terrain at the circle: on a slope, the
+// largest height above the terrain under each point would overstate a crown that reaches
+// downhill. Where it was not (airborne scans), the base is not known better than the treetop, so
+// the top's own height above the terrain is taken.
+double tree_height(const TreeInput& tree, const DbhMeasure& dbh) {
+    const auto& points = tree.points.positions;
+    const auto top = static_cast<std::size_t>(
+            std::max_element(points.begin(), points.end(), [](const auto& a, const auto& b) { return a.z() < b.z(); }) - points.begin());
+    if (dbh.diameter)
+        if (const std::optional<double> ground = terrain_under(tree, dbh.centre)) return static_cast<double>(points[top].z()) - *ground;
+    Eigen::Vector2d centroid(0, 0);
+    for (const auto& p : points) centroid += p.head<2>().cast<double>();
+    centroid /= static_cast<double>(points.size());
+    if (const std::optional<double> ground = terrain_under(tree, centroid)) return static_cast<double>(points[top].z()) - *ground;
+    return tree.height_above_ground[top];
+}
+
 // The measures that need only the tree's points (everything but the woody volume).
 TreeMeasures measure_tree(const TreeInput& tree, const TreePipelineOptions& options) {
     TreeMeasures m;
     m.id = tree.id;
     m.points = tree.points.size();
-    m.height = *std::max_element(tree.height_above_ground.begin(), tree.height_above_ground.end());
     m.dbh = measure_dbh(tree.points.positions, tree.height_above_ground, tree.base, options.dbh);
+    m.height = tree_height(tree, m.dbh);
     m.position = stem_position(tree, m.dbh);
     m.crown = measure_crown(tree.points.positions, tree.height_above_ground, m.position, options.crown);
     return m;

@@ -60,7 +60,7 @@ struct TreePipelineOptions {
 struct TreeMeasures {
     int id = 0;
     Eigen::Vector3d position{0, 0, 0};  // stem base, local frame (x, y of the DBH circle when fitted)
-    double height = 0;                  // metres: highest point above the terrain
+    double height = 0;                  // metres: highest point above the ground at the stem (docs/tile.md)
     DbhMeasure dbh;
     CrownMeasure crown;
     std::optional<double> woody_volume;  // cubic metres, from the skeleton's cylinders (none without a model)

@@ -1,9 +1,10 @@
 // The per-tree pipeline of a tile (forestry/tree_pipeline.hpp): every tree in its own error
-// boundary, and trees too small for a model measured rather than dropped.
+// boundary, trees too small for a model measured rather than dropped, and the height on a slope.
 #include "forestry/tree_pipeline.hpp"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -64,6 +65,17 @@ TEST(TreePipeline, ATreeThatFailsIsReportedAndTheOthersAreModelled) {
     EXPECT_EQ(outcomes[1].id, 2);
     EXPECT_EQ(outcomes[1].failure_code, ExitCode::InvalidInput) << outcomes[1].failure;
     EXPECT_NE(outcomes[1].failure.find("tree 2"), std::string::npos) << outcomes[1].failure;
+}
+
+TEST(TreePipeline, HeightIsTheTopAboveTheGroundAtTheStemBase) {
+    TreeInput tree = stem_and_crown(5, 800);
+    for (std::size_t i = 0; i < tree.points.size(); ++i)  // ground z = x (45 degrees): the crown reaches over ground 2 m down
+        tree.height_above_ground[i] = tree.points.positions[i].z() - tree.points.positions[i].x();
+    const float largest_above_terrain = *std::max_element(tree.height_above_ground.begin(), tree.height_above_ground.end());
+    TreeProducts products;
+    const TreeOutcome outcome = process_tree(tree, {}, products);
+    EXPECT_NEAR(outcome.measures.height, 8.5, 0.1);                   // the crown's top, 8.5 m above the base at z = 0
+    EXPECT_GT(largest_above_terrain, outcome.measures.height + 0.5);  // what the largest height above the terrain would say
 }
 
 TEST(TreePipeline, ATreeTooSmallForAModelIsMeasuredOnly) {
