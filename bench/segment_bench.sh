@@ -39,8 +39,8 @@ tile() {
 }
 for s in 11 12 13 14; do tile "als_open_$s" "$s" --trees 25 --size 100 --scanner als; done
 for s in 1 2 3 4; do tile "als_crowded_$s" "$s" --trees 30 --size 80 --scanner als; done
-for s in 21 22 23; do tile "tls_open_$s" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25; done
-for s in 1 2 3; do tile "tls_crowded_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
+for s in 21 22 23 24 25 26 27; do tile "tls_open_$s" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25; done
+for s in 1 2 3 4 5 6; do tile "tls_crowded_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
 
 # row LABEL ARGS...: one table row from one segment_eval run.
 row() {
@@ -68,10 +68,20 @@ header "tile"
 for s in 11 12 13 14; do row "ALS open, seed $s" "$WORK/als_open_$s/tile.las" --reference treeID; done
 for s in 11 12 13 14; do row "ALS open, seed $s, ground filtered" "$WORK/als_open_$s/tile.las" --reference treeID --ignore-classification; done
 for s in 1 2 3 4; do row "ALS crowded, seed $s" "$WORK/als_crowded_$s/tile.las" --reference treeID; done
-for s in 21 22 23; do row "TLS open, seed $s" "$WORK/tls_open_$s/tile.las" --reference treeID; done
+for s in 21 22 23 24 25 26 27; do row "TLS open, seed $s" "$WORK/tls_open_$s/tile.las" --reference treeID; done
 for s in 21 22 23; do row "TLS open, seed $s, ground filtered" "$WORK/tls_open_$s/tile.las" --reference treeID --ignore-classification; done
-for s in 1 2 3; do row "TLS crowded, seed $s" "$WORK/tls_crowded_$s/tile.las" --reference treeID; done
-
+for s in 1 2 3 4 5 6; do row "TLS crowded, seed $s" "$WORK/tls_crowded_$s/tile.las" --reference treeID; done
+# Crown cover (summed true crown areas over the plot area): how far the crowns interpenetrate.
+echo "crown cover (sum of the true crown areas / plot area):"
+for d in "$WORK"/als_*/ "$WORK"/tls_*/; do
+  python3 - "$d" <<'PY'
+import csv, json, math, sys
+folder = sys.argv[1].rstrip("/")
+side = json.load(open(folder + "/summary.json"))["options"]["size"]
+area = sum(math.pi / 4 * float(r["crown_diameter_m"]) ** 2 for r in csv.DictReader(open(folder + "/truth.csv")))
+print(f"  {folder.split('/')[-1]}: {area / side ** 2:.2f}")
+PY
+done
 echo
 echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
 header "setting"
