@@ -383,7 +383,9 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     }
     const std::optional<float> reach = segmentation_reach(o, segmentation);
     if (plan.core) warn_if_buffer_is_narrow(o, reach);
-    std::vector<forestry::TreeInput> trees = forestry::split_trees(cloud, segmentation.tree_id, terrain.height_above_ground, bases);
+    const bool bases_at_stems = segmentation.mode_used != ScanMode::Airborne;  // terrestrial: stem circles
+    std::vector<forestry::TreeInput> trees =
+            forestry::split_trees(cloud, segmentation.tree_id, terrain.height_above_ground, bases, bases_at_stems);
     const std::size_t trees_in_buffer = plan.core ? keep_core_trees(trees, segmentation.tree_id, *plan.core, cloud.origin) : 0;
     const std::map<int, std::string> global_ids = survey_ids(trees, cloud.origin);
     for (forestry::TreeInput& tree : trees) order_points_by_position(tree);

@@ -99,7 +99,8 @@ Eigen::Vector3d estimate_stem_base(std::span<const Eigen::Vector3f> points, std:
 }
 
 std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std::int32_t> tree_id,
-                                   std::span<const float> height_above_ground, const std::map<int, Eigen::Vector3d>& bases) {
+                                   std::span<const float> height_above_ground, const std::map<int, Eigen::Vector3d>& bases,
+                                   bool bases_at_stems) {
     if (tree_id.size() != cloud.size() || height_above_ground.size() != cloud.size())
         throw Error(ExitCode::Internal, "split_trees: one tree id and height per point expected");
     std::map<int, std::size_t> slot;
@@ -121,8 +122,13 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
         tree.height_above_ground.push_back(height_above_ground[i]);
     }
     for (TreeInput& tree : trees) {
-        const auto known = bases.find(tree.id);
-        tree.base = known != bases.end() ? known->second : estimate_stem_base(tree.points.positions, tree.height_above_ground);
+        if (const auto known = bases.find(tree.id); known != bases.end()) {
+            tree.base = known->second;
+            tree.base_at_stem = bases_at_stems;
+        } else {
+            tree.base = estimate_stem_base(tree.points.positions, tree.height_above_ground);
+            tree.base_at_stem = false;
+        }
     }
     return trees;
 }

@@ -24,10 +24,14 @@ Eigen::Vector3d estimate_stem_base(std::span<const Eigen::Vector3f> points, std:
                                    float stem_reach = 2.0f);
 
 // One TreeInput per tree id > 0, ids ascending, each with the positions (no other attributes)
-// and heights of its points. Trees in `bases` take that base, others estimate_stem_base.
-// Throws Error(Internal) for mismatched sizes.
+// and heights of its points. Trees in `bases` take that base (found at the stem when
+// `bases_at_stems`, a terrestrial segmentation; placed under the treetop otherwise), others
+// estimate_stem_base, which is not taken as found at the stem: the lowest points of an airborne
+// scan are as often the crown's lowest twigs (the tree's measures then place the stem by the
+// DBH circle or the crown's centre). Throws Error(Internal) for mismatched sizes.
 std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std::int32_t> tree_id,
-                                   std::span<const float> height_above_ground, const std::map<int, Eigen::Vector3d>& bases);
+                                   std::span<const float> height_above_ground, const std::map<int, Eigen::Vector3d>& bases,
+                                   bool bases_at_stems);
 
 // A finished tree as the tables show it.
 struct TreeRow {

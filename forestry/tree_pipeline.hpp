@@ -42,6 +42,10 @@ struct TreeInput {
     PointCloud points;                       // its points: positions in the tile's local frame, the tile's origin
     std::vector<float> height_above_ground;  // per point, metres
     Eigen::Vector3d base{0, 0, 0};           // stem base from the segmentation, local frame
+    // Whether `base` was found at the stem (a terrestrial stem circle, the lowest points of a scan
+    // that reaches the ground) or only placed under the treetop (airborne): the crown's centre is
+    // then the better estimate of where the stem stands.
+    bool base_at_stem = true;
 };
 
 struct TreePipelineOptions {

@@ -1,5 +1,6 @@
 // The per-tree pipeline of a tile (forestry/tree_pipeline.hpp): every tree in its own error
-// boundary, trees too small for a model measured rather than dropped, and the height on a slope.
+// boundary, trees too small for a model measured rather than dropped, the height on a slope and
+// the stem position of a crown seen from above.
 #include "forestry/tree_pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -76,6 +77,22 @@ TEST(TreePipeline, HeightIsTheTopAboveTheGroundAtTheStemBase) {
     const TreeOutcome outcome = process_tree(tree, {}, products);
     EXPECT_NEAR(outcome.measures.height, 8.5, 0.1);                   // the crown's top, 8.5 m above the base at z = 0
     EXPECT_GT(largest_above_terrain, outcome.measures.height + 0.5);  // what the largest height above the terrain would say
+}
+
+TEST(TreePipeline, ACrownSeenFromAboveIsPlacedAtItsCentreNotUnderItsTop) {
+    TreeInput crown = stem_and_crown(6, 600);  // the crown alone: no stem points, no DBH
+    crown.points.positions.erase(crown.points.positions.begin(), crown.points.positions.begin() + 1188);
+    crown.height_above_ground.erase(crown.height_above_ground.begin(), crown.height_above_ground.begin() + 1188);
+    crown.base = {1.5, 0.0, 0.0};  // an airborne base: under a top at the crown's edge
+    crown.base_at_stem = false;
+    TreeProducts products;
+    const TreeOutcome placed = process_tree(crown, {}, products);
+    EXPECT_NEAR(placed.measures.position.x(), 0.0, 0.2);
+    EXPECT_NEAR(placed.measures.position.y(), 0.0, 0.2);
+    EXPECT_FALSE(placed.measures.dbh.diameter.has_value());
+
+    crown.base_at_stem = true;  // a base found at the stem is kept
+    EXPECT_NEAR(process_tree(crown, {}, products).measures.position.x(), 1.5, 1e-9);
 }
 
 TEST(TreePipeline, ATreeTooSmallForAModelIsMeasuredOnly) {

@@ -144,10 +144,13 @@ TEST(SurveyBuffer, EveryTreeOnceAndAsInOneRunOfTheUncutPlot) {
         // point when the stem is not seen), not always on the stem.
         EXPECT_LE(std::hypot(number(a, "x") - number(t, "x"), number(a, "y") - number(t, "y")), number(t, "crown_diameter_m") / 2 + 0.5)
                 << "true tree " << a.at("tree_id");
-        // The tree is the one of the tile whose square holds its base.
+        // The tree is the one of the tile whose square holds its segmentation base: the point its
+        // survey-wide id names ("<x>_<y>" of the base's 1 cm cell; x, y are the stem position measured).
+        const std::string& id = a.at("global_id");
+        const double base_x = std::stod(id.substr(0, id.find('_'))), base_y = std::stod(id.substr(id.find('_') + 1));
         char tile[64];
-        std::snprintf(tile, sizeof tile, "tile_%.0f_%.0f", std::floor(number(a, "x") / kTileSize) * kTileSize,
-                      std::floor(number(a, "y") / kTileSize) * kTileSize);
+        std::snprintf(tile, sizeof tile, "tile_%.0f_%.0f", std::floor(base_x / kTileSize) * kTileSize,
+                      std::floor(base_y / kTileSize) * kTileSize);
         EXPECT_EQ(a.at("tile"), tile) << a.at("global_id");
     }
     const auto summary = nlohmann::json::parse(file_bytes(merged / "summary.json"));
