@@ -396,7 +396,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
 
     // Trees finished by an earlier run are read back; the others go through the pipeline.
     const json options = options_json(table, o, segmentation);
-    const std::string key = tree_options_json(o).dump();
+    const std::string key = "treelobes " + std::string(kVersion) + ", records " + std::to_string(forestry::kTreeRecordRevision) + ", " +
+                            tree_options_json(o).dump();
     std::vector<forestry::TreeOutcome> outcomes(trees.size());
     std::vector<std::size_t> lobe_counts(trees.size(), 0);
     std::vector<forestry::TreeInput> todo;

@@ -144,10 +144,22 @@ TEST(TileCli, ResumeKeepsFinishedOutputsAndOverwriteRedoesThemIdentically) {
     EXPECT_EQ(fs::last_write_time(skeleton), made);
     EXPECT_EQ(slurp(dir / "a" / "trees.csv"), csv);
 
+    // A record made by another treelobes (another version or measures revision) is not kept.
+    const fs::path record = dir / "a" / "trees" / "tree_0001.json";
+    auto older = nlohmann::json::parse(slurp(record));
+    older["options_key"] = "treelobes 0.0.9, records 1, " + older["options_key"].get<std::string>();
+    std::ofstream(record) << older.dump();
+    const auto upgraded = run_cli("--json " + run_tile(dir / "a"));
+    ASSERT_EQ(upgraded.exit_code, 0) << upgraded.err;
+    EXPECT_EQ(nlohmann::json::parse(upgraded.out)["counts"]["trees_reused"], 4);
+    EXPECT_EQ(slurp(dir / "a" / "trees.csv"), csv);
+    const auto remade = fs::last_write_time(skeleton);
+    EXPECT_NE(remade, made);
+
     const auto redo = run_cli("--json " + run_tile(dir / "a", "--use-input-segmentation --overwrite"));
     ASSERT_EQ(redo.exit_code, 0) << redo.err;
     EXPECT_EQ(nlohmann::json::parse(redo.out)["counts"]["trees_reused"], 0);
-    EXPECT_NE(fs::last_write_time(skeleton), made);
+    EXPECT_NE(fs::last_write_time(skeleton), remade);
 
     // A fresh run elsewhere gives the same bytes (deterministic, whatever the thread schedule).
     ASSERT_EQ(run_cli("--threads 1 " + run_tile(dir / "b")).exit_code, 0);
