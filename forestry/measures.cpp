@@ -128,6 +128,18 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
     return m;
 }
 
+std::optional<double> ground_under(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
+                                   const Eigen::Vector2d& xy, double radius) {
+    std::vector<double> ground;
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if ((points[i].head<2>().cast<double>() - xy).norm() <= radius)
+            ground.push_back(static_cast<double>(points[i].z() - height_above_ground[i]));
+    if (ground.empty()) return std::nullopt;
+    const auto mid = ground.begin() + static_cast<std::ptrdiff_t>(ground.size() / 2);
+    std::nth_element(ground.begin(), mid, ground.end());
+    return *mid;
+}
+
 double woody_volume(const TreeGraph& skeleton) {
     double volume = 0;
     for (std::size_t i = 1; i < skeleton.size(); ++i) {

@@ -69,6 +69,12 @@ struct CrownMeasure {
 CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
                            const CrownOptions& options = {});
 
+// The ground under `xy` as a tree's own points give it: the median of z - HAG (each point's
+// height is taken from the DTM beneath it) over the points within `radius` horizontally;
+// nullopt when none lies that close.
+std::optional<double> ground_under(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
+                                   const Eigen::Vector2d& xy, double radius = 1.0);
+
 // Volume of the skeleton's branches as truncated cones between each node and its parent
 // (cubic metres), from the node radii.
 double woody_volume(const TreeGraph& skeleton);

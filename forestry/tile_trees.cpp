@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace treelobes::forestry {
 
@@ -88,14 +89,10 @@ Eigen::Vector3d estimate_stem_base(std::span<const Eigen::Vector3f> points, std:
         xs.push_back(points[top].x());
         ys.push_back(points[top].y());
     }
-    const Eigen::Vector2f xy(median(xs), median(ys));
-    std::vector<float> ground_near, ground_all;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const float ground = points[i].z() - height_above_ground[i];
-        ground_all.push_back(ground);
-        if ((points[i].head<2>() - xy).norm() <= 1.0f) ground_near.push_back(ground);
-    }
-    return {xy.x(), xy.y(), median(ground_near.empty() ? ground_all : ground_near)};
+    const Eigen::Vector2d xy(median(xs), median(ys));
+    std::optional<double> ground = ground_under(points, height_above_ground, xy);
+    if (!ground) ground = ground_under(points, height_above_ground, xy, std::numeric_limits<double>::infinity());  // all points
+    return {xy.x(), xy.y(), *ground};
 }
 
 std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std::int32_t> tree_id,

@@ -33,20 +33,6 @@ std::vector<double> species_probabilities(const PointCloud& cloud, const TreePip
     return options.model->probabilities(row.row(0));
 }
 
-// The terrain under `xy`: the median of z - HAG over the tree's points within 1 m horizontally
-// (each point's HAG is taken from the DTM beneath it); nullopt when there are none.
-std::optional<double> terrain_under(const TreeInput& tree, const Eigen::Vector2d& xy) {
-    std::vector<double> ground;
-    for (std::size_t i = 0; i < tree.points.size(); ++i) {
-        const Eigen::Vector3f& p = tree.points.positions[i];
-        if ((p.head<2>().cast<double>() - xy).norm() <= 1.0) ground.push_back(static_cast<double>(p.z() - tree.height_above_ground[i]));
-    }
-    if (ground.empty()) return std::nullopt;
-    const auto mid = ground.begin() + static_cast<std::ptrdiff_t>(ground.size() / 2);
-    std::nth_element(ground.begin(), mid, ground.end());
-    return *mid;
-}
-
 Eigen::Vector2d crown_centre(const TreeInput& tree) {
     Eigen::Vector2d sum(0, 0);
     for (const Eigen::Vector3f& p : tree.points.positions) sum += p.head<2>().cast<double>();
@@ -60,7 +46,7 @@ Eigen::Vector2d crown_centre(const TreeInput& tree) {
 // z is the ground there, from the tree's own points, else the segmentation's.
 Eigen::Vector3d stem_position(const TreeInput& tree, const DbhMeasure& dbh) {
     const Eigen::Vector2d xy = dbh.diameter ? dbh.centre : tree.base_at_stem ? Eigen::Vector2d(tree.base.head<2>()) : crown_centre(tree);
-    return {xy.x(), xy.y(), terrain_under(tree, xy).value_or(tree.base.z())};
+    return {xy.x(), xy.y(), ground_under(tree.points.positions, tree.height_above_ground, xy).value_or(tree.base.z())};
 }
 
 // Height as foresters measure it: the top above the ground at the stem. On a slope the largest

@@ -1,6 +1,7 @@
 // End-to-end: `treelobes tile` on a small synthetic tile (outputs present and consistent with
 // each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, trees too small
-// for a model measured only, failures.jsonl with exit 3) and on bad tiles (empty, all ground, one tree, no CRS, NaN coordinates).
+// for a model measured only, failures.jsonl with exit 3) and on bad tiles (empty, all ground, one
+// tree, no CRS, NaN coordinates).
 #include "core/cloud_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"

@@ -125,5 +125,19 @@ TEST(WoodyVolume, FrustaOfTheSkeleton) {
     EXPECT_NEAR(woody_volume(skeleton), frustum + cylinder, 1e-6);
 }
 
+TEST(GroundUnder, MedianOfTheNearPointsGroundAndNoneFarAway) {
+    // Points at 5 m above a ground z = 0.5 x; one with a wrong height (an outlier of the DTM).
+    std::vector<Eigen::Vector3f> points;
+    std::vector<float> heights;
+    for (float x = -0.8f; x <= 0.81f; x += 0.2f) {
+        points.emplace_back(x, 0.0f, 0.5f * x + 5.0f);
+        heights.push_back(5.0f);
+    }
+    heights[0] = 1.0f;
+    EXPECT_NEAR(*ground_under(points, heights, {0.0, 0.0}), 0.0, 0.11);  // the median, not the outlier's 4 m
+    EXPECT_NEAR(*ground_under(points, heights, {0.8, 0.0}, 0.15), 0.4, 1e-5);
+    EXPECT_FALSE(ground_under(points, heights, {5.0, 5.0}).has_value());
+}
+
 }  // namespace
 }  // namespace treelobes::forestry
