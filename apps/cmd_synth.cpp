@@ -447,6 +447,7 @@ int run_tile(SynthFlags f, TileFlags t, const OptionTable& table, const GlobalOp
                      {{"size_m", t.tile.size_m},
                       {"trees", tile.scene.trees.size()},
                       {"slope_deg", t.tile.slope_deg},
+                      {"competition", t.tile.competition},
                       {"understory_per_100m2", t.tile.understory_per_100m2},
                       {"understory_blades", tile.scene.understory.size()}}},
                     {"scanner", scanner_json(f)},
@@ -521,6 +522,9 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     tile_table->add("--roughness", tile->tile.roughness_m, "Terrain roughness amplitude, m");
     tile_table->add("--understory", tile->tile.understory_per_100m2, "Bushes per 100 m^2 (0 = none)");
     tile_table->add("--spacing", tile->tile.spacing, "Minimum stem distance as a fraction of the summed crown radii");
+    tile_table->add_flag("--competition", tile->tile.competition,
+                         "Neighbours compete for crown space: branches growing where a neighbour owns the canopy are cut "
+                         "(without it, crowded crowns interpenetrate)");
     tile_table->add("--origin", tile->origin, "Coordinates of the tile corner: X Y Z")->expected(3);
     tile_table->add("--station-spacing", tile->station_spacing, "TLS: distance between stations on the grid, m");
     add_common_flags(*tile_table, *tile_flags);

@@ -6,7 +6,8 @@
 #      points assigned to the right tree, ALS and TLS, open stands (25 trees on 1 ha, 10 on
 #      40 x 40 m) and crowded ones (30 on 80 x 80 m, 12 on 30 x 30 m: the synth tile relaxes its
 #      spacing and broad crowns interpenetrate), with the input's ground class and with the ground
-#      filtered afresh (--ignore-classification);
+#      filtered afresh (--ignore-classification); and the same stands with crown competition
+#      (`synth tile --competition`: crowns cut where a neighbour owns the canopy);
 #   2. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
 #   3. treels/pine_plot.las: stems found, with their positions and diameters;
 #   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
@@ -41,6 +42,12 @@ for s in 11 12 13 14; do tile "als_open_$s" "$s" --trees 25 --size 100 --scanner
 for s in 1 2 3 4; do tile "als_crowded_$s" "$s" --trees 30 --size 80 --scanner als; done
 for s in 21 22 23 24 25 26 27; do tile "tls_open_$s" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25; done
 for s in 1 2 3 4 5 6; do tile "tls_crowded_$s" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25; done
+# The same stands with crown competition (`synth tile --competition`): branches that grow where
+# a neighbour owns the canopy are cut, as in a closed stand, instead of interpenetrating.
+for s in 11 12 13 14; do tile "als_open_${s}_competing" "$s" --trees 25 --size 100 --scanner als --competition; done
+for s in 1 2 3 4; do tile "als_crowded_${s}_competing" "$s" --trees 30 --size 80 --scanner als --competition; done
+for s in 21 22 23 24 25 26 27; do tile "tls_open_${s}_competing" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25 --competition; done
+for s in 1 2 3 4 5 6; do tile "tls_crowded_${s}_competing" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25 --competition; done
 
 # row LABEL ARGS...: one table row from one segment_eval run.
 row() {
@@ -71,6 +78,10 @@ for s in 1 2 3 4; do row "ALS crowded, seed $s" "$WORK/als_crowded_$s/tile.las" 
 for s in 21 22 23 24 25 26 27; do row "TLS open, seed $s" "$WORK/tls_open_$s/tile.las" --reference treeID; done
 for s in 21 22 23; do row "TLS open, seed $s, ground filtered" "$WORK/tls_open_$s/tile.las" --reference treeID --ignore-classification; done
 for s in 1 2 3 4 5 6; do row "TLS crowded, seed $s" "$WORK/tls_crowded_$s/tile.las" --reference treeID; done
+for s in 11 12 13 14; do row "ALS open, seed $s, competing" "$WORK/als_open_${s}_competing/tile.las" --reference treeID; done
+for s in 1 2 3 4; do row "ALS crowded, seed $s, competing" "$WORK/als_crowded_${s}_competing/tile.las" --reference treeID; done
+for s in 21 22 23 24 25 26 27; do row "TLS open, seed $s, competing" "$WORK/tls_open_${s}_competing/tile.las" --reference treeID; done
+for s in 1 2 3 4 5 6; do row "TLS crowded, seed $s, competing" "$WORK/tls_crowded_${s}_competing/tile.las" --reference treeID; done
 # Crown cover (summed true crown areas over the plot area): how far the crowns interpenetrate.
 echo "crown cover (sum of the true crown areas / plot area):"
 for d in "$WORK"/als_*/ "$WORK"/tls_*/; do

@@ -9,7 +9,8 @@
 # against the plot's labels (tree_id = the true id with --use-input-segmentation), the buffered
 # merges compared with the reference (ids, bases) and with each other (bytes); the wall times of
 # -j1 and -j2 with the load average of the machine around them. MODE=als runs the same with a
-# fresh airborne segmentation instead of the plot's labels.
+# fresh airborne segmentation instead of the plot's labels; COMPETITION=1 grows the plot with crown
+# competition (`synth tile --competition`: crowns cut where a neighbour owns the canopy).
 #   bench/survey_buffer_bench.sh [WORKDIR] [TREES] [PLOT] [TILE] [BUFFER]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
@@ -17,11 +18,13 @@ cli=${TREELOBES:-$root/build/bin/treelobes}
 work=$(realpath -m "${1:-/tmp/treelobes_survey_buffer_bench}")
 trees=${2:-170} plot=${3:-100} tile=${4:-50} buffer=${5:-15}
 if [[ "${MODE:-input}" == als ]]; then options="--mode als --map-size 200"; else options="--use-input-segmentation --map-size 200"; fi
+synth_options=""
+[[ "${COMPETITION:-0}" == 1 ]] && synth_options="--competition"
 rm -rf "$work" && mkdir -p "$work" && cd "$work"
 
-echo "plot ${plot} x ${plot} m, $trees trees, ${tile} m tiles, ${buffer} m buffer, tile options: $options" >&2
+echo "plot ${plot} x ${plot} m, $trees trees ${synth_options}, ${tile} m tiles, ${buffer} m buffer, tile options: $options" >&2
 "$cli" --log-level warn synth tile --trees "$trees" --size "$plot" --seed 21 --pulse-density 20 --max-leaves 2000 \
-  --origin 500000 5400000 300 --out plot >/dev/null
+  --origin 500000 5400000 300 $synth_options --out plot >/dev/null
 "$cli" --log-level warn retile plot/tile.las --size "$tile" --out tiles >/dev/null
 
 load() { cut -d' ' -f1-3 /proc/loadavg; }
@@ -50,6 +53,13 @@ if command -v slurmctld >/dev/null && [[ $(id -u) == 0 ]]; then
   slurm_ran=yes
 fi
 
+# Detection on the uncut plot against its labels (airborne mode: the segmentation the tiles use).
+if [[ "${MODE:-input}" == als ]]; then
+  "${SEGMENT_EVAL:-$root/build/bin/segment_eval}" plot/tile.las --mode als --reference treeID | python3 -c '
+import json, sys
+s = json.load(sys.stdin)["score"]
+print("uncut plot, airborne segmentation against the labels (trees > 5 m, half-of-points rule): %d true, %d found, %d matched, F1 %.3f" % (s["reference_trees"], s["found_trees"], s["matched"], s["f1"]))'
+fi
 python3 - "$plot" "$tile" "$t_single" "$t_nobuffer" "$t_j1" "$t_j2" "$load_j1_before" "$load_j1_after" "$load_j2_before" "$load_j2_after" "$options" "$slurm_ran" <<'PY'
 import csv, filecmp, glob, json, math, os, struct, sys
 from collections import Counter

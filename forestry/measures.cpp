@@ -81,9 +81,7 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
     return m;
 }
 
-CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
-                           const CrownOptions& options) {
-    check_sizes(points, height_above_ground, "measure_crown");
+CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& base, const CrownOptions& options) {
     CrownMeasure m;
     if (points.size() < options.min_points) {
         m.volume_failure = "too few points";
@@ -94,7 +92,7 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
     const double offset = std::max(options.min_offset, options.offset_fraction * reach);
     std::vector<double> crown_heights;
     for (std::size_t i = 0; i < points.size(); ++i)
-        if (horizontal_distance(points[i], base) >= offset) crown_heights.push_back(height_above_ground[i]);
+        if (horizontal_distance(points[i], base) >= offset) crown_heights.push_back(points[i].z() - base.z());
     if (crown_heights.size() >= options.min_points) m.base_height = std::max(0.0, quantile(crown_heights, options.base_quantile));
 
     const double area = projected_hull_area(points);
@@ -104,9 +102,9 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<co
     }
 
     std::vector<Eigen::Vector3f> crown;
-    const double floor = m.base_height.value_or(0.0);
-    for (std::size_t i = 0; i < points.size(); ++i)
-        if (height_above_ground[i] >= floor) crown.push_back(points[i]);
+    const double floor = base.z() + m.base_height.value_or(0.0);
+    for (const Eigen::Vector3f& p : points)
+        if (p.z() >= floor) crown.push_back(p);
     double cell = options.volume_cell;
     std::vector<std::size_t> kept = first_point_per_cell(crown, static_cast<float>(cell));
     while (kept.size() > options.max_volume_points) {  // coarser cells until the alpha shape stays affordable

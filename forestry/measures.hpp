@@ -51,7 +51,7 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
 struct CrownOptions {
     double min_offset = 0.5;       // metres: crown points lie at least this far from the stem axis...
     double offset_fraction = 0.1;  // ...and this fraction of the tree's horizontal extent
-    double base_quantile = 0.05;   // crown base = this quantile of the crown points' HAG
+    double base_quantile = 0.05;   // crown base = this quantile of the crown points' heights above the stem base
     std::size_t min_points = 10;
     double alpha_factor = 2.0;  // crown volume: alpha shape at alpha = factor * alpha_min
     double volume_cell = 0.25;  // metres: crown points thinned on this grid for the alpha shape
@@ -59,15 +59,17 @@ struct CrownOptions {
 };
 
 struct CrownMeasure {
-    std::optional<double> base_height;     // metres above the terrain
+    std::optional<double> base_height;     // metres above the ground at the stem (as the tree height)
     std::optional<double> diameter;        // metres: diameter of the circle with the projected area
     std::optional<double> projected_area;  // square metres: convex hull of the points seen from above
     std::optional<double> volume;          // cubic metres: alpha shape of the crown points
     std::string volume_failure;            // why there is no volume, or empty
 };
 
-CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
-                           const CrownOptions& options = {});
+// `base` is the stem position with z the ground there: heights within the crown are measured from
+// it, as the tree's height is, not from the terrain under each point (on a slope that would move
+// the crown base of a crown reaching downhill).
+CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, const Eigen::Vector3d& base, const CrownOptions& options = {});
 
 // The ground under `xy` as a tree's own points give it: the median of z - HAG (each point's
 // height is taken from the DTM beneath it) over the points within `radius` horizontally;

@@ -66,7 +66,7 @@ TreeMeasures measure_tree(const TreeInput& tree, const TreePipelineOptions& opti
     m.dbh = measure_dbh(tree.points.positions, tree.height_above_ground, tree.base, options.dbh);
     m.position = stem_position(tree, m.dbh);
     m.height = tree_height(tree, m.position);
-    m.crown = measure_crown(tree.points.positions, tree.height_above_ground, m.position, options.crown);
+    m.crown = measure_crown(tree.points.positions, m.position, options.crown);
     return m;
 }
 

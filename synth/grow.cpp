@@ -625,4 +625,49 @@ TreeMetrics measure(const SyntheticTree& tree) {
     return m;
 }
 
+void prune_subtrees(SyntheticTree& tree, const std::function<bool(int node)>& remove) {
+    const std::vector<TreeNode>& old = tree.skeleton.nodes;
+    // A node's parent has a smaller index (TreeGraph::add_node), so one pass in index order sees
+    // every parent's fate before its children's.
+    std::vector<int> new_index(old.size(), -1);
+    int kept = 0;
+    for (std::size_t i = 0; i < old.size(); ++i) {
+        const int parent = old[i].parent;
+        if (i != 0 && (parent < 0 || parent >= static_cast<int>(i)))
+            throw Error(ExitCode::Internal, "prune_subtrees: node " + std::to_string(i) + " does not follow its parent");
+        const bool gone = i != 0 && (new_index[static_cast<std::size_t>(parent)] < 0 || remove(static_cast<int>(i)));
+        if (!gone) new_index[i] = kept++;
+    }
+    if (kept == static_cast<int>(old.size())) return;
+
+    TreeGraph pruned;
+    pruned.origin = tree.skeleton.origin;
+    std::vector<int> level;
+    std::vector<float> start_radius;
+    for (std::size_t i = 0; i < old.size(); ++i) {
+        if (new_index[i] < 0) continue;
+        const int parent = old[i].parent < 0 ? -1 : new_index[static_cast<std::size_t>(old[i].parent)];
+        pruned.add_node(old[i].position, old[i].radius, parent);
+        level.push_back(tree.node_level[i]);
+        start_radius.push_back(tree.internode_start_radius[i]);
+    }
+    // add_node lists children in index order; restore the original order (main child first).
+    for (std::size_t i = 0; i < old.size(); ++i) {
+        if (new_index[i] < 0) continue;
+        std::vector<int> children;
+        for (const int child : old[i].children)
+            if (new_index[static_cast<std::size_t>(child)] >= 0) children.push_back(new_index[static_cast<std::size_t>(child)]);
+        pruned.nodes[static_cast<std::size_t>(new_index[i])].children = children;
+    }
+    std::vector<Leaf> leaves;
+    for (Leaf leaf : tree.leaves) {
+        leaf.internode = new_index[static_cast<std::size_t>(leaf.internode)];
+        if (leaf.internode >= 0) leaves.push_back(leaf);
+    }
+    tree.skeleton = std::move(pruned);
+    tree.node_level = std::move(level);
+    tree.internode_start_radius = std::move(start_radius);
+    tree.leaves = std::move(leaves);
+}
+
 }  // namespace treelobes::synth

@@ -14,6 +14,7 @@
 #include "core/tree_graph.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -73,6 +74,12 @@ struct TreeMetrics {
 };
 
 TreeMetrics measure(const SyntheticTree& tree);
+
+// Removes every node for which `remove(node)` is true together with all that grows from it (its
+// subtree and the leaves on it); the root never goes. Node indices are renumbered in their old
+// order, children keep theirs (main child first). Forest tiles use it to let neighbours compete
+// for crown space (synth/tile.hpp).
+void prune_subtrees(SyntheticTree& tree, const std::function<bool(int node)>& remove);
 
 // The four (broad, leaflet) or four strip (needle) corners of a leaf, in local coordinates.
 std::array<Eigen::Vector3f, 4> leaf_corners(const Leaf& leaf, LeafShape shape);

@@ -70,6 +70,54 @@ bool place(Rng& rng, double size, const Footprint& f, double spacing, const std:
     return false;
 }
 
+// Crown competition, after placement. A point of the canopy belongs to the tree whose stem is
+// nearest relative to its crown radius (a multiplicatively weighted Voronoi diagram: a broad crown
+// claims more ground than a narrow one), among the trees whose top stands above the point, so a
+// tall tree's upper crown spreads over a lower neighbour while below that neighbour's top the two
+// share the space. A branch node on another tree's ground is cut with all that grows from it;
+// trunks are never cut. Ownership uses the crowns as grown alone, so the result does not depend
+// on the order in which the trees are pruned.
+void compete_for_crown_space(std::vector<PlacedTree>& trees, const std::vector<Footprint>& footprints) {
+    constexpr double kMinCrownRadius = 0.5;
+    std::vector<double> top(trees.size());
+    std::vector<double> radius(trees.size());
+    for (std::size_t i = 0; i < trees.size(); ++i) {
+        top[i] = trees[i].position.z() + measure(trees[i].tree).height_m;
+        radius[i] = std::max(kMinCrownRadius, footprints[i].crown);
+    }
+    for (std::size_t i = 0; i < trees.size(); ++i) {
+        const Eigen::Vector2d stem = trees[i].position.head<2>();
+        std::vector<std::size_t> neighbours;
+        for (std::size_t j = 0; j < trees.size(); ++j)
+            if (j != i && (trees[j].position.head<2>() - stem).norm() < radius[i] + radius[j]) neighbours.push_back(j);
+        if (neighbours.empty()) continue;
+        SyntheticTree& tree = trees[i].tree;
+        prune_subtrees(tree, [&](int node) {
+            if (tree.node_level[static_cast<std::size_t>(node)] == 0) return false;
+            const Eigen::Vector3d p = trees[i].position + tree.skeleton.nodes[static_cast<std::size_t>(node)].position.cast<double>();
+            const double own = (p.head<2>() - stem).norm() / radius[i];
+            return std::any_of(neighbours.begin(), neighbours.end(), [&](std::size_t j) {
+                return top[j] > p.z() && (p.head<2>() - trees[j].position.head<2>()).norm() / radius[j] < own;
+            });
+        });
+    }
+}
+
+TreeTruth truth_row(const PlacedTree& placed, const SpeciesProfile& profile, std::uint64_t seed, const Eigen::Vector3d& origin) {
+    const TreeMetrics m = measure(placed.tree);
+    TreeTruth truth;
+    truth.tree_id = placed.tree_id;
+    truth.species = profile.entry.name;
+    truth.species_id = profile.entry.id;
+    truth.seed = seed;
+    truth.base = origin + placed.position;
+    truth.height_m = m.height_m;
+    truth.dbh_m = m.dbh_m;
+    truth.crown_diameter_m = m.crown_diameter_m;
+    truth.age_years = placed.tree.age_years;
+    return truth;
+}
+
 }  // namespace
 
 std::string truth_csv(const std::vector<TreeTruth>& rows) {
@@ -97,6 +145,8 @@ Tile make_tile(const std::vector<SpeciesProfile>& library, std::uint64_t seed, c
 
     std::vector<Eigen::Vector2d> stems;
     std::vector<Footprint> footprints;
+    std::vector<const SpeciesProfile*> profiles;
+    std::vector<std::uint64_t> seeds;
     Progress progress("synth tile: growing trees", static_cast<std::size_t>(o.trees));
     for (int k = 0; k < o.trees; ++k) {
         const SpeciesProfile& profile = *species[rng.below(species.size())];
@@ -118,23 +168,16 @@ Tile make_tile(const std::vector<SpeciesProfile>& library, std::uint64_t seed, c
         PlacedTree placed;
         placed.position = Eigen::Vector3d(xy.x(), xy.y(), tile.scene.ground->height(xy.x(), xy.y()));
         placed.tree_id = k + 1;
-        const TreeMetrics m = measure(tree);
-        TreeTruth truth;
-        truth.tree_id = placed.tree_id;
-        truth.species = profile.entry.name;
-        truth.species_id = profile.entry.id;
-        truth.seed = s;
-        truth.base = o.origin + placed.position;
-        truth.height_m = m.height_m;
-        truth.dbh_m = m.dbh_m;
-        truth.crown_diameter_m = m.crown_diameter_m;
-        truth.age_years = tree.age_years;
         placed.tree = std::move(tree);
         tile.scene.trees.push_back(std::move(placed));
-        tile.truth.push_back(truth);
+        profiles.push_back(&profile);
+        seeds.push_back(s);
         progress.advance();
     }
     progress.finish();
+    if (o.competition) compete_for_crown_space(tile.scene.trees, footprints);
+    for (std::size_t i = 0; i < tile.scene.trees.size(); ++i)
+        tile.truth.push_back(truth_row(tile.scene.trees[i], *profiles[i], seeds[i], o.origin));
 
     const int clumps = static_cast<int>(std::lround(o.understory_per_100m2 * o.size_m * o.size_m / 100.0));
     double widest = 0;

@@ -18,6 +18,10 @@ struct TileOptions {
     double understory_per_100m2 = 3;   // bushes/grass clumps per 100 m^2 (0 = none)
     double understory_height_m = 1.2;
     double spacing = 0.4;  // stems at least spacing x (sum of crown radii) apart, relaxed when crowded
+    // Neighbours compete for crown space: a branch that grows where a neighbour owns the canopy is
+    // cut (crown shyness, the crowns of a closed stand). Off: every tree keeps the crown it grew
+    // alone, and the crowns of a crowded tile interpenetrate.
+    bool competition = false;
     GrowOptions grow;
     Eigen::Vector3d origin{0, 0, 0};  // added to output coordinates (e.g. a UTM corner)
 };

@@ -92,7 +92,7 @@ TEST(Crown, ConeCrownOverAStem) {
     TreeCloud cloud;
     add_stem(cloud, 0.0, 0.0, 0.15, 6.0, 2 * std::numbers::pi, random);
     add_cone_crown(cloud, 0.0, 0.0, 3.0, 6.0, 15.0, random);
-    const CrownMeasure m = measure_crown(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    const CrownMeasure m = measure_crown(cloud.points, {0.0, 0.0, 0.0});
     ASSERT_TRUE(m.base_height);
     EXPECT_NEAR(*m.base_height, 6.5, 0.7);  // the crown's lowest points more than 0.5 m from the stem
     ASSERT_TRUE(m.projected_area);
@@ -105,11 +105,28 @@ TEST(Crown, ConeCrownOverAStem) {
     EXPECT_LT(*m.volume, 1.2 * cone);
 }
 
+// The crown base and the crown volume's floor are heights above the ground at the stem (the
+// base's z), like the tree's height: the same tree standing 100 m higher measures the same.
+TEST(Crown, BaseHeightIsMeasuredFromTheGroundAtTheStem) {
+    std::mt19937 random(6);
+    TreeCloud cloud;
+    add_stem(cloud, 0.0, 0.0, 0.15, 6.0, 2 * std::numbers::pi, random);
+    add_cone_crown(cloud, 0.0, 0.0, 3.0, 6.0, 15.0, random);
+    std::vector<Eigen::Vector3f> raised;
+    for (const auto& p : cloud.points) raised.push_back(p + Eigen::Vector3f(0, 0, 100));
+    const CrownMeasure low = measure_crown(cloud.points, {0.0, 0.0, 0.0});
+    const CrownMeasure high = measure_crown(raised, {0.0, 0.0, 100.0});
+    ASSERT_TRUE(low.base_height && high.base_height);
+    EXPECT_NEAR(*high.base_height, *low.base_height, 1e-3);
+    ASSERT_TRUE(low.volume && high.volume);
+    EXPECT_NEAR(*high.volume, *low.volume, 1e-3 * *low.volume);
+}
+
 TEST(Crown, TooFewPointsGivesNoMeasures) {
     TreeCloud cloud;
     cloud.add({0, 0, 5});
     cloud.add({1, 0, 5});
-    const CrownMeasure m = measure_crown(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    const CrownMeasure m = measure_crown(cloud.points, {0.0, 0.0, 0.0});
     EXPECT_FALSE(m.base_height);
     EXPECT_FALSE(m.volume);
     EXPECT_FALSE(m.diameter);

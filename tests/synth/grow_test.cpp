@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace treelobes;
@@ -234,4 +235,49 @@ TEST(Grow, DeadLowerCrownKeepsBareBranches) {
         bare_branch =
                 b.node_level[i] == 1 && b.node_level[b.skeleton.nodes[i].parent] == 0 && b.skeleton.nodes[i].position.z() < lowest_leaf;
     EXPECT_TRUE(bare_branch);
+}
+
+// Cutting a node takes its whole subtree and the leaves on it, and leaves a valid tree whose
+// remaining nodes, levels and leaves are those of the original.
+TEST(Grow, PruningASubtreeKeepsTheRestIntact) {
+    const synth::SyntheticTree whole = synth::grow(species("birch"), 4, small_budget());
+    // The first first-order branch, and every node that grows from it.
+    int branch = -1;
+    for (std::size_t i = 0; i < whole.skeleton.size() && branch < 0; ++i)
+        if (whole.node_level[i] == 1) branch = static_cast<int>(i);
+    ASSERT_GT(branch, 0);
+    std::vector<bool> below(whole.skeleton.size(), false);
+    below[static_cast<std::size_t>(branch)] = true;
+    for (std::size_t i = 1; i < whole.skeleton.size(); ++i)
+        if (below[static_cast<std::size_t>(whole.skeleton.nodes[i].parent)]) below[i] = true;
+    const auto subtree = static_cast<std::size_t>(std::count(below.begin(), below.end(), true));
+    std::size_t leaves_on_it = 0;
+    for (const auto& leaf : whole.leaves) leaves_on_it += below[static_cast<std::size_t>(leaf.internode)];
+    ASSERT_GT(subtree, 1u);
+    ASSERT_GT(leaves_on_it, 0u);
+
+    synth::SyntheticTree cut = whole;
+    synth::prune_subtrees(cut, [&](int node) { return node == branch; });
+    EXPECT_NO_THROW(cut.skeleton.validate("pruned tree"));
+    ASSERT_EQ(cut.skeleton.size(), whole.skeleton.size() - subtree);
+    ASSERT_EQ(cut.node_level.size(), cut.skeleton.size());
+    ASSERT_EQ(cut.internode_start_radius.size(), cut.skeleton.size());
+    ASSERT_EQ(cut.leaves.size(), whole.leaves.size() - leaves_on_it);
+    // The survivors in their old order: positions, levels and the leaves' internodes map across.
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < whole.skeleton.size(); ++i) {
+        if (below[i]) continue;
+        EXPECT_EQ(cut.skeleton.nodes[k].position, whole.skeleton.nodes[i].position);
+        EXPECT_EQ(cut.node_level[k], whole.node_level[i]);
+        ++k;
+    }
+    for (const auto& leaf : cut.leaves) EXPECT_LT(static_cast<std::size_t>(leaf.internode), cut.skeleton.size());
+
+    synth::SyntheticTree untouched = whole;
+    synth::prune_subtrees(untouched, [](int) { return false; });
+    EXPECT_EQ(untouched.skeleton.size(), whole.skeleton.size());
+    synth::SyntheticTree root_only = whole;
+    synth::prune_subtrees(root_only, [](int) { return true; });
+    EXPECT_EQ(root_only.skeleton.size(), 1u);  // the root never goes
+    EXPECT_TRUE(root_only.leaves.empty());
 }

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <sstream>
 
 using namespace treelobes;
@@ -28,6 +29,19 @@ double collar(const synth::SyntheticTree& tree) {
         if (tree.node_level[i] == 0 && tree.skeleton.nodes[i].position.z() < 0.5f)
             r = std::max(r, tree.skeleton.nodes[i].position.head<2>().norm() + static_cast<double>(tree.skeleton.nodes[i].radius));
     return r;
+}
+
+// Branch nodes of tree `a` that stand where `b` owns the canopy by the competition rule of
+// synth/tile.hpp: nearer b's stem than a's relative to the crown radii, and below b's top.
+int nodes_on_neighbour_ground(const synth::PlacedTree& a, double crown_a, const synth::PlacedTree& b, double crown_b, double top_b) {
+    int count = 0;
+    for (std::size_t n = 0; n < a.tree.skeleton.size(); ++n) {
+        if (a.tree.node_level[n] == 0) continue;
+        const Eigen::Vector3d p = a.position + a.tree.skeleton.nodes[n].position.cast<double>();
+        const double own = (p - a.position).head<2>().norm() / crown_a;
+        count += top_b > p.z() && (p - b.position).head<2>().norm() / crown_b < own;
+    }
+    return count;
 }
 
 }  // namespace
@@ -99,4 +113,45 @@ TEST(Tile, OvercrowdedTilesFailWithAUsageError) {
     t = small_tile();
     t.species = {"baobab"};
     EXPECT_THROW(synth::make_tile(species_profiles(), 1, t), Error);
+}
+
+// Two broad crowns 6 m apart: grown alone they interpenetrate; with competition neither keeps a
+// branch on the other's ground, both keep their trunks, and the truth is measured on the cut trees.
+TEST(Tile, CompetingCrownsDoNotInterpenetrate) {
+    synth::TileOptions t = small_tile();
+    t.trees = 2;
+    t.size_m = 12;
+    t.spacing = 0;
+    t.understory_per_100m2 = 0;
+    t.species = {"oak"};
+    const synth::Tile alone = synth::make_tile(species_profiles(), 5, t);
+    t.competition = true;
+    const synth::Tile competing = synth::make_tile(species_profiles(), 5, t);
+    ASSERT_EQ(competing.scene.trees.size(), 2u);
+
+    const auto top = [](const synth::PlacedTree& p) { return p.position.z() + synth::measure(p.tree).height_m; };
+    const auto crown = [](const synth::PlacedTree& p) { return 0.5 * synth::measure(p.tree).crown_diameter_m; };
+    const auto& a0 = alone.scene.trees[0];
+    const auto& b0 = alone.scene.trees[1];
+    const double crown_a = crown(a0), crown_b = crown(b0);
+    EXPECT_GT(nodes_on_neighbour_ground(a0, crown_a, b0, crown_b, top(b0)) + nodes_on_neighbour_ground(b0, crown_b, a0, crown_a, top(a0)),
+              20);
+
+    const auto& a = competing.scene.trees[0];
+    const auto& b = competing.scene.trees[1];
+    EXPECT_EQ(a.position, a0.position);  // the same stand, only the crowns differ
+    EXPECT_EQ(nodes_on_neighbour_ground(a, crown_a, b, crown_b, top(b0)), 0);
+    EXPECT_EQ(nodes_on_neighbour_ground(b, crown_b, a, crown_a, top(a0)), 0);
+    for (std::size_t i = 0; i < 2; ++i) {
+        const auto& cut = competing.scene.trees[i].tree;
+        const auto& whole = alone.scene.trees[i].tree;
+        EXPECT_LT(cut.skeleton.size(), whole.skeleton.size());
+        EXPECT_LT(cut.leaves.size(), whole.leaves.size());
+        EXPECT_NO_THROW(cut.skeleton.validate("competing tree"));
+        const auto trunk = [](const synth::SyntheticTree& tree) { return std::count(tree.node_level.begin(), tree.node_level.end(), 0); };
+        EXPECT_EQ(trunk(cut), trunk(whole));
+        for (const auto& leaf : cut.leaves) EXPECT_LT(static_cast<std::size_t>(leaf.internode), cut.skeleton.size());
+        EXPECT_DOUBLE_EQ(competing.truth[i].crown_diameter_m, synth::measure(cut).crown_diameter_m);
+        EXPECT_LE(competing.truth[i].crown_diameter_m, alone.truth[i].crown_diameter_m);
+    }
 }
