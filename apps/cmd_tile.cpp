@@ -299,6 +299,32 @@ std::map<int, std::string> survey_ids(const std::vector<forestry::TreeInput>& tr
     return by_tree;
 }
 
+// The survey-wide ids of the kept trees that have points within `margin` of the buffer's outer
+// edge. Points lie there only where a neighbouring tile gave them, so such a tree may go on
+// beyond the buffer and be cut: its crown, height and model would then differ from an uncut run.
+std::vector<std::string> trees_at_buffer_edge(const std::vector<forestry::TreeInput>& trees, const survey::TileCore& core, double buffer,
+                                              const Eigen::Vector3d& origin, const std::map<int, std::string>& global_ids) {
+    constexpr double kMargin = 0.5;  // metres: about twice the point spacing of a 20 pulses/m² airborne scan
+    const Box3d box = survey::buffered_box(core, buffer);
+    const auto at_edge = [&](const Eigen::Vector3f& local) {
+        const Eigen::Vector3d p = origin + local.cast<double>();
+        return p.x() < box.min.x() + kMargin || p.x() > box.max.x() - kMargin || p.y() < box.min.y() + kMargin ||
+               p.y() > box.max.y() - kMargin;
+    };
+    std::vector<std::string> ids;
+    for (const forestry::TreeInput& tree : trees)
+        if (std::any_of(tree.points.positions.begin(), tree.points.positions.end(), at_edge)) ids.push_back(global_ids.at(tree.id));
+    std::sort(ids.begin(), ids.end());
+    return ids;
+}
+
+void warn_of_trees_at_buffer_edge(const TileCliOptions& o, const std::vector<std::string>& ids) {
+    if (ids.empty()) return;
+    log_warn(o.input + ": " + std::to_string(ids.size()) + (ids.size() == 1 ? " tree reaches" : " trees reach") +
+             " the outer edge of the " + summary_value(o.buffer).dump() + " m buffer and may be cut there (" + ids.front() +
+             (ids.size() > 1 ? ", ..." : "") + "; all in summary.json, buffer.trees_at_edge): a wider --buffer keeps them whole");
+}
+
 // The airborne segmentation's reach (segment_trees.hpp) when the tile's trees come from one;
 // null for terrestrial plots and the input's labels.
 std::optional<float> segmentation_reach(const TileCliOptions& o, const TreeSegmentation& segmentation) {
@@ -319,7 +345,8 @@ void warn_if_buffer_is_narrow(const TileCliOptions& o, std::optional<float> reac
     });
 }
 
-json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::BufferedTile& buffered, std::optional<float> reach) {
+json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::BufferedTile& buffered, std::optional<float> reach,
+                 const std::vector<std::string>& trees_at_edge) {
     if (!plan.core) return nullptr;
     json read = json::array();
     for (const fs::path& file : buffered.neighbours_read) read.push_back(file.filename().string());
@@ -335,7 +362,8 @@ json buffer_json(const TileCliOptions& o, const BufferPlan& plan, const survey::
             {"neighbours_read", read},
             {"neighbours_skipped", buffered.neighbours_skipped},
             {"segmentation_reach_m", summary_value(reach)},
-            {"wide_enough", reach ? json(o.buffer >= *reach) : json(nullptr)}};
+            {"wide_enough", reach ? json(o.buffer >= *reach) : json(nullptr)},
+            {"trees_at_edge", trees_at_edge}};
 }
 
 int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
@@ -388,6 +416,9 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
             forestry::split_trees(cloud, segmentation.tree_id, terrain.height_above_ground, bases, bases_at_stems);
     const std::size_t trees_in_buffer = plan.core ? keep_core_trees(trees, segmentation.tree_id, *plan.core, cloud.origin) : 0;
     const std::map<int, std::string> global_ids = survey_ids(trees, cloud.origin);
+    const std::vector<std::string> trees_at_edge =
+            plan.core ? trees_at_buffer_edge(trees, *plan.core, o.buffer, cloud.origin, global_ids) : std::vector<std::string>{};
+    warn_of_trees_at_buffer_edge(o, trees_at_edge);
     for (forestry::TreeInput& tree : trees) order_points_by_position(tree);
     seconds["segmentation"] = rounded(lap_seconds(mark));
     if (trees.empty())
@@ -509,7 +540,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                           {"input", o.input},
                           {"out", o.out},
                           {"options", options},
-                          {"buffer", buffer_json(o, plan, buffered, reach)},
+                          {"buffer", buffer_json(o, plan, buffered, reach, trees_at_edge)},
                           {"counts",
                            {{"points", buffered.own_points},
                             {"buffer_points", cloud.size() - buffered.own_points},

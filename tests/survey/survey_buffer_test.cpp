@@ -13,6 +13,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <set>
 #include <sstream>
 
 using namespace treelobes;
@@ -179,4 +180,37 @@ TEST(SurveyBuffer, WithoutABufferTreesAcrossEdgesComeOutInPieces) {
     EXPECT_GT(extra_rows, 0);
     std::printf("without a buffer: %d true trees in %d pieces too many; with a %.0f m buffer: %d\n", cut, extra_rows, kBuffer,
                 cut_with_buffer);
+}
+
+// Every tile's summary names the kept trees that reach its buffer's outer edge (buffer.trees_at_edge).
+std::set<std::string> trees_named_at_buffer_edge(const fs::path& batch) {
+    std::set<std::string> named;
+    for (const auto& tile : fs::directory_iterator(batch)) {
+        if (!fs::exists(tile.path() / "summary.json")) continue;
+        const auto summary = nlohmann::json::parse(file_bytes(tile.path() / "summary.json"));
+        for (const auto& id : summary["buffer"]["trees_at_edge"]) named.insert(id.get<std::string>());
+    }
+    return named;
+}
+
+// A tree that goes on beyond the buffer is cut there. A 3 m buffer cuts several: the tiles name
+// the trees that reach their buffer's outer edge, and every tree that comes out otherwise than
+// from the uncut plot is among them. The 15 m buffer of the other tests cuts none and names none.
+TEST(SurveyBuffer, TreesReachingTheBufferEdgeAreNamed) {
+    TempDir dir;
+    const fs::path merged = batch_and_merge(dir.path(), "--buffer 3 --tile-size " + std::to_string(kTileSize));
+    const std::set<std::string> named = trees_named_at_buffer_edge(dir / "batch");
+    std::map<std::string, std::string> whole_points;
+    for (const auto& row : read_csv(plot().single / "trees.csv")) whole_points[row.at("global_id")] = row.at("points");
+    int cut = 0;
+    for (const auto& row : read_csv(merged / "trees.csv")) {
+        const auto whole = whole_points.find(row.at("global_id"));
+        if (whole != whole_points.end() && whole->second == row.at("points")) continue;
+        ++cut;
+        EXPECT_TRUE(named.count(row.at("global_id"))) << row.at("global_id") << " was cut by the buffer's edge and not named";
+    }
+    EXPECT_GT(cut, 0);
+    EXPECT_GE(named.size(), static_cast<std::size_t>(cut));
+    buffered_merge();
+    EXPECT_TRUE(trees_named_at_buffer_edge(buffered_merge().parent_path() / "batch").empty());
 }
