@@ -31,6 +31,10 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
     const survey::TileFolders folders = survey::find_tile_folders(dirs);
     for (const std::string& name : folders.incomplete) log_warn("tile " + name + " is not finished (no completion marker): left out");
     const survey::MergedSurvey merged = survey::merge_tiles(folders);
+    if (!merged.trees_at_buffer_edge.empty())
+        log_warn(std::to_string(merged.trees_at_buffer_edge.size()) + " trees reached their tile's buffer edge and may be cut there (" +
+                 merged.trees_at_buffer_edge.front() + (merged.trees_at_buffer_edge.size() > 1 ? ", ..." : "") +
+                 "; all in summary.json, trees_at_buffer_edge): run those tiles again with a wider --buffer");
     for (const std::string& duplicate : merged.duplicated_ids)
         log_warn("tree " + duplicate + ": one tree modelled by two tiles; run the tiles with --buffer so that each tree belongs to one");
     std::error_code ec;

@@ -237,6 +237,9 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
             options = tile_options;
         else if (options != tile_options)
             log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
+        if (const auto buffer = summary.find("buffer"); buffer != summary.end() && buffer->is_object())
+            for (const json& id : buffer->value("trees_at_edge", json::array()))
+                merged.trees_at_buffer_edge.push_back(id.get<std::string>());
         json tile_counts = summary.at("counts");
         tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
         add_counts(counts, tile_counts);
@@ -249,6 +252,7 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
     merged.tiles = folders.complete.size();
     merged.trees = csv.rows.size();
     merged.duplicated_ids = duplicated_ids(csv);
+    std::sort(merged.trees_at_buffer_edge.begin(), merged.trees_at_buffer_edge.end());
     merged.trees_csv = "global_id,tile," + csv.header.substr(std::string("global_id,").size()) + "\n";
     for (const auto& [id, row] : csv.rows) merged.trees_csv += row;
     json collection = {{"type", "FeatureCollection"}, {"features", json::array()}};
@@ -269,6 +273,7 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
                           {"tiles_failed", std::count(merged.failures_jsonl.begin(), merged.failures_jsonl.end(), '\n')},
                           {"trees", merged.trees},
                           {"trees_in_several_tiles", merged.duplicated_ids.size()},
+                          {"trees_at_buffer_edge", merged.trees_at_buffer_edge},
                           {"forest_trees", ordered.size()},
                           {"crs", crs.empty() ? json(nullptr) : json(crs)},
                           {"options", options}};

@@ -28,6 +28,9 @@ struct MergedSurvey {
     // Survey-wide ids found in more than one tile ("<id> in <tile>, <tile>"): one tree modelled
     // by two tiles, which happens when tiles are run without --buffer.
     std::vector<std::string> duplicated_ids;
+    // Survey-wide ids of the trees that reached their tile's buffer edge (buffer.trees_at_edge of
+    // the tiles' summaries), sorted: they may have been cut there.
+    std::vector<std::string> trees_at_buffer_edge;
     std::size_t tiles = 0, trees = 0;
 };
 

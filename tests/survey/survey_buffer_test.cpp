@@ -211,6 +211,10 @@ TEST(SurveyBuffer, TreesReachingTheBufferEdgeAreNamed) {
     }
     EXPECT_GT(cut, 0);
     EXPECT_GE(named.size(), static_cast<std::size_t>(cut));
+    // The merge gathers them in one list.
+    const auto summary = nlohmann::json::parse(file_bytes(merged / "summary.json"));
+    EXPECT_EQ(summary["trees_at_buffer_edge"].get<std::vector<std::string>>(), std::vector<std::string>(named.begin(), named.end()));
     buffered_merge();
     EXPECT_TRUE(trees_named_at_buffer_edge(buffered_merge().parent_path() / "batch").empty());
+    EXPECT_TRUE(nlohmann::json::parse(file_bytes(buffered_merge() / "summary.json"))["trees_at_buffer_edge"].empty());
 }
