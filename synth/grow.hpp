@@ -76,9 +76,10 @@ struct TreeMetrics {
 TreeMetrics measure(const SyntheticTree& tree);
 
 // Removes every node for which `remove(node)` is true together with all that grows from it (its
-// subtree and the leaves on it); the root never goes. Node indices are renumbered in their old
-// order, children keep theirs (main child first). Forest tiles use it to let neighbours compete
-// for crown space (synth/tile.hpp).
+// subtree and the leaves on it); the root never goes. `remove` sees the tree as it was: every
+// call comes before anything is removed, with the original indices. The kept nodes are
+// renumbered in their old order, children keep theirs (main child first). Forest tiles use it
+// to let neighbours compete for crown space (synth/tile.hpp).
 void prune_subtrees(SyntheticTree& tree, const std::function<bool(int node)>& remove);
 
 // The four (broad, leaflet) or four strip (needle) corners of a leaf, in local coordinates.
