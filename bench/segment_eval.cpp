@@ -107,6 +107,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"merge_pass_ratio", &o.merge_pass_ratio},
                                                   {"chm_smoothing", &o.chm_smoothing},
                                                   {"max_stem_lean", &o.max_stem_lean},
+                                                  {"stem_layer_height", &o.stem_layer_height},
                                                   {"graph_beta", &o.graph_beta},
                                                   {"seed_ratio", &o.seed_ratio},
                                                   {"crown_ratio", &o.crown_ratio},

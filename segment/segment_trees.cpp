@@ -55,6 +55,7 @@ void check_options(const SegmentOptions& o) {
     share(o.min_circle_inliers, "min circle inliers");
     share(o.min_arc_coverage, "min arc coverage");
     if (!(o.max_stem_lean >= 0.0f && o.max_stem_lean < 90.0f)) throw Error::usage("segment: max stem lean must be in 0..90 degrees");
+    positive(o.stem_layer_height, "stem layer height");
     positive(o.graph_voxel, "graph voxel");
     if (o.graph_neighbours < 2 || o.graph_neighbours > 64) throw Error::usage("segment: graph neighbours must be in 2..64");
     positive(o.max_gap, "max gap");
@@ -455,8 +456,59 @@ bool upright(const PointCloud& cloud, const std::vector<int>& points, float max_
     return step.z() > 0 && step.head<2>().norm() <= tangent * step.z();
 }
 
+// Does a circle of a plausible radius hold enough of these points around enough of its
+// circumference (Liang et al. 2012, §2.2)?
+bool circle_holds(const CircleFit& circle, std::size_t points, const SegmentOptions& options) {
+    return circle.ok && static_cast<float>(circle.inliers) >= options.min_circle_inliers * static_cast<float>(points) &&
+           circle.coverage >= options.min_arc_coverage;
+}
+
+// A trunk that tapers within the slice (a root flare: the synthetic oaks and figs of 1.2-1.5 m
+// narrow by a third between 1 and 2 m above the ground) holds no single circle over the slice's
+// height, but each thin horizontal layer of it does. The stem is then the median of the layers'
+// circles when at least half of the layers (two at least) hold one.
+std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vector<int>& cluster, float low, float high,
+                                       const SegmentOptions& options) {
+    const int count = std::max(1, static_cast<int>(std::ceil((high - low) / options.stem_layer_height)));
+    std::vector<std::vector<int>> layers(static_cast<std::size_t>(count));
+    for (int i : cluster) {
+        const float z = cloud.positions[static_cast<std::size_t>(i)].z();
+        layers[static_cast<std::size_t>(std::min(count - 1, static_cast<int>((z - low) / options.stem_layer_height)))].push_back(i);
+    }
+    std::vector<CircleFit> circles;
+    std::vector<int> on_circles;
+    for (const std::vector<int>& layer : layers) {
+        if (static_cast<int>(layer.size()) < options.min_stem_points) continue;
+        std::vector<Eigen::Vector2f> xy;
+        for (int i : layer) xy.push_back(cloud.positions[static_cast<std::size_t>(i)].head<2>());
+        const CircleFit circle = fit_circle(xy, options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
+        if (!circle_holds(circle, layer.size(), options)) continue;
+        circles.push_back(circle);
+        for (std::size_t k = 0; k < layer.size(); ++k)
+            if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circles.push_back(layer[k]);
+    }
+    if (circles.size() < 2 || 2 * static_cast<int>(circles.size()) < count) return std::nullopt;
+    const auto median = [&](auto value) {
+        std::vector<float> values;
+        for (const CircleFit& c : circles) values.push_back(value(c));
+        std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2), values.end());
+        return values[values.size() / 2];
+    };
+    Stem stem;
+    stem.centre = {median([](const CircleFit& c) { return c.centre.x(); }), median([](const CircleFit& c) { return c.centre.y(); })};
+    stem.radius = median([](const CircleFit& c) { return c.radius; });
+    for (const CircleFit& c : circles) {
+        if ((c.centre - stem.centre).norm() > 0.5f * stem.radius) return std::nullopt;  // one trunk, layer above layer
+        stem.inliers += c.inliers;
+    }
+    if (!upright(cloud, on_circles, options.max_stem_lean)) return std::nullopt;
+    stem.points = std::move(on_circles);
+    return stem;
+}
+
 // A slice cluster is a stem when it spans most of the slice height and a circle of a plausible
-// radius holds enough of its points around enough of its circumference (Liang et al. 2012, §2.2).
+// radius holds enough of its points around enough of its circumference (Liang et al. 2012, §2.2),
+// over the slice's height or, for a tapering trunk, layer by layer.
 std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cluster, const SegmentOptions& options) {
     if (static_cast<int>(cluster.size()) < options.min_stem_points) return std::nullopt;
     float low = std::numeric_limits<float>::infinity(), high = -low;
@@ -470,9 +522,7 @@ std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cl
     }
     if (high - low < 0.5f * (options.stem_slice_high - options.stem_slice_low)) return std::nullopt;
     const CircleFit circle = fit_circle(xy, options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
-    if (!circle.ok || static_cast<float>(circle.inliers) < options.min_circle_inliers * static_cast<float>(cluster.size()) ||
-        circle.coverage < options.min_arc_coverage)
-        return std::nullopt;
+    if (!circle_holds(circle, cluster.size(), options)) return fit_stem_by_layers(cloud, cluster, low, high, options);
     // Only the points on the circle seed the tree: a branch or a bush touching the stem in the
     // slice must win its points through the graph like any other.
     std::vector<int> on_circle;

@@ -9,7 +9,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
+#include <numbers>
 
 using namespace treelobes;
 using test::ToyTile;
@@ -120,6 +122,39 @@ TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
     const SegmentationScore score = score_segmentation(tile.truth, result.tree_id, terrain.height_above_ground, 5.0f);
     EXPECT_EQ(score.f1, 1.0);
     EXPECT_GT(score.points_right, 0.85);
+}
+
+// A broad trunk with a root flare (radius 1.1 m at the ground, 0.8 m at 1 m, 0.6 m from 2.5 m up:
+// no single circle holds the slice 1-2 m above the ground) beside an ordinary stem.
+TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
+    ToyTile tile;
+    test::add_ground(tile, -4, 9, -4, 5, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    for (float z = 0.0f; z <= 8.0f; z += 0.02f) {
+        const float radius = 0.6f + 0.5f * std::max(0.0f, 2.5f - z) / 2.5f;
+        for (int a = 0; a < 144; ++a) {
+            const float t = static_cast<float>(a) * 2.5f * std::numbers::pi_v<float> / 180.0f;
+            tile.add({radius * std::cos(t), radius * std::sin(t), z}, 1);
+        }
+    }
+    test::add_stem_and_ball(tile, 5, 0, 0.15f, 8, 2.0f, 0.15f, 2);
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 2u);
+    EXPECT_NEAR(result.trees[0].base.x(), 0.0f, 0.05f);
+    EXPECT_NEAR(result.trees[0].base.y(), 0.0f, 0.05f);
+    EXPECT_GT(result.trees[0].stem_radius, 0.65f);  // the layers' median, between 0.8 and 0.68 m
+    EXPECT_LT(result.trees[0].stem_radius, 0.8f);
+    EXPECT_NEAR(result.trees[1].stem_radius, 0.15f, 0.01f);
+
+    SegmentOptions one_layer;  // one circle over the whole slice: the flared trunk is not a stem
+    one_layer.stem_layer_height = 2.0f;
+    const TreeSegmentation whole_slice = segment_trees(tile.cloud, terrain, one_layer);
+    ASSERT_EQ(whole_slice.trees.size(), 1u);
+    EXPECT_NEAR(whole_slice.trees[0].base.x(), 5.0f, 0.05f);
 }
 
 TEST(SegmentTrees, AutomaticModeFollowsPointDensity) {
