@@ -55,7 +55,10 @@ void check_options(const SegmentOptions& o) {
     share(o.min_circle_inliers, "min circle inliers");
     share(o.min_arc_coverage, "min arc coverage");
     if (!(o.max_stem_lean >= 0.0f && o.max_stem_lean < 90.0f)) throw Error::usage("segment: max stem lean must be in 0..90 degrees");
-    positive(o.stem_layer_height, "stem layer height");
+    // Thinner layers than a few centimetres hold too few points for a circle, and a layer count
+    // of slice height / layer height must stay small.
+    if (!(o.stem_layer_height >= 0.05f && o.stem_layer_height <= 10.0f))
+        throw Error::usage("segment: stem layer height must be in 0.05..10 metres");
     positive(o.graph_voxel, "graph voxel");
     if (o.graph_neighbours < 2 || o.graph_neighbours > 64) throw Error::usage("segment: graph neighbours must be in 2..64");
     positive(o.max_gap, "max gap");
@@ -463,10 +466,12 @@ bool circle_holds(const CircleFit& circle, std::size_t points, const SegmentOpti
            circle.coverage >= options.min_arc_coverage;
 }
 
-// A trunk that tapers within the slice (a root flare: the synthetic oaks and figs of 1.2-1.5 m
-// narrow by a third between 1 and 2 m above the ground) holds no single circle over the slice's
-// height, but each thin horizontal layer of it does. The stem is then the median of the layers'
-// circles when at least half of the layers (two at least) hold one.
+// A trunk that tapers within the slice (a root flare: the synthetic oaks, figs and mahoganies of
+// 1.0-1.5 m narrow by a third between 1 and 2 m above the ground) holds no single circle over the
+// slice's height, but each thin horizontal layer of it does. The stem is then the median of the
+// layers' circles when at least half of the layers (two at least) hold one and every layer's
+// centre lies within half that radius of the median centre: one trunk, layer above layer, not
+// a limb and a twig curtain that happen to fit circles at different places.
 std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vector<int>& cluster, float low, float high,
                                        const SegmentOptions& options) {
     const int count = std::max(1, static_cast<int>(std::ceil((high - low) / options.stem_layer_height)));

@@ -227,27 +227,35 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
     json options;
     std::optional<encode::TreeFileOptions> dbf6;
     for (const fs::path& dir : folders.complete) {  // sorted by tile name
-        const json summary = read_json(dir / "summary.json");
-        const encode::TreeFileOptions tile_dbf6 = forest_options(summary, (dir / "summary.json").string());
-        if (dbf6 && (tile_dbf6.encode.resolution != dbf6->encode.resolution || tile_dbf6.lods != dbf6->lods))
-            throw Error::input((dir / "summary.json").string(), "made with other DBF6 options (--resolution, --lods) than the other tiles");
-        dbf6 = tile_dbf6;
-        const json tile_options = shaping_options(summary.at("options"));
-        if (options.is_null())
-            options = tile_options;
-        else if (options != tile_options)
-            log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
-        if (const auto buffer = summary.find("buffer"); buffer != summary.end() && buffer->is_object())
-            for (const json& id : buffer->value("trees_at_edge", json::array()))
-                merged.trees_at_buffer_edge.push_back(id.get<std::string>());
-        json tile_counts = summary.at("counts");
-        tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
-        add_counts(counts, tile_counts);
-        tiles.push_back(
-                {{"name", tile_of(dir)}, {"trees", tile_counts.value("trees", 0)}, {"trees_failed", tile_counts.value("trees_failed", 0)}});
-        add_csv(csv, dir);
-        add_features(features, crs, dir);
-        add_forest_trees(forest_trees, csv, dir);
+        try {
+            const json summary = read_json(dir / "summary.json");
+            const encode::TreeFileOptions tile_dbf6 = forest_options(summary, (dir / "summary.json").string());
+            if (dbf6 && (tile_dbf6.encode.resolution != dbf6->encode.resolution || tile_dbf6.lods != dbf6->lods))
+                throw Error::input((dir / "summary.json").string(),
+                                   "made with other DBF6 options (--resolution, --lods) than the other tiles");
+            dbf6 = tile_dbf6;
+            const json tile_options = shaping_options(summary.at("options"));
+            if (options.is_null())
+                options = tile_options;
+            else if (options != tile_options)
+                log_warn(dir.string() + ": made with other tile options than " + folders.complete.front().string());
+            if (const auto buffer = summary.find("buffer"); buffer != summary.end() && buffer->is_object())
+                for (const json& id : buffer->value("trees_at_edge", json::array()))
+                    merged.trees_at_buffer_edge.push_back(id.get<std::string>());
+            json tile_counts = summary.at("counts");
+            tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
+            add_counts(counts, tile_counts);
+            tiles.push_back({{"name", tile_of(dir)},
+                             {"trees", tile_counts.value("trees", 0)},
+                             {"trees_failed", tile_counts.value("trees_failed", 0)}});
+            add_csv(csv, dir);
+            add_features(features, crs, dir);
+            add_forest_trees(forest_trees, csv, dir);
+        } catch (const json::exception& e) {
+            // Files that parse but miss a field or hold one of another type: the tile's outputs
+            // were damaged (edited, or written by another program); say which tile, not where in nlohmann.
+            throw Error::input(dir.string(), std::string("malformed tile outputs (") + e.what() + ")");
+        }
     }
     merged.tiles = folders.complete.size();
     merged.trees = csv.rows.size();

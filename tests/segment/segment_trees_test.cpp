@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <map>
 #include <numbers>
 
@@ -208,6 +209,11 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     bad = {};
     bad.stem_slice_high = bad.stem_slice_low;
     EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
+    for (const float layer : {0.0f, 1e-9f, 100.0f, std::numeric_limits<float>::quiet_NaN()}) {
+        bad = {};
+        bad.stem_layer_height = layer;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
+    }
     EXPECT_EQ(test::error_code_of([&] { segment_trees(PointCloud{}, terrain, {}); }), ExitCode::Internal);
 }
 

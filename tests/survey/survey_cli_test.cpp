@@ -16,7 +16,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cstdio>
 #include <map>
 #include <random>
@@ -77,6 +79,32 @@ TEST(SurveyCli, SingleRunMergesEveryTree) {
     EXPECT_EQ(csv.rfind("global_id,tile,tree_id,x,y", 0), 0u) << csv.substr(0, 80);
     EXPECT_NE(csv.find("\n5000"), std::string::npos);  // survey-wide ids from the stem base: "<x>_<y>" of its 1 cm cell
     EXPECT_NE(csv.find(",t_3,"), std::string::npos);
+}
+
+// A tile folder whose JSON parses but is not what `tile` writes (a field missing or of another
+// type) stops the merge with one line naming the tile and exit 2, and no output folder.
+TEST(SurveyCli, MalformedTileOutputsAreOneLineErrors) {
+    const Reference& r = reference();
+    TempDir dir;
+    fs::copy(r.merged.parent_path() / "single", dir / "batch", fs::copy_options::recursive);
+    const fs::path tile = dir / "batch" / "t_1";
+    const auto summary = nlohmann::json::parse(file_bytes(tile / "summary.json"));
+    for (const auto& damage : std::vector<std::function<void(nlohmann::json&)>>{
+                 [](nlohmann::json& s) { s["counts"] = 5; },
+                 [](nlohmann::json& s) {
+                     s["buffer"] = {{"trees_at_edge", {1}}};
+                 },
+                 [](nlohmann::json& s) { s.erase("options"); },
+         }) {
+        nlohmann::json damaged = summary;
+        damage(damaged);
+        write_text(tile / "summary.json", damaged.dump());
+        const CommandResult result = run_cli("merge '" + (dir / "batch").string() + "' --out '" + (dir / "out").string() + "'");
+        EXPECT_EQ(result.exit_code, 2) << result.err;
+        EXPECT_NE(result.err.find("t_1"), std::string::npos) << result.err;
+        EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
+        EXPECT_FALSE(fs::exists(dir / "out"));
+    }
 }
 
 TEST(SurveyCli, FourShardsMergeToTheBytesOfOneRun) {
