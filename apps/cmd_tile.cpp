@@ -605,8 +605,9 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
                "paths) or auto (from the point density)")
             ->check(CLI::IsMember({"auto", "als", "tls"}));
     table->add("--stand", o->stand,
-               "Airborne crowns: broadleaf (broad crowns, many maxima merged) or conifer (every treetop a tree, crowns at most 3.5 m "
-               "from their top: dense conifer stands)")
+               "Stand type: broadleaf (airborne: broad crowns, many maxima merged; terrestrial: thick trunks reach farther) or "
+               "conifer (dense conifer stands; airborne: every treetop a tree, crowns at most 3.5 m from their top; terrestrial: all "
+               "stems reach alike)")
             ->check(CLI::IsMember({"broadleaf", "conifer"}));
     table->add("--max-crown-radius", o->max_crown_radius,
                "Airborne: no crown reaches farther from its treetop, metres (default: the stand's, 15 broadleaf, 3.5 conifer)")

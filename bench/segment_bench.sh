@@ -9,7 +9,8 @@
 #      filtered afresh (--ignore-classification); and the same stands with crown competition
 #      (`synth tile --competition`: crowns cut where a neighbour owns the canopy);
 #   2. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
-#   3. treels/pine_plot.las: stems found, with their positions and diameters;
+#   3. treels/pine_plot.las: stems found, with their positions and diameters (--stand conifer,
+#      and the heights the broadleaf default gives);
 #   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
 #      2 x 2 and 4 x 4 copies side by side) and the TLS tiles.
 # Matching rule: a true tree and a found tree match when each holds at least half of the other's
@@ -109,15 +110,15 @@ for r in d["score"]["by_height"]:
 PY
 
 echo
-echo "== TreeLS pine_plot.las: stems"
-python3 - "$("$EVAL" "$DATA/treels/pine_plot.las" --trees)" <<'PY'
+echo "== TreeLS pine_plot.las: stems (--stand conifer; heights with the broadleaf default in the last column)"
+python3 - "$("$EVAL" "$DATA/treels/pine_plot.las" --trees --stand conifer)" "$("$EVAL" "$DATA/treels/pine_plot.las" --trees)" <<'PY'
 import json, sys
-d = json.loads(sys.argv[1])
+d, broadleaf = json.loads(sys.argv[1]), json.loads(sys.argv[2])
 print(f"{d['trees']} trees ({d['mode_reason']}; ground {d['ground_source']}), {d['seconds']['total']:.2f} s")
-print("| id | x | y | height m | stem diameter at 1-2 m, cm | points |")
-print("|---|---|---|---|---|---|")
-for t in d["tree_list"]:
-    print(f"| {t['id']} | {t['x']:.2f} | {t['y']:.2f} | {t['height']:.1f} | {200 * t['stem_radius']:.1f} | {t['points']} |")
+print("| id | x | y | height m | stem diameter at 1-2 m, cm | points | height m, broadleaf |")
+print("|---|---|---|---|---|---|---|")
+for t, b in zip(d["tree_list"], broadleaf["tree_list"]):
+    print(f"| {t['id']} | {t['x']:.2f} | {t['y']:.2f} | {t['height']:.1f} | {200 * t['stem_radius']:.1f} | {t['points']} | {b['height']:.1f} |")
 PY
 
 echo

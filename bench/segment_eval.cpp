@@ -109,6 +109,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"max_stem_lean", &o.max_stem_lean},
                                                   {"stem_layer_height", &o.stem_layer_height},
                                                   {"graph_beta", &o.graph_beta},
+                                                  {"stem_reach_exponent", &o.stem_reach_exponent},
                                                   {"seed_ratio", &o.seed_ratio},
                                                   {"crown_ratio", &o.crown_ratio},
                                                   {"max_crown_radius", &o.max_crown_radius},

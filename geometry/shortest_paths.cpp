@@ -3,6 +3,7 @@
 #include "core/error.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 
@@ -79,6 +80,22 @@ private:
 }  // namespace
 
 ShortestPaths shortest_paths(const NeighbourGraph& graph, std::span<const int> sources, EdgeCost edge_cost) {
+    const std::vector<float> unscaled(sources.size(), 1.0f);
+    return shortest_paths(graph, sources, SourceScaling{unscaled, {}}, edge_cost);
+}
+
+ShortestPaths shortest_paths(const NeighbourGraph& graph, std::span<const int> sources, const SourceScaling& scaling,
+                             EdgeCost edge_cost) {
+    if (scaling.source_scale.size() != sources.size())
+        throw Error(ExitCode::Internal, "shortest_paths: " + std::to_string(scaling.source_scale.size()) + " scale factors for " +
+                                            std::to_string(sources.size()) + " sources");
+    if (!scaling.edge_share.empty() && scaling.edge_share.size() != graph.targets.size())
+        throw Error(ExitCode::Internal, "shortest_paths: " + std::to_string(scaling.edge_share.size()) + " edge shares for " +
+                                            std::to_string(graph.targets.size()) + " edges");
+    for (float scale : scaling.source_scale)
+        if (!(scale > 0.0f) || !std::isfinite(scale)) throw Error(ExitCode::Internal, "shortest_paths: scale factors must be positive");
+    for (float share : scaling.edge_share)
+        if (!(share >= 0.0f && share <= 1.0f)) throw Error(ExitCode::Internal, "shortest_paths: edge shares must be in 0..1");
     const std::size_t n = graph.vertex_count();
     ShortestPaths sp;
     sp.parent.assign(n, -1);
@@ -104,7 +121,9 @@ ShortestPaths shortest_paths(const NeighbourGraph& graph, std::span<const int> s
         sp.order.push_back(u);
         for (std::uint32_t e = graph.offsets[u]; e < graph.offsets[u + 1]; ++e) {
             const int v = graph.targets[e];
-            const double candidate = cost + step[e];
+            const double share = scaling.edge_share.empty() ? 1.0 : scaling.edge_share[e];
+            const double factor = 1.0 + (scaling.source_scale[static_cast<std::size_t>(sp.source[u])] - 1.0) * share;
+            const double candidate = cost + factor * step[e];
             if (heap.settled(v) || candidate >= sp.cost[v]) continue;
             sp.cost[v] = candidate;
             sp.parent[v] = u;

@@ -26,4 +26,20 @@ enum class EdgeCost { Weight, Length };
 // sources throw Error(Internal).
 ShortestPaths shortest_paths(const NeighbourGraph& graph, std::span<const int> sources, EdgeCost edge_cost = EdgeCost::Weight);
 
+// Sources whose paths cost more or less than others, per edge: a path from sources[s] pays on
+// edge e its cost times 1 + (source_scale[s] - 1) * edge_share[e]. With every share 1 that is a
+// multiplicatively weighted partition (a source with a smaller factor reaches farther); a share
+// below 1 exempts that part of an edge (the vertical part, say, when the sources differ in how
+// far they reach sideways). Each vertex goes to the source whose scaled path to it is cheapest
+// among the paths through vertices of the same source, so every region is connected.
+struct SourceScaling {
+    std::span<const float> source_scale;  // one positive, finite factor per source
+    std::span<const float> edge_share;    // per edge, in graph.targets order, each in 0..1; empty = 1 for all
+};
+
+// Sizes that differ from the sources' and the edges', or factors and shares out of range, throw
+// Error(Internal).
+ShortestPaths shortest_paths(const NeighbourGraph& graph, std::span<const int> sources, const SourceScaling& scaling,
+                             EdgeCost edge_cost = EdgeCost::Weight);
+
 }  // namespace treelobes

@@ -15,6 +15,7 @@
 #include <limits>
 #include <optional>
 #include <queue>
+#include <span>
 #include <tuple>
 #include <unordered_map>
 
@@ -63,6 +64,8 @@ void check_options(const SegmentOptions& o) {
     if (o.graph_neighbours < 2 || o.graph_neighbours > 64) throw Error::usage("segment: graph neighbours must be in 2..64");
     positive(o.max_gap, "max gap");
     positive(o.graph_beta, "graph beta");
+    if (!(o.stem_reach_exponent >= 0.0f && o.stem_reach_exponent <= 4.0f))
+        throw Error::usage("segment: stem reach exponent must be in 0..4");
     if (!(o.ground_clearance >= 0.0f) || !std::isfinite(o.ground_clearance)) throw Error::usage("segment: ground clearance must be >= 0");
 }
 
@@ -435,20 +438,20 @@ std::vector<std::vector<int>> cluster_slice(const PointCloud& cloud, const std::
     return clusters;
 }
 
-// A stem stands upright: the centroids of the lower and upper halves of its slice points lie
-// above each other within `max_lean_degrees`. A low branch crossing the slice aslant can fit a
-// circle arc too, but its halves are offset by its horizontal run.
-bool upright(const PointCloud& cloud, const std::vector<int>& points, float max_lean_degrees) {
+// A stem stands upright: the centroids of the lower and upper halves of its samples (its slice
+// points on the circle, or the centres of its layers' circles) lie above each other within
+// `max_lean_degrees`. A low branch crossing the slice aslant can fit a circle arc too, but its
+// halves are offset by its horizontal run.
+bool upright(std::span<const Eigen::Vector3f> samples, float max_lean_degrees) {
     float low = std::numeric_limits<float>::infinity(), high = -low;
-    for (int i : points) {
-        low = std::min(low, cloud.positions[static_cast<std::size_t>(i)].z());
-        high = std::max(high, cloud.positions[static_cast<std::size_t>(i)].z());
+    for (const Eigen::Vector3f& p : samples) {
+        low = std::min(low, p.z());
+        high = std::max(high, p.z());
     }
     const float middle = 0.5f * (low + high);
     Eigen::Vector3d sum[2] = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     std::size_t count[2] = {0, 0};
-    for (int i : points) {
-        const Eigen::Vector3f& p = cloud.positions[static_cast<std::size_t>(i)];
+    for (const Eigen::Vector3f& p : samples) {
         const int half = p.z() >= middle;
         sum[half] += p.cast<double>();
         ++count[half];
@@ -457,6 +460,20 @@ bool upright(const PointCloud& cloud, const std::vector<int>& points, float max_
     const Eigen::Vector3d step = sum[1] / count[1] - sum[0] / count[0];
     const double tangent = std::tan(static_cast<double>(max_lean_degrees) * std::numbers::pi / 180.0);
     return step.z() > 0 && step.head<2>().norm() <= tangent * step.z();
+}
+
+// The points as (x, y, height above the DTM). The slice is cut by height above the DTM, so on a
+// slope its uphill side lies higher than its downhill side: split by z, the halves of a thick
+// trunk would be its downhill and uphill arcs, offset by its diameter however upright it stands.
+std::vector<Eigen::Vector3f> above_ground(const PointCloud& cloud, const std::vector<float>& height_above_ground,
+                                          const std::vector<int>& points) {
+    std::vector<Eigen::Vector3f> samples;
+    samples.reserve(points.size());
+    for (int i : points) {
+        const auto k = static_cast<std::size_t>(i);
+        samples.emplace_back(cloud.positions[k].x(), cloud.positions[k].y(), height_above_ground[k]);
+    }
+    return samples;
 }
 
 // Does a circle of a plausible radius hold enough of these points around enough of its
@@ -471,7 +488,9 @@ bool circle_holds(const CircleFit& circle, std::size_t points, const SegmentOpti
 // slice's height, but each thin horizontal layer of it does. The stem is then the median of the
 // layers' circles when at least half of the layers (two at least) hold one and every layer's
 // centre lies within half that radius of the median centre: one trunk, layer above layer, not
-// a limb and a twig curtain that happen to fit circles at different places.
+// a limb and a twig curtain that happen to fit circles at different places. Whether it stands
+// upright is judged by the circles' centres: the layers of a thick trunk see different arcs
+// (occlusion changes with height), so their points' centroids wander by up to a radius.
 std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vector<int>& cluster, float low, float high,
                                        const SegmentOptions& options) {
     const int count = std::max(1, static_cast<int>(std::ceil((high - low) / options.stem_layer_height)));
@@ -481,16 +500,19 @@ std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vecto
         layers[static_cast<std::size_t>(std::min(count - 1, static_cast<int>((z - low) / options.stem_layer_height)))].push_back(i);
     }
     std::vector<CircleFit> circles;
+    std::vector<Eigen::Vector3f> centres;  // of the circles, at their layers' mid-heights
     std::vector<int> on_circles;
-    for (const std::vector<int>& layer : layers) {
+    for (int k = 0; k < count; ++k) {
+        const std::vector<int>& layer = layers[static_cast<std::size_t>(k)];
         if (static_cast<int>(layer.size()) < options.min_stem_points) continue;
         std::vector<Eigen::Vector2f> xy;
         for (int i : layer) xy.push_back(cloud.positions[static_cast<std::size_t>(i)].head<2>());
         const CircleFit circle = fit_circle(xy, options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
         if (!circle_holds(circle, layer.size(), options)) continue;
         circles.push_back(circle);
-        for (std::size_t k = 0; k < layer.size(); ++k)
-            if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circles.push_back(layer[k]);
+        centres.emplace_back(circle.centre.x(), circle.centre.y(), low + (static_cast<float>(k) + 0.5f) * options.stem_layer_height);
+        for (std::size_t j = 0; j < layer.size(); ++j)
+            if (std::abs((xy[j] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circles.push_back(layer[j]);
     }
     if (circles.size() < 2 || 2 * static_cast<int>(circles.size()) < count) return std::nullopt;
     const auto median = [&](auto value) {
@@ -506,15 +528,17 @@ std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vecto
         if ((c.centre - stem.centre).norm() > 0.5f * stem.radius) return std::nullopt;  // one trunk, layer above layer
         stem.inliers += c.inliers;
     }
-    if (!upright(cloud, on_circles, options.max_stem_lean)) return std::nullopt;
+    if (!upright(centres, options.max_stem_lean)) return std::nullopt;
     stem.points = std::move(on_circles);
     return stem;
 }
 
 // A slice cluster is a stem when it spans most of the slice height and a circle of a plausible
 // radius holds enough of its points around enough of its circumference (Liang et al. 2012, §2.2),
-// over the slice's height or, for a tapering trunk, layer by layer.
-std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cluster, const SegmentOptions& options) {
+// standing upright, over the slice's height or else layer by layer (a tapering trunk, or one
+// whose visible arc turns with height).
+std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<float>& height_above_ground, const std::vector<int>& cluster,
+                             const SegmentOptions& options) {
     if (static_cast<int>(cluster.size()) < options.min_stem_points) return std::nullopt;
     float low = std::numeric_limits<float>::infinity(), high = -low;
     std::vector<Eigen::Vector2f> xy;
@@ -527,14 +551,18 @@ std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<int>& cl
     }
     if (high - low < 0.5f * (options.stem_slice_high - options.stem_slice_low)) return std::nullopt;
     const CircleFit circle = fit_circle(xy, options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
-    if (!circle_holds(circle, cluster.size(), options)) return fit_stem_by_layers(cloud, cluster, low, high, options);
-    // Only the points on the circle seed the tree: a branch or a bush touching the stem in the
-    // slice must win its points through the graph like any other.
-    std::vector<int> on_circle;
-    for (std::size_t k = 0; k < cluster.size(); ++k)
-        if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circle.push_back(cluster[k]);
-    if (!upright(cloud, on_circle, options.max_stem_lean)) return std::nullopt;
-    return Stem{circle.centre, circle.radius, circle.inliers, std::move(on_circle)};
+    if (circle_holds(circle, cluster.size(), options)) {
+        // Only the points on the circle seed the tree: a branch or a bush touching the stem in
+        // the slice must win its points through the graph like any other.
+        std::vector<int> on_circle;
+        for (std::size_t k = 0; k < cluster.size(); ++k)
+            if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circle.push_back(cluster[k]);
+        if (upright(above_ground(cloud, height_above_ground, on_circle), options.max_stem_lean))
+            return Stem{circle.centre, circle.radius, circle.inliers, std::move(on_circle)};
+    }
+    // Points that lean may be a trunk whose visible arc turns with height (occlusion): its
+    // layers' circles tell.
+    return fit_stem_by_layers(cloud, cluster, low, high, options);
 }
 
 // Stems found in the slice that also have points under them down to the ground clearance, one
@@ -566,7 +594,7 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
     };
     std::vector<Stem> stems;
     for (const auto& cluster : cluster_slice(cloud, slice, options.stem_cluster_distance))
-        if (auto stem = fit_stem(cloud, cluster, options); stem && reaches_ground(*stem)) stems.push_back(std::move(*stem));
+        if (auto stem = fit_stem(cloud, terrain.height_above_ground, cluster, options); stem && reaches_ground(*stem)) stems.push_back(std::move(*stem));
     std::stable_sort(stems.begin(), stems.end(), [](const Stem& a, const Stem& b) { return a.inliers > b.inliers; });
     std::vector<Stem> kept;
     for (auto& stem : stems) {
@@ -616,6 +644,38 @@ Voxels voxelise(const PointCloud& cloud, const std::vector<std::uint8_t>& vegeta
     return voxels;
 }
 
+// What the paths from each source cost per unit of the horizontal part of their edges' weights:
+// (median stem radius / the source's stem radius)^exponent. A thick trunk carries a wide crown
+// (crown width grows with the stem diameter), so its paths reach farther sideways than a thin
+// neighbour's: the far limbs of a broad crown that reach over a small tree stay with their trunk
+// instead of going to the stem that is nearer through the mixed branches (a multiplicatively
+// weighted partition, Aurenhammer & Edelsbrunner 1984, in the graph's metric). Climbing is not
+// scaled: a thin tree reaches its own top as cheaply as a thick one, whose paths would otherwise
+// take the tops of tall, slender neighbours.
+std::vector<float> reach_scales(const std::vector<Stem>& stems, const std::vector<int>& source_stem, float exponent) {
+    std::vector<float> radii;
+    for (const Stem& stem : stems) radii.push_back(stem.radius);
+    std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+    const float median_radius = radii[radii.size() / 2];
+    std::vector<float> scales;
+    scales.reserve(source_stem.size());
+    for (int s : source_stem) scales.push_back(std::pow(median_radius / stems[static_cast<std::size_t>(s)].radius, exponent));
+    return scales;
+}
+
+// Per edge of the graph, the horizontal share of its squared length: the part of its cost a
+// stem's reach scales (a thick trunk's crown spreads wider, not higher).
+std::vector<float> horizontal_shares(const NeighbourGraph& graph, const std::vector<Eigen::Vector3f>& positions) {
+    std::vector<float> shares(graph.targets.size(), 0.0f);
+    for (std::size_t u = 0; u + 1 < graph.offsets.size(); ++u)
+        for (std::uint32_t e = graph.offsets[u]; e < graph.offsets[u + 1]; ++e) {
+            const Eigen::Vector3f step = positions[static_cast<std::size_t>(graph.targets[e])] - positions[u];
+            const float squared = step.squaredNorm();
+            if (squared > 0.0f) shares[e] = std::clamp(step.head<2>().squaredNorm() / squared, 0.0f, 1.0f);
+        }
+    return shares;
+}
+
 void segment_terrestrial(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
                          const SegmentOptions& options, TreeSegmentation& result) {
     const std::vector<Stem> stems = find_stems(cloud, terrain, vegetation, options);
@@ -640,7 +700,9 @@ void segment_terrestrial(const PointCloud& cloud, const Terrain& terrain, const 
     graph_options.join_components = false;  // a gap wider than max_gap separates: what lies beyond stays 0
     graph_options.beta = options.graph_beta;
     const NeighbourGraph graph = build_neighbour_graph(voxels.centres, graph_options);
-    const ShortestPaths paths = shortest_paths(graph, sources, EdgeCost::Weight);
+    const std::vector<float> scales = reach_scales(stems, source_stem, options.stem_reach_exponent);
+    const std::vector<float> shares = horizontal_shares(graph, voxels.centres);
+    const ShortestPaths paths = shortest_paths(graph, sources, SourceScaling{scales, shares}, EdgeCost::Weight);
 
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const int v = voxels.voxel_of_point[i];
@@ -691,6 +753,7 @@ SegmentOptions with_stand_type(SegmentOptions options, StandType stand) {
     options.min_top_prominence = stand == StandType::Conifer ? 0.0f : broadleaf.min_top_prominence;
     options.chm_smoothing = stand == StandType::Conifer ? 0.0f : broadleaf.chm_smoothing;
     options.max_crown_radius = stand == StandType::Conifer ? 3.5f : broadleaf.max_crown_radius;
+    options.stem_reach_exponent = stand == StandType::Conifer ? 0.0f : broadleaf.stem_reach_exponent;
     return options;
 }
 

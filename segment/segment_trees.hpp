@@ -14,9 +14,11 @@
 // et al. 2012, §2.2); then one multi-source Dijkstra over the whole plot's neighbour graph, from
 // all stem bases at once (the multi-root variant of the skeleton's shortest paths, Livny et al.
 // 2010, §3), gives every point to the base it reaches most cheaply, an edge costing
-// length^graph_beta. The graph is built on a voxel-thinned copy of the non-ground points with no
-// edge longer than `max_gap`, and every point takes the label of its voxel: points no base
-// reaches (understory apart from the trees, clutter beyond a gap) stay 0.
+// length^graph_beta, its horizontal part times a factor that falls with the stem's radius (a
+// thick trunk's crown reaches farther sideways). The graph is built on a voxel-thinned copy of
+// the non-ground points with no edge longer than `max_gap`, and every point takes the label of
+// its voxel: points no base reaches (understory apart from the trees, clutter beyond a gap)
+// stay 0.
 // docs/segment.md has the figures and the settings for dense conifer stands.
 #pragma once
 
@@ -83,21 +85,27 @@ struct SegmentOptions {
     float graph_voxel = 0.1f;         // voxel edge of the thinned cloud the plot graph is built on (metres)
     int graph_neighbours = 10;        // k of the kNN graph
     float graph_beta = 2.0f;          // an edge costs length^beta: > 1 makes jumps across the sparse contact of two crowns dear
+    // Paths from a stem of radius r cost (median stem radius / r)^stem_reach_exponent per unit of
+    // the horizontal part of their edge costs: thick trunks, which carry wide crowns, reach
+    // farther sideways (0 = all stems alike).
+    float stem_reach_exponent = 1.0f;
     float max_gap = 0.5f;             // longest graph edge (metres): points beyond wider gaps stay 0
     float ground_clearance = 0.3f;    // points lower than this above the DTM stay out of the graph (metres)
 };
 
-// Presets of the airborne segmentation for the stand at hand (`treelobes tile --stand`).
+// Presets of the segmentation for the stand at hand (`treelobes tile --stand`).
 // Broadleaf: the defaults above (broad crowns with many maxima: shallow tops merged into higher
-// ones, CHM smoothed, crowns up to 15 m from their top). Conifer: every window maximum is a tree
-// on the unsmoothed CHM and a crown reaches at most 3.5 m from its top (narrow, pointed crowns
-// side by side; on lidR's MixedConifer F1 0.87 against lidR's treeID, 0.35 with the broadleaf
-// preset). Terrestrial segmentation does not depend on it.
+// ones, CHM smoothed, crowns up to 15 m from their top; a thick trunk's paths reach farther).
+// Conifer: every window maximum is a tree on the unsmoothed CHM and a crown reaches at most
+// 3.5 m from its top (narrow, pointed crowns side by side; on lidR's MixedConifer F1 0.87
+// against lidR's treeID, 0.35 with the broadleaf preset), and all stems reach alike (narrow
+// crowns of one height whatever the diameter: on TreeLS's pine plot a thick pine's paths would
+// take the top of a thin neighbour).
 enum class StandType { Broadleaf, Conifer };
 
 // Parses "broadleaf" or "conifer"; throws Error(Usage) otherwise.
 StandType parse_stand_type(std::string_view text);
-// The options with the preset's airborne settings (top merging, CHM smoothing, crown radius).
+// The options with the preset's settings (top merging, CHM smoothing, crown radius, stem reach).
 SegmentOptions with_stand_type(SegmentOptions options, StandType stand);
 
 // How far around a crown the airborne segmentation reads points that can change it: the crown

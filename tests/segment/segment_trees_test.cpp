@@ -158,6 +158,126 @@ TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
     EXPECT_NEAR(whole_slice.trees[0].base.x(), 5.0f, 0.05f);
 }
 
+// A flared trunk as above that neighbours hide but for a 120-degree arc, which turns from +x at
+// 1 m to -x at 2 m above the ground. The centroids of its slice points' lower and upper halves
+// then lie 0.8 m apart at 0.5 m of height, as if it leaned 58 degrees, while its layers'
+// circles stand one above the other.
+TEST(SegmentTrees, ATrunkHalfHiddenIsFoundByItsLayersCentres) {
+    ToyTile tile;
+    test::add_ground(tile, -4, 5, -4, 5, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    for (float z = 0.0f; z <= 8.0f; z += 0.02f) {
+        const float radius = 0.6f + 0.5f * std::max(0.0f, 2.5f - z) / 2.5f;
+        const float facing = std::clamp(z - 1.0f, 0.0f, 1.0f) * std::numbers::pi_v<float>;
+        for (int a = -72; a < 72; ++a) {
+            const float t = static_cast<float>(a) * 2.5f * std::numbers::pi_v<float> / 180.0f;
+            if (std::cos(t - facing) < 0.5f) continue;  // more than 60 degrees from the facing direction
+            tile.add({radius * std::cos(t), radius * std::sin(t), z}, 1);
+        }
+    }
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].base.x(), 0.0f, 0.05f);
+    EXPECT_NEAR(result.trees[0].base.y(), 0.0f, 0.05f);
+}
+
+// A thick straight trunk (radius 0.75 m) on a 20-degree slope, judged by one circle over the
+// whole slice (layers as thick as the slice). The slice 1-2 m above the ground is 0.55 m higher
+// on the trunk's uphill side than on its downhill side; cut by z, its lower half would lie
+// 0.2 m downhill of the axis and its upper half as far uphill, as if it leaned 39 degrees.
+TEST(SegmentTrees, AThickTrunkOnASlopeStandsUpright) {
+    ToyTile tile;
+    // Off the origin: a small tile whose ground crosses z = 0 would pass for a height-normalised one.
+    test::add_ground(tile, 6, 15, -4, 5, 0.05f, 20.0f, 0.0f, [](float, float) { return false; });
+    for (int a = 0; a < 144; ++a) {
+        const float t = static_cast<float>(a) * 2.5f * std::numbers::pi_v<float> / 180.0f;
+        const float x = 10.0f + 0.75f * std::cos(t), y = 0.75f * std::sin(t);
+        for (float z = test::ground_height(x, y, 20.0f, 0.0f); z <= 8.0f; z += 0.02f) tile.add({x, y, z}, 1);
+    }
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (!tile.truth[i]) tile.cloud.classification[i] = 2;
+    SegmentOptions whole_slice;
+    whole_slice.stem_layer_height = 2.0f;
+    const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), whole_slice);
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].stem_radius, 0.75f, 0.02f);
+}
+
+// A thick tree (stem radius 0.4 m) whose limb reaches 5.8 m out, into the crown of a thin
+// neighbour (0.1 m). Through the thin tree's short stem the limb's far half (3-5 m out) is
+// nearer than through its own trunk; a thick trunk's paths reach farther, so it stays there.
+TEST(SegmentTrees, ALimbReachingOverAThinNeighbourStaysWithItsTrunk) {
+    ToyTile tile;
+    test::add_ground(tile, -4, 9, -4, 4, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    test::add_stem_and_ball(tile, 0, 0, 0.4f, 6, 2.5f, 0.15f, 1);
+    const Eigen::Vector3f limb_start(0.4f, 0, 3), limb_end(5.8f, 0, 3.5f);
+    for (float t = 0; t <= 1.0f; t += 0.004f)
+        for (int a = 0; a < 12; ++a) {
+            const float angle = static_cast<float>(a) * std::numbers::pi_v<float> / 6.0f;
+            tile.add(limb_start + t * (limb_end - limb_start) + Eigen::Vector3f(0, 0.08f * std::cos(angle), 0.08f * std::sin(angle)), 1);
+        }
+    test::add_stem_and_ball(tile, 6.5f, 0, 0.1f, 3.5f, 1.0f, 0.1f, 2);
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+
+    const auto shares = [&](const SegmentOptions& options) {
+        const TreeSegmentation result = segment_trees(tile.cloud, terrain, options);
+        EXPECT_EQ(result.trees.size(), 2u);
+        // The two stems stand on one line of y: which id each gets is not the point here.
+        const std::int32_t thick_id = result.trees.at(0).base.x() < 3.0f ? 1 : 2, thin_id = 3 - thick_id;
+        std::size_t limb = 0, limb_kept = 0, thin = 0, thin_kept = 0;
+        for (std::size_t i = 0; i < tile.truth.size(); ++i) {
+            const Eigen::Vector3f& p = tile.cloud.positions[i];
+            if (tile.truth[i] == 1 && p.x() > 3.0f && p.x() < 5.0f) {
+                ++limb;
+                limb_kept += result.tree_id[i] == thick_id;
+            }
+            if (tile.truth[i] == 2 && p.z() > 2.5f) {
+                ++thin;
+                thin_kept += result.tree_id[i] == thin_id;
+            }
+        }
+        return std::pair(static_cast<double>(limb_kept) / static_cast<double>(limb), static_cast<double>(thin_kept) / static_cast<double>(thin));
+    };
+    const auto [limb_share, thin_share] = shares({});
+    EXPECT_EQ(limb_share, 1.0);  // the far end of the limb is the thick tree's
+    EXPECT_GT(thin_share, 0.95);  // and the thin tree keeps its crown
+    SegmentOptions alike;
+    alike.stem_reach_exponent = 0.0f;  // every stem reaching alike: the thin tree takes the limb's end
+    const auto [limb_share_alike, thin_share_alike] = shares(alike);
+    EXPECT_LT(limb_share_alike, 0.5);
+    EXPECT_GT(thin_share_alike, 0.95);
+}
+
+// A tall thin tree (stem radius 0.1 m, 12.8 m) whose stem rises past the crown of a thick one
+// (0.4 m, a 3 m ball around 5 m). The thick trunk's reach is sideways: the thin tree's stem and
+// top above the ball stay its own, though a path from the thick stem through the ball and up
+// the thin stem is not much longer.
+TEST(SegmentTrees, ATallThinTreeKeepsItsTopBesideAThickOne) {
+    ToyTile tile;
+    test::add_ground(tile, -4, 6, -4, 4, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    test::add_stem_and_ball(tile, 0, 0, 0.4f, 5, 3.0f, 0.15f, 1);
+    test::add_stem_and_ball(tile, 3.15f, 0, 0.1f, 12, 0.8f, 0.1f, 2);
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), {});
+    ASSERT_EQ(result.trees.size(), 2u);
+    const std::int32_t thin_id = result.trees[0].base.x() > 1.5f ? 1 : 2;  // the stems stand on one line of y
+    std::size_t top = 0, kept = 0;
+    for (std::size_t i = 0; i < tile.truth.size(); ++i)
+        if (tile.truth[i] == 2 && tile.cloud.positions[i].z() > 8.5f) {
+            ++top;
+            kept += result.tree_id[i] == thin_id;
+        }
+    EXPECT_EQ(kept, top);
+}
+
 TEST(SegmentTrees, AutomaticModeFollowsPointDensity) {
     const ToyTile airborne = two_crowns_airborne();
     const TreeSegmentation als = segment_trees(airborne.cloud, analyse_terrain(airborne.cloud, {}), {});
@@ -214,6 +334,11 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
         bad.stem_layer_height = layer;
         EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
     }
+    for (const float exponent : {-0.5f, 5.0f, std::numeric_limits<float>::quiet_NaN()}) {
+        bad = {};
+        bad.stem_reach_exponent = exponent;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << exponent;
+    }
     EXPECT_EQ(test::error_code_of([&] { segment_trees(PointCloud{}, terrain, {}); }), ExitCode::Internal);
 }
 
@@ -235,12 +360,14 @@ TEST(SegmentTrees, StandPresets) {
     EXPECT_EQ(conifer.min_top_prominence, 0.0f);
     EXPECT_EQ(conifer.chm_smoothing, 0.0f);
     EXPECT_EQ(conifer.max_crown_radius, 3.5f);
+    EXPECT_EQ(conifer.stem_reach_exponent, 0.0f);
     EXPECT_EQ(conifer.min_tree_height, 4.0f);
     const SegmentOptions broadleaf = with_stand_type(conifer, parse_stand_type("broadleaf"));
     const SegmentOptions defaults;
     EXPECT_EQ(broadleaf.min_top_prominence, defaults.min_top_prominence);
     EXPECT_EQ(broadleaf.chm_smoothing, defaults.chm_smoothing);
     EXPECT_EQ(broadleaf.max_crown_radius, defaults.max_crown_radius);
+    EXPECT_EQ(broadleaf.stem_reach_exponent, defaults.stem_reach_exponent);
     EXPECT_EQ(broadleaf.min_tree_height, 4.0f);
     EXPECT_EQ(test::error_code_of([] { parse_stand_type("palm"); }), ExitCode::Usage);
 }
