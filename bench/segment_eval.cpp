@@ -110,6 +110,8 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"stem_layer_height", &o.stem_layer_height},
                                                   {"graph_beta", &o.graph_beta},
                                                   {"stem_reach_exponent", &o.stem_reach_exponent},
+                                                  {"stem_subcluster_distance", &o.stem_subcluster_distance},
+                                                  {"stem_merge_distance", &o.stem_merge_distance},
                                                   {"seed_ratio", &o.seed_ratio},
                                                   {"crown_ratio", &o.crown_ratio},
                                                   {"max_crown_radius", &o.max_crown_radius},

@@ -49,6 +49,10 @@ void check_options(const SegmentOptions& o) {
     if (!(o.stem_slice_high > o.stem_slice_low) || !std::isfinite(o.stem_slice_low) || !std::isfinite(o.stem_slice_high))
         throw Error::usage("segment: the stem slice needs low < high");
     positive(o.stem_cluster_distance, "stem cluster distance");
+    if (!(o.stem_subcluster_distance >= 0.0f && o.stem_subcluster_distance < o.stem_cluster_distance))
+        throw Error::usage("segment: stem subcluster distance must be >= 0 and below the stem cluster distance");
+    if (!(o.stem_merge_distance >= 0.0f) || !std::isfinite(o.stem_merge_distance))
+        throw Error::usage("segment: stem merge distance must be >= 0");
     if (o.min_stem_points < 5) throw Error::usage("segment: min stem points must be >= 5");
     positive(o.min_stem_radius, "min stem radius");
     if (!(o.max_stem_radius > o.min_stem_radius)) throw Error::usage("segment: max stem radius must exceed min stem radius");
@@ -566,8 +570,9 @@ std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<float>& 
 }
 
 // Stems found in the slice that also have points under them down to the ground clearance, one
-// per trunk: arcs of one trunk split by occlusion give circles whose centres lie within each
-// other; the one with more inliers stays.
+// per tree: arcs of one trunk split by occlusion give circles whose centres lie within each
+// other, the one with more inliers stays; trunks closer than stem_merge_distance are one tree's,
+// seeded from all of them and measured by the one with more inliers.
 std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
                              const SegmentOptions& options) {
     std::vector<int> slice;
@@ -593,15 +598,37 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
         return static_cast<int>(near.size()) >= options.min_stem_points;
     };
     std::vector<Stem> stems;
-    for (const auto& cluster : cluster_slice(cloud, slice, options.stem_cluster_distance))
-        if (auto stem = fit_stem(cloud, terrain.height_above_ground, cluster, options); stem && reaches_ground(*stem)) stems.push_back(std::move(*stem));
+    const auto stem_of = [&](const std::vector<int>& cluster) {
+        std::optional<Stem> stem = fit_stem(cloud, terrain.height_above_ground, cluster, options);
+        return stem && reaches_ground(*stem) ? stem : std::nullopt;
+    };
+    for (const auto& cluster : cluster_slice(cloud, slice, options.stem_cluster_distance)) {
+        if (auto stem = stem_of(cluster)) {
+            stems.push_back(std::move(*stem));
+            continue;
+        }
+        // A trunk inside a curtain of hanging twigs, or under limbs that fill the slice, joins
+        // them at the cluster distance but not at a finer one.
+        if (options.stem_subcluster_distance <= 0.0f || static_cast<int>(cluster.size()) < 2 * options.min_stem_points) continue;
+        for (const auto& part : cluster_slice(cloud, cluster, options.stem_subcluster_distance))
+            if (auto stem = stem_of(part)) stems.push_back(std::move(*stem));
+    }
     std::stable_sort(stems.begin(), stems.end(), [](const Stem& a, const Stem& b) { return a.inliers > b.inliers; });
     std::vector<Stem> kept;
     for (auto& stem : stems) {
         const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Stem& k) {
             return (k.centre - stem.centre).norm() < std::max(k.radius, stem.radius) + options.circle_tolerance;
         });
-        if (!duplicate) kept.push_back(std::move(stem));
+        if (duplicate) continue;
+        // A second trunk this close is the same tree's (a multi-stemmed tree, an arc of a
+        // willow's curtain beside its trunk): its points seed that tree too.
+        const auto same_tree = std::find_if(kept.begin(), kept.end(), [&](const Stem& k) {
+            return (k.centre - stem.centre).norm() < options.stem_merge_distance;
+        });
+        if (same_tree != kept.end())
+            same_tree->points.insert(same_tree->points.end(), stem.points.begin(), stem.points.end());
+        else
+            kept.push_back(std::move(stem));
     }
     // Ids in a reproducible spatial order (south to north, then west to east).
     std::sort(kept.begin(), kept.end(), [](const Stem& a, const Stem& b) {

@@ -74,6 +74,10 @@ struct SegmentOptions {
     float stem_slice_low = 1.0f;         // stem slice, metres above ground: from ...
     float stem_slice_high = 2.0f;        // ... to
     float stem_cluster_distance = 0.1f;  // slice points closer than this belong to one cluster (metres)
+    // A cluster that holds no stem is split again at this distance (0 = not): a trunk inside a
+    // curtain of hanging twigs or under limbs that fill the slice (metres).
+    float stem_subcluster_distance = 0.05f;
+    float stem_merge_distance = 1.0f;    // stems closer than this are one tree's (multi-stemmed trees; metres)
     int min_stem_points = 15;            // smaller slice clusters are not stems
     float min_stem_radius = 0.025f;      // accepted circle radii (metres)
     float max_stem_radius = 0.8f;

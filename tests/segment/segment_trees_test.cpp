@@ -31,16 +31,13 @@ ToyTile two_crowns_airborne() {
 
 // Two stems 3 m apart whose ball crowns overlap by 2 m, a bush 4 m from both, dense ground.
 ToyTile two_stems_terrestrial() {
-    ToyTile tile;
-    test::add_ground(tile, -4, 7, -4, 6, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    ToyTile tile = test::flat_ground(-4, 7, -4, 6);
     test::add_stem_and_ball(tile, 0, 0, 0.15f, 8, 2.5f, 0.15f, 1);
     test::add_stem_and_ball(tile, 3, 0, 0.12f, 8, 2.5f, 0.15f, 2);
     for (float z = 0.35f; z <= 1.0f; z += 0.05f)
         for (float y = 3.6f; y <= 4.4f; y += 0.05f)
             for (float x = 1.1f; x <= 1.9f; x += 0.05f) tile.add({x, y, z}, 0);
-    tile.cloud.classification.assign(tile.cloud.size(), 1);
-    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
-        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    test::classify_flat_ground(tile);
     return tile;
 }
 
@@ -128,8 +125,7 @@ TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
 // A broad trunk with a root flare (radius 1.1 m at the ground, 0.8 m at 1 m, 0.6 m from 2.5 m up:
 // no single circle holds the slice 1-2 m above the ground) beside an ordinary stem.
 TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
-    ToyTile tile;
-    test::add_ground(tile, -4, 9, -4, 5, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    ToyTile tile = test::flat_ground(-4, 9, -4, 5);
     for (float z = 0.0f; z <= 8.0f; z += 0.02f) {
         const float radius = 0.6f + 0.5f * std::max(0.0f, 2.5f - z) / 2.5f;
         for (int a = 0; a < 144; ++a) {
@@ -138,9 +134,7 @@ TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
         }
     }
     test::add_stem_and_ball(tile, 5, 0, 0.15f, 8, 2.0f, 0.15f, 2);
-    tile.cloud.classification.assign(tile.cloud.size(), 1);
-    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
-        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    test::classify_flat_ground(tile);
     const Terrain terrain = analyse_terrain(tile.cloud, {});
 
     const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
@@ -163,8 +157,7 @@ TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
 // then lie 0.8 m apart at 0.5 m of height, as if it leaned 58 degrees, while its layers'
 // circles stand one above the other.
 TEST(SegmentTrees, ATrunkHalfHiddenIsFoundByItsLayersCentres) {
-    ToyTile tile;
-    test::add_ground(tile, -4, 5, -4, 5, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    ToyTile tile = test::flat_ground(-4, 5, -4, 5);
     for (float z = 0.0f; z <= 8.0f; z += 0.02f) {
         const float radius = 0.6f + 0.5f * std::max(0.0f, 2.5f - z) / 2.5f;
         const float facing = std::clamp(z - 1.0f, 0.0f, 1.0f) * std::numbers::pi_v<float>;
@@ -174,9 +167,7 @@ TEST(SegmentTrees, ATrunkHalfHiddenIsFoundByItsLayersCentres) {
             tile.add({radius * std::cos(t), radius * std::sin(t), z}, 1);
         }
     }
-    tile.cloud.classification.assign(tile.cloud.size(), 1);
-    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
-        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    test::classify_flat_ground(tile);
     const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), {});
     ASSERT_EQ(result.trees.size(), 1u);
     EXPECT_NEAR(result.trees[0].base.x(), 0.0f, 0.05f);
@@ -196,9 +187,7 @@ TEST(SegmentTrees, AThickTrunkOnASlopeStandsUpright) {
         const float x = 10.0f + 0.75f * std::cos(t), y = 0.75f * std::sin(t);
         for (float z = test::ground_height(x, y, 20.0f, 0.0f); z <= 8.0f; z += 0.02f) tile.add({x, y, z}, 1);
     }
-    tile.cloud.classification.assign(tile.cloud.size(), 1);
-    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
-        if (!tile.truth[i]) tile.cloud.classification[i] = 2;
+    test::classify_ground(tile);
     SegmentOptions whole_slice;
     whole_slice.stem_layer_height = 2.0f;
     const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), whole_slice);
@@ -210,8 +199,7 @@ TEST(SegmentTrees, AThickTrunkOnASlopeStandsUpright) {
 // neighbour (0.1 m). Through the thin tree's short stem the limb's far half (3-5 m out) is
 // nearer than through its own trunk; a thick trunk's paths reach farther, so it stays there.
 TEST(SegmentTrees, ALimbReachingOverAThinNeighbourStaysWithItsTrunk) {
-    ToyTile tile;
-    test::add_ground(tile, -4, 9, -4, 4, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    ToyTile tile = test::flat_ground(-4, 9, -4, 4);
     test::add_stem_and_ball(tile, 0, 0, 0.4f, 6, 2.5f, 0.15f, 1);
     const Eigen::Vector3f limb_start(0.4f, 0, 3), limb_end(5.8f, 0, 3.5f);
     for (float t = 0; t <= 1.0f; t += 0.004f)
@@ -220,9 +208,7 @@ TEST(SegmentTrees, ALimbReachingOverAThinNeighbourStaysWithItsTrunk) {
             tile.add(limb_start + t * (limb_end - limb_start) + Eigen::Vector3f(0, 0.08f * std::cos(angle), 0.08f * std::sin(angle)), 1);
         }
     test::add_stem_and_ball(tile, 6.5f, 0, 0.1f, 3.5f, 1.0f, 0.1f, 2);
-    tile.cloud.classification.assign(tile.cloud.size(), 1);
-    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
-        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    test::classify_flat_ground(tile);
     const Terrain terrain = analyse_terrain(tile.cloud, {});
 
     const auto shares = [&](const SegmentOptions& options) {
@@ -259,13 +245,10 @@ TEST(SegmentTrees, ALimbReachingOverAThinNeighbourStaysWithItsTrunk) {
 // top above the ball stay its own, though a path from the thick stem through the ball and up
 // the thin stem is not much longer.
 TEST(SegmentTrees, ATallThinTreeKeepsItsTopBesideAThickOne) {
-    ToyTile tile;
-    test::add_ground(tile, -4, 6, -4, 4, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    ToyTile tile = test::flat_ground(-4, 6, -4, 4);
     test::add_stem_and_ball(tile, 0, 0, 0.4f, 5, 3.0f, 0.15f, 1);
     test::add_stem_and_ball(tile, 3.15f, 0, 0.1f, 12, 0.8f, 0.1f, 2);
-    tile.cloud.classification.assign(tile.cloud.size(), 1);
-    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
-        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+    test::classify_flat_ground(tile);
     const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), {});
     ASSERT_EQ(result.trees.size(), 2u);
     const std::int32_t thin_id = result.trees[0].base.x() > 1.5f ? 1 : 2;  // the stems stand on one line of y
@@ -276,6 +259,47 @@ TEST(SegmentTrees, ATallThinTreeKeepsItsTopBesideAThickOne) {
             kept += result.tree_id[i] == thin_id;
         }
     EXPECT_EQ(kept, top);
+}
+
+// A trunk (radius 0.15 m) inside a willow's curtain: twigs hanging from 4 m down to 0.6 m on rings
+// 0.23-0.95 m from the axis, 8 cm apart, so that at the 10 cm cluster distance trunk and
+// curtain are one cluster in which the trunk holds an eighth of the points.
+TEST(SegmentTrees, ATrunkInsideACurtainOfTwigsIsAStem) {
+    ToyTile tile = test::flat_ground(-3, 3, -3, 3);
+    test::add_stem_and_ball(tile, 0, 0, 0.15f, 6, 2.0f, 0.15f, 1);
+    for (float ring = 0.23f; ring < 0.96f; ring += 0.08f) {
+        const int twigs = static_cast<int>(2.0f * std::numbers::pi_v<float> * ring / 0.08f);
+        for (int k = 0; k < twigs; ++k) {
+            const float angle = 2.0f * std::numbers::pi_v<float> * (static_cast<float>(k) + 0.5f * ring) / static_cast<float>(twigs);
+            for (float z = 0.6f; z <= 4.0f; z += 0.02f) tile.add({ring * std::cos(angle), ring * std::sin(angle), z}, 1);
+        }
+    }
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].base.head<2>().norm(), 0.0f, 0.03f);
+    EXPECT_NEAR(result.trees[0].stem_radius, 0.15f, 0.01f);
+    SegmentOptions one_split;  // without the second, finer split the curtain hides the trunk
+    one_split.stem_subcluster_distance = 0.0f;
+    EXPECT_TRUE(segment_trees(tile.cloud, terrain, one_split).trees.empty());
+}
+
+// Two trunks 0.6 m apart under one crown (a multi-stemmed tree) are one tree; with no merging,
+// two that share the crown between them.
+TEST(SegmentTrees, TrunksWithinAMetreAreOneTree) {
+    ToyTile tile = test::flat_ground(-3, 4, -3, 3);
+    test::add_stem_and_ball(tile, 0, 0, 0.08f, 5, 2.0f, 0.15f, 1);
+    test::add_stem_and_ball(tile, 0.6f, 0, 0.08f, 5, 0.3f, 0.15f, 1);
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    const SegmentationScore score = score_segmentation(tile.truth, result.tree_id, terrain.height_above_ground, 2.0f);
+    EXPECT_EQ(score.f1, 1.0);
+    SegmentOptions apart;
+    apart.stem_merge_distance = 0.0f;
+    EXPECT_EQ(segment_trees(tile.cloud, terrain, apart).trees.size(), 2u);
 }
 
 TEST(SegmentTrees, AutomaticModeFollowsPointDensity) {
@@ -333,6 +357,14 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
         bad = {};
         bad.stem_layer_height = layer;
         EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
+    }
+    for (const float distance : {-0.01f, 0.1f, std::numeric_limits<float>::quiet_NaN()}) {
+        bad = {};
+        bad.stem_subcluster_distance = distance;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << distance;
+        bad = {};
+        bad.stem_merge_distance = distance < 0.0f || std::isnan(distance) ? distance : std::numeric_limits<float>::infinity();
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << distance;
     }
     for (const float exponent : {-0.5f, 5.0f, std::numeric_limits<float>::quiet_NaN()}) {
         bad = {};

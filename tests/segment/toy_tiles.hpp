@@ -33,6 +33,30 @@ void add_ground(ToyTile& tile, float x0, float x1, float y0, float y1, float spa
             if (!skip(x, y)) tile.add({x, y, ground_height(x, y, slope_deg, roughness)}, 0);
 }
 
+// A tile of flat ground at z = 0 over [x0, x1] x [y0, y1], a return every 5 cm (a terrestrial
+// scan's density), to put trees on.
+inline ToyTile flat_ground(float x0, float x1, float y0, float y1) {
+    ToyTile tile;
+    add_ground(tile, x0, x1, y0, y1, 0.05f, 0.0f, 0.0f, [](float, float) { return false; });
+    return tile;
+}
+
+// Classes as a classified tile has them: every point that is no tree's is ground (2), the rest
+// unclassified (1).
+inline void classify_ground(ToyTile& tile) {
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (!tile.truth[i]) tile.cloud.classification[i] = 2;
+}
+
+// The same for a tile on flat ground at z = 0 that holds other points than trees (a bush): only
+// the points at z = 0 are ground.
+inline void classify_flat_ground(ToyTile& tile) {
+    tile.cloud.classification.assign(tile.cloud.size(), 1);
+    for (std::size_t i = 0; i < tile.cloud.size(); ++i)
+        if (tile.cloud.positions[i].z() <= 0.001f && !tile.truth[i]) tile.cloud.classification[i] = 2;
+}
+
 // Airborne view of a conical crown: surface points on a grid of `spacing`, top at `height`
 // above the ground, falling 2 m per metre of radius, plus a few stem points beneath.
 inline void add_cone_crown(ToyTile& tile, float cx, float cy, float height, float radius, float spacing, float slope_deg, float roughness,
