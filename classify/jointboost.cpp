@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <numeric>
@@ -771,14 +772,27 @@ void save_jointboost(const JointBoostModel& model, const std::filesystem::path& 
 
 namespace {
 
+// A JSON integer as an int. A number that is not an integer, or one outside int's range (JSON
+// allows 1e25), is bad input: converting it as it is would be undefined behaviour.
+int integer_of(const nlohmann::json& value, const std::string& file, const std::string& what) {
+    if (!value.is_number_integer()) throw Error::input(file, what + " is not an integer");
+    const auto wide = value.get<std::int64_t>();
+    if (value.is_number_unsigned() ? value.get<std::uint64_t>() > static_cast<std::uint64_t>(std::numeric_limits<int>::max())
+                                   : wide < std::numeric_limits<int>::min() || wide > std::numeric_limits<int>::max())
+        throw Error::input(file, what + " is out of range");
+    return static_cast<int>(wide);
+}
+
 Stump parse_stump(const nlohmann::json& j, const JointBoostModel& model, const std::string& file, const std::string& where) {
     Stump s;
-    s.feature = j.at("feature").get<int>();
+    s.feature = integer_of(j.at("feature"), file, where + "feature index");
     s.threshold = j.at("threshold").get<double>();
     s.missing_above = j.contains("missing_above") && j.at("missing_above").get<bool>();
     s.a = j.at("a").get<double>();
     s.b = j.at("b").get<double>();
-    s.sharing = j.at("sharing").get<std::vector<int>>();
+    const auto& sharing = j.at("sharing");
+    if (!sharing.is_array()) throw Error::input(file, where + "\"sharing\" is not an array");
+    for (const auto& c : sharing) s.sharing.push_back(integer_of(c, file, where + "class index"));
     s.k = j.at("k").get<std::vector<double>>();
     if (s.feature < 0 || s.feature >= static_cast<int>(model.feature_names.size()))
         throw Error::input(file, where + "feature index out of range");
@@ -859,7 +873,7 @@ JointBoostModel load_jointboost(const std::filesystem::path& path) {
     if (!doc.is_object() || !doc.contains("format") || doc["format"] != "treelobes-jointboost")
         throw Error::input(file, "not a JointBoost model (expected \"format\": \"treelobes-jointboost\")");
     if (!doc.contains("version") || !doc["version"].is_number_integer()) throw Error::input(file, "the model has no integer \"version\"");
-    const int version = doc["version"].get<int>();
+    const int version = integer_of(doc["version"], file, "the model version");
     if (version < 1 || version > kJointBoostModelVersion)
         throw Error::input(file, "model version " + std::to_string(version) + " is not supported (this build reads versions 1 to " +
                                          std::to_string(kJointBoostModelVersion) + ")");

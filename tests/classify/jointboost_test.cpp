@@ -388,7 +388,12 @@ TEST(JointBoost, ModelFileRoundTripsAndRejectsBadFiles) {
     for (const std::string& bad :
          {std::string("{\"format\": 3, \"version\": 1}"), std::string("{\"format\": \"treelobes-jointboost\", \"version\": \"1\"}"),
           std::string("[1, 2]"), std::string(""), text.substr(0, text.size() / 2),
-          std::string(text).replace(text.find("\"k\": ["), 6, "\"k\": [\"x\", ")}) {
+          std::string(text).replace(text.find("\"k\": ["), 6, "\"k\": [\"x\", "),
+          // Numbers no int holds (a fuzzer's find: converting 6.7e25 to int was undefined).
+          std::string(text).replace(text.find("\"feature\": "), 11, "\"feature\": 66666666666666666666666661, \"f\": "),
+          std::string(text).replace(text.find("\"feature\": "), 11, "\"feature\": 1.5, \"f\": "),
+          std::string(text).replace(text.find("\"sharing\": ["), 12, "\"sharing\": [4294967296, "),
+          std::string(text).replace(text.find("\"version\": 3"), 12, "\"version\": 4294967299")}) {
         test::write_text(dir / "bad.jb", bad);
         EXPECT_EQ(test::error_code_of([&] { load_jointboost(dir / "bad.jb"); }), ExitCode::InvalidInput) << bad.substr(0, 80);
     }
