@@ -81,6 +81,15 @@ void add_counts(json& into, const json& from) {
     }
 }
 
+// A count of a tile's summary: 0 when absent. A number that is not an integer (1e30) is no
+// count, and converting it as it is would be undefined: a damaged file.
+long count_in(const json& counts, const char* key, const fs::path& file) {
+    const auto it = counts.find(key);
+    if (it == counts.end()) return 0;
+    if (!it->is_number_integer()) throw Error::input(file.string(), std::string("count \"") + key + "\" is not an integer");
+    return it->get<long>();
+}
+
 // A merged tree's key: its survey-wide id, then its tile (the same id in two tiles is one tree
 // modelled twice, by tiles run without a buffer; both rows are kept and reported).
 using TreeKey = std::pair<std::string, std::string>;
@@ -246,8 +255,8 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
             tile_counts.erase("trees_reused");  // how a tile was resumed, not what it holds
             add_counts(counts, tile_counts);
             tiles.push_back({{"name", tile_of(dir)},
-                             {"trees", tile_counts.value("trees", 0)},
-                             {"trees_failed", tile_counts.value("trees_failed", 0)}});
+                             {"trees", count_in(tile_counts, "trees", dir / "summary.json")},
+                             {"trees_failed", count_in(tile_counts, "trees_failed", dir / "summary.json")}});
             add_csv(csv, dir);
             add_features(features, crs, dir);
             add_forest_trees(forest_trees, csv, dir);

@@ -95,6 +95,7 @@ TEST(SurveyCli, MalformedTileOutputsAreOneLineErrors) {
                      s["buffer"] = {{"trees_at_edge", {1}}};
                  },
                  [](nlohmann::json& s) { s.erase("options"); },
+                 [](nlohmann::json& s) { s["counts"]["trees"] = 1e30; },  // no int holds it
          }) {
         nlohmann::json damaged = summary;
         damage(damaged);
