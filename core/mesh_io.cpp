@@ -1,5 +1,5 @@
 // Mesh files: OBJ through core/obj_mesh_io.cpp and glb through core/glb_mesh_io.cpp (face
-// names), PLY, OFF, STL and OM through OpenMesh. Points are read in double precision so georeferenced meshes keep their precision;
+// names), OFF through core/off_mesh_io.cpp, PLY, STL and OM through OpenMesh. Points are read in double precision so georeferenced meshes keep their precision;
 // the origin is moved into TriangleMesh::origin.
 #include "core/mesh_io.hpp"
 
@@ -9,6 +9,7 @@
 #include "core/georef_sidecar.hpp"
 #include "core/glb_mesh_io.hpp"
 #include "core/obj_mesh_io.hpp"
+#include "core/off_mesh_io.hpp"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
@@ -16,7 +17,6 @@
 
 #include <array>
 #include <charconv>
-#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -111,67 +111,11 @@ void check_ply_header(const fs::path& path, const std::string& name) {
     throw Error::input(name, "PLY header has no end_header line");
 }
 
-// OpenMesh's OFF reader asked for 1.6 GB on a 1.7 kB file with damaged vertex lines (found by
-// fuzzing in CI), so an OFF file is checked first: a header keyword ending in OFF (binary OFF is
-// refused), counts that the file can hold, vertex lines of at least three numbers, and faces of
-// 3 to V corners, each below V.
-void check_off(const fs::path& path, const std::string& name) {
-    std::ifstream in(path, std::ios::binary);
-    std::error_code error;
-    const std::uintmax_t size = fs::file_size(path, error);
-    const auto next_words = [&](const char* what) {
-        std::string line;
-        while (std::getline(in, line)) {
-            std::istringstream words(line);
-            std::vector<std::string> word{std::istream_iterator<std::string>(words), {}};
-            if (!word.empty() && word[0][0] != '#') return word;
-        }
-        throw Error::input(name, std::string("OFF file ends before its ") + what);
-    };
-    const auto number = [&](const std::string& text, const char* what) {
-        double value = 0;
-        const auto [end, status] = std::from_chars(text.data(), text.data() + text.size(), value);
-        if (status != std::errc() || end != text.data() + text.size() || !std::isfinite(value))
-            throw Error::input(name, std::string("OFF ") + what + ": '" + text.substr(0, 32) + "' is not a number");
-        return value;
-    };
-    const auto count = [&](const std::string& text, const char* what, double most) {
-        const double value = number(text, what);
-        if (value < 0 || value != std::floor(value) || value > most)
-            throw Error::input(name, std::string("OFF ") + what + " " + text.substr(0, 32) + " is not a count the file can hold");
-        return static_cast<std::size_t>(value);
-    };
-    std::vector<std::string> word = next_words("header");
-    if (word[0].size() < 3 || word[0].compare(word[0].size() - 3, 3, "OFF") != 0)
-        throw Error::input(name, "OFF file does not start with OFF");
-    if (word.size() > 1 && word[1] == "BINARY") throw Error::input(name, "binary OFF is not supported: convert it to PLY");
-    if (word.size() == 1)
-        word = next_words("counts");
-    else
-        word.erase(word.begin());
-    if (word.size() < 2) throw Error::input(name, "OFF counts line needs the vertex and face counts");
-    const std::size_t vertices = count(word[0], "vertex count", static_cast<double>(size) / 6);
-    const std::size_t faces = count(word[1], "face count", static_cast<double>(size) / 8);
-    for (std::size_t v = 0; v < vertices; ++v) {
-        word = next_words("vertices");
-        if (word.size() < 3) throw Error::input(name, "OFF vertex " + std::to_string(v) + " has fewer than three coordinates");
-        for (int k = 0; k < 3; ++k) number(word[k], "coordinate");
-    }
-    for (std::size_t f = 0; f < faces; ++f) {
-        word = next_words("faces");
-        const std::size_t corners = count(word[0], "corner count", static_cast<double>(vertices));
-        if (corners < 3 || word.size() < corners + 1)
-            throw Error::input(name, "OFF face " + std::to_string(f) + " lists fewer than 3 corners or fewer than it declares");
-        for (std::size_t k = 1; k <= corners; ++k) count(word[k], "corner index", static_cast<double>(vertices) - 1);
-    }
-}
-
-// PLY, OFF, STL, OM. OpenMesh gives non-manifold faces their own vertex copies and skips
+// PLY, STL, OM. OpenMesh gives non-manifold faces their own vertex copies and skips
 // faces with a repeated corner or a corner index out of range.
 NamedMesh read_with_openmesh(const fs::path& path) {
     const std::string name = path.string();
     if (file_extension(path) == "ply") check_ply_header(path, name);
-    if (file_extension(path) == "off") check_off(path, name);
     silence_openmesh();
     PolyMesh mesh;
     OpenMesh::IO::Options options;
@@ -209,6 +153,7 @@ NamedMesh read_named_mesh(const fs::path& path) {
     if (!is_mesh_extension(ext)) throw Error::input(name, "unknown mesh format (expected .obj, .glb, .ply, .off, .stl)");
     if (ext == "obj") return read_obj(path);
     if (ext == "glb") return read_glb(path);
+    if (ext == "off") return read_off(path);
     return read_with_openmesh(path);
 }
 

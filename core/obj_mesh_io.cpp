@@ -4,6 +4,7 @@
 #include "core/error.hpp"
 #include "core/georef_sidecar.hpp"
 #include "core/log.hpp"
+#include "core/text_tokens.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -16,25 +17,6 @@ namespace fs = std::filesystem;
 namespace treelobes {
 
 namespace {
-
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-
-std::string_view trimmed(std::string_view s) {
-    while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-    return s;
-}
-
-// Splits off the next blank-separated token of `line` (empty at the end).
-std::string_view next_token(std::string_view& line) {
-    std::size_t i = 0;
-    while (i < line.size() && is_blank(line[i])) ++i;
-    std::size_t j = i;
-    while (j < line.size() && !is_blank(line[j])) ++j;
-    const std::string_view token = line.substr(i, j - i);
-    line.remove_prefix(j);
-    return token;
-}
 
 // Records that carry nothing a tree rebuild needs.
 bool is_skipped_record(std::string_view keyword) {

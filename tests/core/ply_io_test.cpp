@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <map>
 
 using namespace treelobes;
 using treelobes::test::error_code_of;
@@ -251,19 +252,53 @@ TEST(MeshRead, PlyFormatVersionNotANumberIsBadInputNotAHang) {
               ExitCode::InvalidInput);
 }
 
-// Found by fuzzing: OpenMesh asked for 1.6 GB on a small OFF file whose vertex lines were damaged,
-// and PCL's PCD reader crashed on a header line of binary garbage.
-TEST(MeshRead, DamagedOffIsBadInputBeforeOpenMeshReadsIt) {
+// Found by fuzzing: OpenMesh's OFF reader asked for 1.6 GB on a small OFF file whose vertex lines
+// were damaged (and, after a header check, again on another), so OFF has its own reader.
+TEST(MeshRead, DamagedOffIsBadInput) {
     TempDir dir;
     const std::string vertices = "OFF\n3 1 0\n0 0 0\n1 0 0\n";
-    write_text(dir / "vertex.off", vertices + "0 1 0-05 x\n3 0 1 2\n");
-    write_text(dir / "count.off", "OFF\n99999999 1 0\n0 0 0\n");
-    write_text(dir / "corner.off", vertices + "0 1 0\n3 0 1 7\n");
-    write_text(dir / "binary.off", "OFF BINARY\n");
-    for (const char* file : {"vertex.off", "count.off", "corner.off", "binary.off"})
+    const std::map<std::string, std::string> damaged{
+            {"vertex.off", vertices + "0 1 0-05 x\n3 0 1 2\n"},
+            {"nan.off", vertices + "0 nan 0\n3 0 1 2\n"},
+            {"count.off", "OFF\n99999999 1 0\n0 0 0\n"},
+            {"negative.off", "OFF\n3 -1 0\n0 0 0\n1 0 0\n0 1 0\n"},
+            {"no_face_count.off", "OFF\n3\n0 0 0\n1 0 0\n0 1 0\n"},
+            {"corner.off", vertices + "0 1 0\n3 0 1 7\n"},
+            {"huge_corner_count.off", vertices + "0 1 0\n18446744073709551615 0 1 2\n"},
+            {"short_face.off", vertices + "0 1 0\n4 0 1 2\n"},
+            {"two_corners.off", vertices + "0 1 0\n2 0 1\n"},
+            {"truncated.off", vertices + "0 1 0\n"},
+            {"binary.off", "OFF BINARY\n3 1 0\n"},
+            {"four_d.off", "4OFF\n3 1 0\n0 0 0 1\n1 0 0 1\n0 1 0 1\n3 0 1 2\n"},
+            {"not_off.off", "ply\nformat ascii 1.0\n"},
+    };
+    for (const auto& [file, text] : damaged) {
+        write_text(dir / file, text);
         EXPECT_EQ(error_code_of([&] { read_mesh(dir / file); }), ExitCode::InvalidInput) << file;
-    write_text(dir / "good.off", vertices + "0 1 0\n3 0 1 2\n");
-    EXPECT_EQ(read_mesh(dir / "good.off").faces.size(), 1u);
+    }
+}
+
+// Colours, normals and comments are skipped, the counts may follow the keyword, polygons become
+// fans and a face with a repeated corner is dropped and counted.
+TEST(MeshRead, OffVariantsAreRead) {
+    TempDir dir;
+    write_text(dir / "plain.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+    EXPECT_EQ(read_mesh(dir / "plain.off").faces.size(), 1u);
+    write_text(dir / "coloured.off",
+               "# a comment\nCNOFF 5 3 0\n"
+               "0 0 0  0 0 1  255 0 0 255\n1 0 0  0 0 1  0 255 0 255\n1 1 0 0 0 1 0 0 255 255\n"
+               "0 1 0 0 0 1 9 9 9 255  # trailing comment\n\n5000 5000 5000 0 0 1 1 1 1 255\n"
+               "4 0 1 2 3  0.5 0.5 0.5\n3 0 0 4\n3 2 3 4\n");
+    const NamedMesh mesh = read_named_mesh(dir / "coloured.off");
+    EXPECT_EQ(mesh.mesh.vertex_count(), 5u);
+    EXPECT_EQ(mesh.mesh.face_count(), 3u);
+    EXPECT_EQ(mesh.report.polygons_split, 1u);
+    EXPECT_EQ(mesh.report.degenerate_faces, 1u);
+    EXPECT_EQ(mesh.mesh.faces[2], (std::array<int, 3>{2, 3, 4}));
+    write_text(dir / "utm.off", "OFF\n3 1 0\n512345.25 5400123.5 301\n512346.25 5400123.5 301\n512345.25 5400124.5 301\n3 0 1 2\n");
+    const TriangleMesh utm = read_mesh(dir / "utm.off");
+    EXPECT_EQ(utm.origin, Eigen::Vector3d(512000, 5400000, 0));
+    EXPECT_FLOAT_EQ(utm.vertices[1].x(), 346.25f);
 }
 
 TEST(Pcd, GarbageHeaderLineIsBadInputNotACrash) {
