@@ -86,6 +86,28 @@ TEST(SegmentTrees, AirborneSeparatesTwoCrownsHighestFirst) {
         }
 }
 
+// The tops are found on the smoothed CHM, and a crown whose highest returns ring a lower centre
+// (a palm's fronds, a dip between leaf clumps) has its smoothed maximum over that centre. Its
+// crown must still grow over the higher cells around it: measured against the centre cell's own
+// height they were refused, and the tree kept one cell of its crown.
+TEST(SegmentTrees, AirborneCrownGrowsPastTheHigherCellsAroundASmoothedTop) {
+    ToyTile tile;
+    test::add_ground(tile, 0, 12, 0, 12, 0.3f, 0.0f, 0.0f, [](float, float) { return false; });
+    const float centre = 6.25f;  // the centre of a 0.5 m CHM cell: its highest return is the dip's
+    for (float y = 2.0f; y <= 10.0f; y += 0.2f)
+        for (float x = 2.0f; x <= 10.0f; x += 0.2f) {
+            const float r = std::hypot(x - centre, y - centre);
+            if (r <= 4.0f) tile.add({x, y, r < 0.4f ? 11.5f : 12.0f - 0.25f * r * r}, 1);
+        }
+    test::classify_ground(tile);
+    SegmentOptions options;
+    options.mode = ScanMode::Airborne;
+    const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), options);
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_GT(dominant_ids(tile, result).at(1).second, 0.95);
+    EXPECT_NEAR(result.trees[0].top.z(), 12.0f, 0.1f);
+}
+
 TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
     const ToyTile tile = two_stems_terrestrial();
     const Terrain terrain = analyse_terrain(tile.cloud, {});
