@@ -93,7 +93,7 @@ struct SegmentOptions {
     // the horizontal part of their edge costs: thick trunks, which carry wide crowns, reach
     // farther sideways (0 = all stems alike).
     float stem_reach_exponent = 1.0f;
-    float max_gap = 0.5f;             // longest graph edge (metres): points beyond wider gaps stay 0
+    float max_gap = 1.0f;             // longest graph edge (metres): points beyond wider gaps stay 0
     float ground_clearance = 0.3f;    // points lower than this above the DTM stay out of the graph (metres)
 };
 
