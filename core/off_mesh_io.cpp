@@ -7,7 +7,9 @@
 
 #include <array>
 #include <charconv>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string_view>
 
 namespace fs = std::filesystem;
@@ -30,7 +32,9 @@ public:
         check_keyword(next_token(line));
         if (std::string_view rest = line; next_token(rest) == "BINARY") fail("binary OFF is not supported: convert it to PLY");
         if (line.empty()) line = next_line("counts");
-        const std::size_t vertices = count(next_token(line), "vertex count", text_.size() / kShortestVertexLine);
+        // Faces index vertices with int (TriangleMesh).
+        const std::size_t most_vertices = std::min<std::size_t>(text_.size() / kShortestVertexLine, std::numeric_limits<int>::max());
+        const std::size_t vertices = count(next_token(line), "vertex count", most_vertices);
         const std::size_t faces = count(next_token(line), "face count", text_.size() / kShortestFaceLine);
         read_vertices(vertices);
         read_faces(faces);
@@ -60,7 +64,7 @@ private:
         if (keyword.size() < 3 || keyword.substr(keyword.size() - 3) != "OFF") fail("the file does not start with OFF");
         const std::string_view prefix = keyword.substr(0, keyword.size() - 3);
         if (prefix.find('4') != std::string_view::npos || prefix.find('n') != std::string_view::npos)
-            fail("4D and n-dimensional OFF ('" + std::string(keyword) + "') are not supported");
+            fail("4D and n-dimensional OFF ('" + std::string(keyword.substr(0, 16)) + "') are not supported");
         if (prefix.find_first_not_of("STCN") != std::string_view::npos)
             fail("unknown OFF variant '" + std::string(keyword.substr(0, 16)) + "'");
     }
