@@ -182,14 +182,14 @@ void fill_pits(Raster& chm, float depth) {
     chm.values.swap(out);
 }
 
-// Gaussian smoothing (separable, kernel to 3 sigma) of the CHM the tops are searched on: the
-// leaf clumps of a broad crown make many small maxima that smoothing removes while the peaks of
-// separate crowns stay (Popescu & Wynne 2004, §2.3 smooth their CHM the same way).
 // Cells the smoothing kernel reaches on either side (3 sigma; none without smoothing).
 int smoothing_reach(const Raster& chm, float sigma) {
     return sigma > 0.0f ? std::max(1, static_cast<int>(std::ceil(3.0f * sigma / chm.cell))) : 0;
 }
 
+// Gaussian smoothing (separable, kernel to 3 sigma) of the CHM the tops are searched on: the
+// leaf clumps of a broad crown make many small maxima that smoothing removes while the peaks of
+// separate crowns stay (Popescu & Wynne 2004, §2.3 smooth their CHM the same way).
 Raster smoothed(const Raster& chm, float sigma) {
     if (sigma <= 0.0f) return chm;
     const float s = sigma / chm.cell;
