@@ -78,6 +78,15 @@ private:
         return static_cast<std::size_t>(value);
     }
 
+    int corner(std::string_view token, std::size_t face, std::size_t vertices) const {
+        unsigned long long value = 0;
+        const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+        if (error != std::errc() || end != token.data() + token.size() || value >= vertices)
+            fail("face " + std::to_string(face) + " refers to vertex '" + std::string(token.substr(0, 32)) + "' but the file has " +
+                 std::to_string(vertices) + " vertices (0-based)");
+        return static_cast<int>(value);
+    }
+
     double coordinate(std::string_view token, std::size_t vertex) const {
         double value = 0;
         const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
@@ -111,7 +120,7 @@ private:
             for (std::size_t k = 0; k < declared; ++k) {
                 const std::string_view token = next_token(line);
                 if (token.empty()) fail("face " + std::to_string(f) + " lists fewer corners than it declares");
-                corners_.push_back(static_cast<int>(this->count(token, "corner index", vertices - 1)));
+                corners_.push_back(corner(token, f, vertices));
             }
             add_fan(corners_);
         }
