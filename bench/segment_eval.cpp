@@ -108,6 +108,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"chm_smoothing", &o.chm_smoothing},
                                                   {"max_stem_lean", &o.max_stem_lean},
                                                   {"stem_layer_height", &o.stem_layer_height},
+                                                  {"trunk_layer_height", &o.trunk_layer_height},
                                                   {"graph_beta", &o.graph_beta},
                                                   {"stem_reach_exponent", &o.stem_reach_exponent},
                                                   {"stem_subcluster_distance", &o.stem_subcluster_distance},

@@ -1,6 +1,7 @@
 #include "segment/segment_trees.hpp"
 
 #include "core/error.hpp"
+#include "geometry/euclidean_clusters.hpp"
 #include "geometry/kd_tree.hpp"
 #include "geometry/neighbour_graph.hpp"
 #include "geometry/ransac_fit.hpp"
@@ -64,6 +65,8 @@ void check_options(const SegmentOptions& o) {
     // of slice height / layer height must stay small.
     if (!(o.stem_layer_height >= 0.05f && o.stem_layer_height <= 10.0f))
         throw Error::usage("segment: stem layer height must be in 0.05..10 metres");
+    if (!(o.trunk_layer_height >= 0.05f && o.trunk_layer_height <= 10.0f))
+        throw Error::usage("segment: trunk layer height must be in 0.05..10 metres");
     positive(o.graph_voxel, "graph voxel");
     if (o.graph_neighbours < 2 || o.graph_neighbours > 64) throw Error::usage("segment: graph neighbours must be in 2..64");
     positive(o.max_gap, "max gap");
@@ -443,23 +446,9 @@ std::vector<std::vector<int>> cluster_slice(const PointCloud& cloud, const std::
     std::vector<Eigen::Vector3f> points;
     points.reserve(slice.size());
     for (int i : slice) points.push_back(cloud.positions[static_cast<std::size_t>(i)]);
-    std::vector<std::vector<int>> clusters;
-    if (points.empty()) return clusters;
-    const KdTree index(points);
-    UnionFind sets(points.size());
-    std::vector<int> near;
-    std::vector<float> squared;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        index.radius_search(points[i], distance, near, squared, 16);
-        for (int j : near) sets.unite(static_cast<int>(i), j);
-    }
-    std::unordered_map<int, std::size_t> cluster_of_root;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const int root = sets.find(static_cast<int>(i));
-        const auto [it, added] = cluster_of_root.emplace(root, clusters.size());
-        if (added) clusters.emplace_back();
-        clusters[it->second].push_back(slice[i]);
-    }
+    std::vector<std::vector<int>> clusters = euclidean_clusters(points, distance);
+    for (auto& cluster : clusters)
+        for (int& member : cluster) member = slice[static_cast<std::size_t>(member)];
     return clusters;
 }
 
@@ -558,6 +547,59 @@ std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vecto
     return stem;
 }
 
+// A thin trunk followed up from the bottom of the slice, layer by layer, for as long as its
+// layers hold circles of about one radius, each within a radius and the circle band of the one
+// below (a leaning trunk moves by tan(lean) x the layer height between layers); two layers in a
+// row that do not continue it end it. Where twigs and leaves start the layers hold other
+// circles. nullopt unless the trunk is followed over `min_layers` layers.
+std::optional<Stem> follow_trunk_up(const PointCloud& cloud, const std::vector<int>& cluster, float low, float high, int min_layers,
+                                    const SegmentOptions& options) {
+    const float height = options.trunk_layer_height;
+    const int count = std::max(1, static_cast<int>(std::ceil((high - low) / height)));
+    std::vector<std::vector<Eigen::Vector2f>> layers(static_cast<std::size_t>(count));
+    std::vector<std::vector<int>> layer_points(static_cast<std::size_t>(count));
+    for (int i : cluster) {
+        const Eigen::Vector3f& p = cloud.positions[static_cast<std::size_t>(i)];
+        const auto k = static_cast<std::size_t>(std::min(count - 1, static_cast<int>((p.z() - low) / height)));
+        layers[k].push_back(p.head<2>());
+        layer_points[k].push_back(i);
+    }
+    std::vector<CircleFit> run;
+    Stem trunk;
+    int missed = 0;  // layers in a row that did not continue the trunk
+    for (std::size_t k = 0; k < layers.size() && missed < 2; ++k) {
+        const CircleFit circle =
+                static_cast<int>(layers[k].size()) < options.min_stem_points
+                        ? CircleFit{}
+                        : fit_circle(layers[k], options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
+        bool continues = circle_holds(circle, layers[k].size(), options);
+        if (continues && !run.empty()) {
+            const CircleFit& below = run.back();
+            const bool same_radius = circle.radius <= 1.5f * below.radius && below.radius <= 1.5f * circle.radius;
+            continues = same_radius && (circle.centre - below.centre).norm() <= below.radius + options.circle_tolerance;
+        }
+        if (!continues) {
+            missed += !run.empty();
+            continue;
+        }
+        missed = 0;
+        run.push_back(circle);
+        for (std::size_t j = 0; j < layers[k].size(); ++j)
+            if (std::abs((layers[k][j] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance)
+                trunk.points.push_back(layer_points[k][j]);
+    }
+    if (static_cast<int>(run.size()) < min_layers) return std::nullopt;
+    std::vector<float> radii;
+    for (const CircleFit& c : run) {
+        radii.push_back(c.radius);
+        trunk.inliers += c.inliers;
+    }
+    std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+    trunk.radius = radii[radii.size() / 2];
+    trunk.centre = run.front().centre;
+    return trunk;
+}
+
 // A slice cluster is a stem when it spans most of the slice height and a circle of a plausible
 // radius holds enough of its points around enough of its circumference (Liang et al. 2012, §2.2),
 // standing upright, over the slice's height or else layer by layer (a tapering trunk, or one
@@ -582,8 +624,16 @@ std::optional<Stem> fit_stem(const PointCloud& cloud, const std::vector<float>& 
         std::vector<int> on_circle;
         for (std::size_t k = 0; k < cluster.size(); ++k)
             if (std::abs((xy[k] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circle.push_back(cluster[k]);
-        if (upright(above_ground(cloud, height_above_ground, on_circle), options.max_stem_lean))
+        if (upright(above_ground(cloud, height_above_ground, on_circle), options.max_stem_lean)) {
+            // A thin trunk that leans (a crape myrtle's trunks part at 12-24 degrees) is smeared
+            // over the slice's height, and with the twigs it carries it holds a circle several
+            // times its radius; thin layers of it hold its own.
+            const float quarter_slice = 0.25f * (options.stem_slice_high - options.stem_slice_low);
+            const int min_layers = static_cast<int>(std::ceil(quarter_slice / options.trunk_layer_height));
+            std::optional<Stem> trunk = follow_trunk_up(cloud, cluster, low, high, min_layers, options);
+            if (trunk && trunk->radius < 0.5f * circle.radius) return trunk;
             return Stem{circle.centre, circle.radius, circle.inliers, std::move(on_circle)};
+        }
     }
     // Points that lean may be a trunk whose visible arc turns with height (occlusion): its
     // layers' circles tell.
@@ -636,6 +686,7 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
     }
     std::stable_sort(stems.begin(), stems.end(), [](const Stem& a, const Stem& b) { return a.inliers > b.inliers; });
     std::vector<Stem> kept;
+    std::vector<float> squared_radii;  // of each kept tree's trunks
     for (auto& stem : stems) {
         const bool duplicate = std::any_of(kept.begin(), kept.end(), [&](const Stem& k) {
             return (k.centre - stem.centre).norm() < std::max(k.radius, stem.radius) + options.circle_tolerance;
@@ -646,11 +697,20 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
         const auto same_tree = std::find_if(kept.begin(), kept.end(), [&](const Stem& k) {
             return (k.centre - stem.centre).norm() < options.stem_merge_distance;
         });
-        if (same_tree != kept.end())
+        if (same_tree != kept.end()) {
+            // The trunks of one root collar are alike; a wider circle beside a trunk is an arc
+            // of its curtain of twigs or a limb, which adds nothing to its cross-section.
+            if (stem.radius <= 1.5f * same_tree->radius)
+                squared_radii[static_cast<std::size_t>(same_tree - kept.begin())] += stem.radius * stem.radius;
             same_tree->points.insert(same_tree->points.end(), stem.points.begin(), stem.points.end());
-        else
+        } else {
+            squared_radii.push_back(stem.radius * stem.radius);
             kept.push_back(std::move(stem));
+        }
     }
+    // A multi-stemmed tree is as wide as the one stem of the same cross-section (its
+    // equivalent diameter): sqrt(sum r^2).
+    for (std::size_t k = 0; k < kept.size(); ++k) kept[k].radius = std::sqrt(squared_radii[k]);
     // Ids in a reproducible spatial order (south to north, then west to east).
     std::sort(kept.begin(), kept.end(), [](const Stem& a, const Stem& b) {
         return a.centre.y() != b.centre.y() ? a.centre.y() < b.centre.y() : a.centre.x() < b.centre.x();

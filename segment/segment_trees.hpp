@@ -86,6 +86,7 @@ struct SegmentOptions {
     float min_arc_coverage = 0.2f;    // share of the circle's 10-degree sectors that hold inliers
     float max_stem_lean = 30.0f;      // degrees from vertical between the lower and upper half of a stem's slice points
     float stem_layer_height = 0.25f;  // a tapering trunk: circles fitted layer by layer, this thick (metres)
+    float trunk_layer_height = 0.1f;  // a thin, leaning trunk under twigs: layers this thick (metres)
     float graph_voxel = 0.1f;         // voxel edge of the thinned cloud the plot graph is built on (metres)
     int graph_neighbours = 10;        // k of the kNN graph
     float graph_beta = 2.0f;          // an edge costs length^beta: > 1 makes jumps across the sparse contact of two crowns dear

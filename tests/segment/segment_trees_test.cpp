@@ -331,8 +331,8 @@ TEST(SegmentTrees, ATrunkInsideACurtainOfTwigsIsAStem) {
     EXPECT_TRUE(segment_trees(tile.cloud, terrain, one_split).trees.empty());
 }
 
-// Two trunks 0.6 m apart under one crown (a multi-stemmed tree) are one tree; with no merging,
-// two that share the crown between them.
+// Two trunks 0.6 m apart under one crown (a multi-stemmed tree) are one tree, as wide as the two
+// together; with no merging, two that share the crown between them.
 TEST(SegmentTrees, TrunksWithinAMetreAreOneTree) {
     ToyTile tile = test::flat_ground(-3, 4, -3, 3);
     test::add_stem_and_ball(tile, 0, 0, 0.08f, 5, 2.0f, 0.15f, 1);
@@ -341,11 +341,60 @@ TEST(SegmentTrees, TrunksWithinAMetreAreOneTree) {
     const Terrain terrain = analyse_terrain(tile.cloud, {});
     const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
     ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].stem_radius, std::hypot(0.08f, 0.08f), 0.01f);  // their equivalent radius
     const SegmentationScore score = score_segmentation(tile.truth, result.tree_id, terrain.height_above_ground, 2.0f);
     EXPECT_EQ(score.f1, 1.0);
     SegmentOptions apart;
     apart.stem_merge_distance = 0.0f;
     EXPECT_EQ(segment_trees(tile.cloud, terrain, apart).trees.size(), 2u);
+}
+
+// A multi-stemmed tree (a crape myrtle's): three trunks of 5 cm rising from one root collar at
+// 18 degrees from vertical, each fanning out into a vase of upright twigs from 1.4 m, a crown
+// above. A circle through the whole 1-2 m slice is the ring of the twigs, six times a trunk's
+// radius; followed up from the bottom in thin layers each trunk is its own 5 cm. The tree is as
+// wide as one stem of the same cross-section: sqrt(3) x 5 cm.
+TEST(SegmentTrees, AMultiStemmedTreeIsAsWideAsItsTrunksTogether) {
+    ToyTile tile = test::flat_ground(-3, 3, -3, 3);
+    const float lean = std::tan(18.0f * std::numbers::pi_v<float> / 180.0f);
+    const auto around = [](float radius, int k, int count) {
+        const float t = static_cast<float>(k) * 2.0f * std::numbers::pi_v<float> / static_cast<float>(count);
+        return Eigen::Vector2f(radius * std::cos(t), radius * std::sin(t));
+    };
+    for (int trunk = 0; trunk < 3; ++trunk) {
+        const Eigen::Vector2f away = around(1.0f, trunk, 3);
+        for (float z = 0.0f; z <= 2.5f; z += 0.02f)
+            for (int a = 0; a < 36; ++a) {
+                const Eigen::Vector2f p = lean * z * away + around(0.05f, a, 36);
+                tile.add({p.x(), p.y(), z}, 1);
+            }
+        const Eigen::Vector2f vase_centre = lean * 1.4f * away;
+        for (int twig = 0; twig < 24; ++twig) {
+            for (float r = 0.05f; r < 0.3f; r += 0.02f) {  // from the trunk out ...
+                const Eigen::Vector2f p = vase_centre + around(r, twig, 24);
+                tile.add({p.x(), p.y(), 1.4f}, 1);
+            }
+            for (float z = 1.4f; z <= 2.5f; z += 0.005f) {  // ... and up
+                const Eigen::Vector2f p = vase_centre + around(0.3f, twig, 24);
+                tile.add({p.x(), p.y(), z}, 1);
+            }
+        }
+    }
+    for (float z = -1.2f; z <= 1.2f; z += 0.15f)  // the crown, a ball over the trunks' tops
+        for (float y = -1.2f; y <= 1.2f; y += 0.15f)
+            for (float x = -1.2f; x <= 1.2f; x += 0.15f)
+                if (x * x + y * y + z * z <= 1.44f) tile.add({x, y, 3.5f + z}, 1);
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].stem_radius, std::sqrt(3.0f) * 0.05f, 0.015f);
+    SegmentOptions whole_slice;  // one trunk layer over the whole slice: the twigs' ring
+    whole_slice.trunk_layer_height = 2.0f;
+    const TreeSegmentation ring = segment_trees(tile.cloud, terrain, whole_slice);
+    ASSERT_EQ(ring.trees.size(), 1u);
+    EXPECT_GT(ring.trees[0].stem_radius, 0.25f);
 }
 
 TEST(SegmentTrees, AutomaticModeFollowsPointDensity) {
@@ -402,6 +451,9 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     for (const float layer : {0.0f, 1e-9f, 100.0f, std::numeric_limits<float>::quiet_NaN()}) {
         bad = {};
         bad.stem_layer_height = layer;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
+        bad = {};
+        bad.trunk_layer_height = layer;
         EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
     }
     for (const float distance : {-0.01f, 0.1f, std::numeric_limits<float>::quiet_NaN()}) {
