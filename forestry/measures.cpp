@@ -1,6 +1,7 @@
 #include "forestry/measures.hpp"
 
 #include "core/error.hpp"
+#include "geometry/euclidean_clusters.hpp"
 #include "geometry/grid_thinning.hpp"
 #include "geometry/ransac_fit.hpp"
 #include "geometry/alpha_shape.hpp"
@@ -47,6 +48,104 @@ DbhMeasure not_visible(DbhMeasure m, std::string reason) {
     return m;
 }
 
+CircleFit fit_stem_circle(std::span<const Eigen::Vector2f> slice, const DbhOptions& options) {
+    return fit_circle(slice, static_cast<float>(options.fit_tolerance), static_cast<float>(options.min_radius),
+                      static_cast<float>(options.max_radius));
+}
+
+// Why a circle fitted to breast-height points is not a stem, or empty when it is one.
+std::string stem_problem(const CircleFit& fit, std::span<const Eigen::Vector2f> slice, const DbhOptions& options) {
+    if (fit.inliers < options.min_inliers) return "too few points on the fitted circle";
+    if (fit.rms > options.max_relative_rms * fit.radius) return "the breast-height points do not lie on a circle";
+    // A scanned stem is hollow: its points lie on the bark. Points filling the circle are
+    // foliage or undergrowth, on which RANSAC also finds some circle.
+    std::size_t interior = 0;
+    for (const auto& p : slice) interior += (p - fit.centre).norm() < options.hollow_fraction * fit.radius;
+    if (static_cast<double>(interior) > options.max_interior_share * static_cast<double>(fit.inliers))
+        return "the breast-height points fill the circle (foliage or undergrowth, not a stem)";
+    if (fit.coverage < options.min_coverage) return "the stem is seen over less than a quarter of its circumference";
+    return {};
+}
+
+// The trunks at breast height, each a circle fitted to its own points: the slice's clusters,
+// trunk_gap apart, that hold a circle passing every check of a stem. Clusters whose circles
+// overlap are arcs of one trunk split by occlusion and are fitted together. A trunk much
+// narrower than the widest (under 1 / 1.5 of its radius) is a limb or a sapling beside it, not
+// a trunk of the same root collar, whose trunks are alike: two or more trunks left may be a
+// multi-stemmed tree (a crape myrtle's, a coppiced tree's), whose trunks fitted all at once give
+// a ring through them.
+std::vector<CircleFit> separate_trunks(std::span<const Eigen::Vector2f> slice, const DbhOptions& options) {
+    std::vector<Eigen::Vector3f> flat;
+    for (const auto& p : slice) flat.emplace_back(p.x(), p.y(), 0.0f);
+    struct Trunk {
+        CircleFit circle;
+        std::vector<Eigen::Vector2f> points;
+    };
+    std::vector<Trunk> arcs;
+    for (const std::vector<int>& cluster : euclidean_clusters(flat, static_cast<float>(options.trunk_gap))) {
+        if (cluster.size() < options.min_inliers) continue;
+        Trunk arc;
+        for (int i : cluster) arc.points.push_back(slice[static_cast<std::size_t>(i)]);
+        arc.circle = fit_stem_circle(arc.points, options);
+        if (arc.circle.ok && stem_problem(arc.circle, arc.points, options).empty()) arcs.push_back(std::move(arc));
+    }
+    std::stable_sort(arcs.begin(), arcs.end(), [](const Trunk& a, const Trunk& b) { return a.circle.inliers > b.circle.inliers; });
+    std::vector<Trunk> trunks;
+    for (Trunk& arc : arcs) {
+        const auto same_trunk = std::find_if(trunks.begin(), trunks.end(), [&](const Trunk& t) {
+            return (t.circle.centre - arc.circle.centre).norm() <= t.circle.radius + arc.circle.radius;
+        });
+        if (same_trunk == trunks.end())
+            trunks.push_back(std::move(arc));
+        else
+            same_trunk->points.insert(same_trunk->points.end(), arc.points.begin(), arc.points.end());
+    }
+    std::vector<CircleFit> circles;
+    for (const Trunk& trunk : trunks) {
+        const CircleFit whole = fit_stem_circle(trunk.points, options);
+        circles.push_back(whole.ok && stem_problem(whole, trunk.points, options).empty() ? whole : trunk.circle);
+    }
+    float widest = 0.0f;
+    for (const CircleFit& circle : circles) widest = std::max(widest, circle.radius);
+    std::erase_if(circles, [&](const CircleFit& circle) { return circle.radius < widest / 1.5f; });
+    return circles;
+}
+
+// A trunk continues down from breast height toward the root collar; the hanging twigs of a
+// willow's curtain, which can form circles of a trunk's size at breast height, end above the
+// ground. The trunk may lean (a crape myrtle's trunks part from one collar at up to 30 degrees),
+// so its points are looked for in a cone that widens downward, and some must lie in the lower
+// half of the way down to half the breast height.
+bool reaches_down(const CircleFit& trunk, std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
+                  const DbhOptions& options) {
+    const double slope = std::tan(options.max_trunk_lean * std::numbers::pi / 180.0);
+    const double top = options.breast_height - options.slice_half_width, bottom = 0.5 * options.breast_height;
+    std::size_t low_points = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const double hag = height_above_ground[i];
+        if (hag < bottom || hag >= 0.5 * (top + bottom)) continue;
+        const double reach = trunk.radius + options.fit_tolerance + (options.breast_height - hag) * slope;
+        low_points += (points[i].head<2>() - trunk.centre).norm() <= reach;
+    }
+    return low_points >= options.min_inliers;
+}
+
+DbhMeasure multi_stem(DbhMeasure m, const std::vector<CircleFit>& trunks, const DbhOptions& options) {
+    double squared_radii = 0.0;
+    m.coverage = 1.0;
+    m.centre.setZero();
+    for (const CircleFit& trunk : trunks) {
+        squared_radii += static_cast<double>(trunk.radius) * trunk.radius;
+        m.centre += trunk.centre.cast<double>() / static_cast<double>(trunks.size());
+        m.coverage = std::min(m.coverage, static_cast<double>(trunk.coverage));
+        m.rms = std::max(m.rms, static_cast<double>(trunk.rms));
+    }
+    m.quality = m.coverage >= options.ok_coverage ? DbhQuality::Ok : DbhQuality::PartialArc;
+    m.diameter = 2.0 * std::sqrt(squared_radii);
+    m.stems = static_cast<int>(trunks.size());
+    return m;
+}
+
 }  // namespace
 
 DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
@@ -61,23 +160,20 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
     m.slice_points = slice.size();
     if (slice.size() < options.min_inliers)
         return not_visible(m, "fewer than " + std::to_string(options.min_inliers) + " points at breast height");
-    const CircleFit fit = fit_circle(slice, static_cast<float>(options.fit_tolerance), static_cast<float>(options.min_radius),
-                                     static_cast<float>(options.max_radius));
+    const std::vector<CircleFit> trunks = separate_trunks(slice, options);
+    if (trunks.size() >= 2 && std::all_of(trunks.begin(), trunks.end(), [&](const CircleFit& trunk) {
+            return reaches_down(trunk, points, height_above_ground, options);
+        }))
+        return multi_stem(m, trunks, options);
+    const CircleFit fit = fit_stem_circle(slice, options);
     if (!fit.ok) return not_visible(m, "no circle fits the breast-height points");
     m.centre = fit.centre.cast<double>();
     m.coverage = fit.coverage;
     m.rms = fit.rms;
-    if (fit.inliers < options.min_inliers) return not_visible(m, "too few points on the fitted circle");
-    if (fit.rms > options.max_relative_rms * fit.radius) return not_visible(m, "the breast-height points do not lie on a circle");
-    // A scanned stem is hollow: its points lie on the bark. Points filling the circle are
-    // foliage or undergrowth, on which RANSAC also finds some circle.
-    std::size_t interior = 0;
-    for (const auto& p : slice) interior += (p - fit.centre).norm() < options.hollow_fraction * fit.radius;
-    if (static_cast<double>(interior) > options.max_interior_share * static_cast<double>(fit.inliers))
-        return not_visible(m, "the breast-height points fill the circle (foliage or undergrowth, not a stem)");
-    if (fit.coverage < options.min_coverage) return not_visible(m, "the stem is seen over less than a quarter of its circumference");
+    if (const std::string problem = stem_problem(fit, slice, options); !problem.empty()) return not_visible(m, problem);
     m.quality = fit.coverage >= options.ok_coverage ? DbhQuality::Ok : DbhQuality::PartialArc;
     m.diameter = 2.0 * fit.radius;
+    m.stems = 1;
     return m;
 }
 

@@ -16,7 +16,8 @@ namespace treelobes::forestry {
 
 // How a DBH was obtained: `Ok` a circle fitted to stem points seen around most of the stem,
 // `PartialArc` a circle fitted to one side only (a number, less certain), `NotVisible` no stem
-// at breast height in the scan (no number).
+// at breast height in the scan (no number). A multi-stemmed tree's DBH is `Ok` when every
+// trunk's circle is.
 enum class DbhQuality { Ok, PartialArc, NotVisible };
 const char* dbh_quality_name(DbhQuality quality);
 
@@ -32,19 +33,26 @@ struct DbhOptions {
     double max_relative_rms = 0.25;    // rms / radius above this: not a stem (branch clutter, leaves)
     double hollow_fraction = 0.6;      // points closer to the centre than this many radii are inside the stem...
     double max_interior_share = 0.25;  // ...and more of them than this share of the inliers: not a stem
+    double trunk_gap = 0.1;            // metres: breast-height points this far apart belong to different trunks
+    double max_trunk_lean = 30.0;      // degrees: how far a multi-stemmed tree's trunk may lean below breast height
 };
 
 struct DbhMeasure {
     DbhQuality quality = DbhQuality::NotVisible;
-    std::optional<double> diameter;  // metres; set for Ok and PartialArc
-    Eigen::Vector2d centre{0, 0};    // local frame, when a circle was fitted
-    double coverage = 0.0;           // of the fitted circle (0 when none)
-    double rms = 0.0;                // metres
-    std::size_t slice_points = 0;    // points in the breast-height slice near the base
-    std::string reason;              // why not_visible, or empty
+    // Metres; set for Ok and PartialArc. For a multi-stemmed tree the equivalent diameter, that
+    // of the one stem of the same cross-section: sqrt(sum of the trunks' diameters squared).
+    std::optional<double> diameter;
+    int stems = 0;                 // trunks at breast height the diameter covers (0 when not visible)
+    Eigen::Vector2d centre{0, 0};  // local frame, when a circle was fitted (a multi-stemmed tree: its trunks' mean)
+    double coverage = 0.0;         // of the fitted circle (0 when none; the least of a multi-stemmed tree's)
+    double rms = 0.0;              // metres (the largest of a multi-stemmed tree's)
+    std::size_t slice_points = 0;  // points in the breast-height slice near the base
+    std::string reason;            // why not_visible, or empty
 };
 
-// `base` is the stem base in the local frame (its x, y limit the search).
+// `base` is the stem base in the local frame (its x, y limit the search). Breast-height points
+// that fall apart into two or more trunks, each holding a circle, alike in radius and not
+// overlapping, are a multi-stemmed tree; otherwise one circle is fitted to all of them.
 DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground, const Eigen::Vector3d& base,
                        const DbhOptions& options = {});
 

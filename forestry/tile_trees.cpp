@@ -58,6 +58,7 @@ json row_properties(const TreeRow& row, const Eigen::Vector3d& origin) {
             {"height_m", value_or_null(m.height, 2)},
             {"dbh_m", value_or_null(m.dbh.diameter, 3)},
             {"dbh_quality", dbh_quality_name(m.dbh.quality)},
+            {"stems", m.dbh.stems > 0 ? json(m.dbh.stems) : json(nullptr)},
             {"crown_base_height_m", value_or_null(m.crown.base_height, 2)},
             {"crown_diameter_m", value_or_null(m.crown.diameter, 2)},
             {"crown_area_m2", value_or_null(m.crown.projected_area, 2)},
@@ -132,16 +133,17 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
 
 std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin) {
     std::string csv =
-            "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
+            "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,stems,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
             "woody_volume_m3,species,species_confidence,points,lobes,model\n";
     for (const TreeRow& row : rows) {
         const TreeMeasures& m = row.measures;
         const Eigen::Vector3d p = origin + m.position;
         csv += row.global_id + "," + std::to_string(m.id) + "," + fixed(p.x(), 3) + "," + fixed(p.y(), 3) + "," + fixed(p.z(), 3) + "," +
                fixed(m.height, 2) + "," + cell(m.dbh.diameter, 3) + "," + dbh_quality_name(m.dbh.quality) + "," +
-               cell(m.crown.base_height, 2) + "," + cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," +
-               cell(m.crown.volume, 2) + "," + cell(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," +
-               std::to_string(m.points) + "," + (row.modelled ? std::to_string(row.lobes) : std::string()) + "," + model_name(row) + "\n";
+               (m.dbh.stems > 0 ? std::to_string(m.dbh.stems) : std::string()) + "," + cell(m.crown.base_height, 2) + "," +
+               cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," + cell(m.crown.volume, 2) + "," +
+               cell(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," + std::to_string(m.points) + "," +
+               (row.modelled ? std::to_string(row.lobes) : std::string()) + "," + model_name(row) + "\n";
     }
     return csv;
 }
@@ -170,6 +172,7 @@ std::string tree_record(const TreeRow& row, const Eigen::Vector3d& origin, const
                        {"dbh",
                         {{"quality", dbh_quality_name(m.dbh.quality)},
                          {"diameter", optional_json(m.dbh.diameter)},
+                         {"stems", m.dbh.stems},
                          {"centre", {m.dbh.centre.x(), m.dbh.centre.y()}},
                          {"coverage", m.dbh.coverage},
                          {"rms", m.dbh.rms},
@@ -204,6 +207,7 @@ std::optional<TreeRow> read_tree_record(const std::string& text, const std::stri
         const json& dbh = e.at("dbh");
         m.dbh.quality = parse_quality(dbh.at("quality").get<std::string>());
         m.dbh.diameter = optional_from(dbh.at("diameter"));
+        m.dbh.stems = dbh.at("stems").get<int>();
         const auto centre = dbh.at("centre").get<std::vector<double>>();
         m.dbh.centre = {centre.at(0), centre.at(1)};
         m.dbh.coverage = dbh.at("coverage").get<double>();

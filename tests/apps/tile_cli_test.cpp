@@ -83,7 +83,7 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
     // One row, one feature, one forest tree and one set of files per tree.
     const auto csv = lines_of(slurp(dir / "out" / "trees.csv"));
     ASSERT_EQ(csv.size(), static_cast<std::size_t>(trees + 1));
-    EXPECT_EQ(csv[0].rfind("global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,", 0), 0u);
+    EXPECT_EQ(csv[0].rfind("global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,stems,", 0), 0u);
     const auto geojson = nlohmann::json::parse(slurp(dir / "out" / "trees.geojson"));
     ASSERT_EQ(geojson["features"].size(), static_cast<std::size_t>(trees));
     EXPECT_EQ(geojson["crs_wkt"], kWkt);
@@ -105,6 +105,8 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
         EXPECT_GT(xyz[1].get<double>(), 5400000.0);
         EXPECT_GT(feature["properties"]["height_m"].get<double>(), 2.0);
         EXPECT_TRUE(feature["properties"]["dbh_quality"].is_string());
+        const bool measured = feature["properties"]["dbh_quality"] != "not_visible";
+        EXPECT_EQ(feature["properties"]["stems"].is_number_integer(), measured);  // trunks the DBH covers, null when none
     }
     for (const char* file : {"dtm.asc", "hillshade.png", "top_view.png", "points.las"}) EXPECT_TRUE(fs::exists(dir / "out" / file)) << file;
 

@@ -1,5 +1,5 @@
 // Forestry measures on clouds with known answers: a stem cylinder seen all round, from one
-// side, or not at all; a cone crown; the cylinders of a two-node skeleton.
+// side, or not at all; the trunks of a multi-stemmed tree; a cone crown; the cylinders of a two-node skeleton.
 #include "forestry/measures.hpp"
 
 #include <gtest/gtest.h>
@@ -55,6 +55,43 @@ TEST(Dbh, FullCylinderIsOkWithItsDiameter) {
     EXPECT_NEAR(m.centre.x(), 3.0, 0.01);
     EXPECT_NEAR(m.centre.y(), -2.0, 0.01);
     EXPECT_GT(m.coverage, 0.9);
+    EXPECT_EQ(m.stems, 1);
+}
+
+// Three trunks of 5-6 cm, 0.35 m from the tree's centre (a crape myrtle's): each its own circle,
+// the tree's DBH the equivalent diameter of the three.
+TEST(Dbh, AMultiStemmedTreeGivesTheEquivalentDiameterOfItsTrunks) {
+    std::mt19937 random(5);
+    TreeCloud cloud;
+    const double radii[] = {0.05, 0.06, 0.055};
+    for (int k = 0; k < 3; ++k) {
+        const double a = 2 * std::numbers::pi * k / 3;
+        add_stem(cloud, 1.0 + 0.35 * std::cos(a), 0.35 * std::sin(a), radii[k], 3.0, 2 * std::numbers::pi, random);
+    }
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {1.0, 0.0, 0.0});
+    EXPECT_EQ(m.quality, DbhQuality::Ok) << m.reason;
+    EXPECT_EQ(m.stems, 3);
+    ASSERT_TRUE(m.diameter);
+    EXPECT_NEAR(*m.diameter, 2 * std::sqrt(0.05 * 0.05 + 0.06 * 0.06 + 0.055 * 0.055), 0.01);
+    EXPECT_NEAR(m.centre.x(), 1.0, 0.01);
+    EXPECT_NEAR(m.centre.y(), 0.0, 0.01);
+}
+
+// A 15 cm trunk with a curtain of hanging twigs beside it that ends 1 m above the ground (a
+// willow's): at breast height the curtain's bundle holds a circle like the trunk's, but it does
+// not reach down. One stem.
+TEST(Dbh, ATwigBundleBesideATrunkIsNotASecondStem) {
+    std::mt19937 random(6);
+    TreeCloud cloud;
+    add_stem(cloud, 0.0, 0.0, 0.15, 4.0, 2 * std::numbers::pi, random);
+    TreeCloud bundle;
+    add_stem(bundle, 0.8, 0.0, 0.12, 2.0, 2 * std::numbers::pi, random);
+    for (std::size_t k = 0; k < bundle.points.size(); k += 5)  // twigs, sparser than the trunk
+        if (bundle.points[k].z() >= 1.0f) cloud.add(bundle.points[k]);
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    EXPECT_EQ(m.stems, 1);
+    ASSERT_TRUE(m.diameter);
+    EXPECT_NEAR(*m.diameter, 0.30, 0.01);
 }
 
 TEST(Dbh, HalfArcIsPartial) {
@@ -74,6 +111,7 @@ TEST(Dbh, NoStemPointsIsNotVisibleWithoutANumber) {
     const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
     EXPECT_EQ(m.quality, DbhQuality::NotVisible);
     EXPECT_FALSE(m.diameter);
+    EXPECT_EQ(m.stems, 0);
     EXPECT_FALSE(m.reason.empty());
     EXPECT_STREQ(dbh_quality_name(m.quality), "not_visible");
 }
