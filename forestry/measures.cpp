@@ -113,19 +113,19 @@ std::vector<CircleFit> separate_trunks(std::span<const Eigen::Vector2f> slice, c
 
 // A trunk continues down from breast height toward the root collar; the hanging twigs of a
 // willow's curtain, which can form circles of a trunk's size at breast height, end above the
-// ground. The trunk may lean (a crape myrtle's trunks part from one collar at up to 30 degrees),
-// so its points are looked for in a cone that widens downward, and some must lie in the lower
-// half of the way down to half the breast height.
-bool reaches_down(const CircleFit& trunk, std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
-                  const DbhOptions& options) {
-    const double slope = std::tan(options.max_trunk_lean * std::numbers::pi / 180.0);
+// ground, and so do limbs and sprouts. Its points are looked for within `reach` of the circle's
+// centre in the lower half of the way down to half the breast height, and for a trunk that may
+// lean (a crape myrtle's trunks part from one collar at up to 30 degrees) in a cone that widens
+// downward at `lean_degrees`.
+bool reaches_down(const CircleFit& trunk, double reach, double lean_degrees, std::span<const Eigen::Vector3f> points,
+                  std::span<const float> height_above_ground, const DbhOptions& options) {
+    const double slope = std::tan(lean_degrees * std::numbers::pi / 180.0);
     const double top = options.breast_height - options.slice_half_width, bottom = 0.5 * options.breast_height;
     std::size_t low_points = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const double hag = height_above_ground[i];
         if (hag < bottom || hag >= 0.5 * (top + bottom)) continue;
-        const double reach = trunk.radius + options.fit_tolerance + (options.breast_height - hag) * slope;
-        low_points += (points[i].head<2>() - trunk.centre).norm() <= reach;
+        low_points += (points[i].head<2>() - trunk.centre).norm() <= reach + (options.breast_height - hag) * slope;
     }
     return low_points >= options.min_inliers;
 }
@@ -162,11 +162,26 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
         return not_visible(m, "fewer than " + std::to_string(options.min_inliers) + " points at breast height");
     const std::vector<CircleFit> trunks = separate_trunks(slice, options);
     if (trunks.size() >= 2 && std::all_of(trunks.begin(), trunks.end(), [&](const CircleFit& trunk) {
-            return reaches_down(trunk, points, height_above_ground, options);
+            return reaches_down(trunk, trunk.radius + options.fit_tolerance, options.max_trunk_lean, points, height_above_ground, options);
         }))
         return multi_stem(m, trunks, options);
-    const CircleFit fit = fit_stem_circle(slice, options);
+    CircleFit fit = fit_stem_circle(slice, options);
     if (!fit.ok) return not_visible(m, "no circle fits the breast-height points");
+    // A limb, a sprout or a bundle of twigs crossing breast height can hold more points than a
+    // trunk seen from one side, and the circle is then theirs. When it does not reach down
+    // (within 1.5 radii, a root flare) and the points it leaves hold a stem's circle that does,
+    // that one is the stem.
+    const auto stands_on_the_ground = [&](const CircleFit& circle) {
+        return reaches_down(circle, 1.5 * circle.radius + 2.0 * options.fit_tolerance, 0.0, points, height_above_ground, options);
+    };
+    if (stem_problem(fit, slice, options).empty() && !stands_on_the_ground(fit)) {
+        std::vector<Eigen::Vector2f> rest;
+        for (const auto& p : slice)
+            if ((p - fit.centre).norm() > fit.radius + 2.0f * static_cast<float>(options.fit_tolerance)) rest.push_back(p);
+        const CircleFit other = rest.size() >= options.min_inliers ? fit_stem_circle(rest, options) : CircleFit{};
+        if (other.ok && stem_problem(other, rest, options).empty() && stands_on_the_ground(other))
+            fit = other;
+    }
     m.centre = fit.centre.cast<double>();
     m.coverage = fit.coverage;
     m.rms = fit.rms;

@@ -94,6 +94,26 @@ TEST(Dbh, ATwigBundleBesideATrunkIsNotASecondStem) {
     EXPECT_NEAR(*m.diameter, 0.30, 0.01);
 }
 
+// A 0.6 m trunk seen from one side (a third of its circumference, about 65 points at breast
+// height) with a dense bundle of its own sprouts in front of it (about 500 points at breast
+// height, 11 cm across, ending 1.1 m above the ground): the bundle's circle holds more points,
+// but only the trunk reaches the ground.
+TEST(Dbh, ABundleOfSproutsInFrontOfATrunkSeenFromOneSideGivesWay) {
+    std::mt19937 random(7);
+    TreeCloud cloud;
+    TreeCloud trunk;
+    add_stem(trunk, 0.0, 0.0, 0.6, 3.0, 2 * std::numbers::pi / 3, random);
+    for (std::size_t k = 0; k < trunk.points.size(); k += 4) cloud.add(trunk.points[k]);
+    TreeCloud sprouts;
+    add_stem(sprouts, 0.75, 0.35, 0.055, 1.6, 2 * std::numbers::pi, random);
+    for (const Eigen::Vector3f& p : sprouts.points)
+        if (p.z() >= 1.1f) cloud.add(p);
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    ASSERT_TRUE(m.diameter) << m.reason;
+    EXPECT_EQ(m.quality, DbhQuality::PartialArc);
+    EXPECT_NEAR(*m.diameter, 1.2, 0.05);
+}
+
 TEST(Dbh, HalfArcIsPartial) {
     std::mt19937 random(2);
     TreeCloud cloud;
