@@ -39,7 +39,7 @@ esac
 target=$1
 seconds=${2:?usage: scripts/fuzz.sh TARGET SECONDS}
 shift 2
-echo "$targets" | grep -qx "$target" || { echo "fuzz.sh: no target '$target' (scripts/fuzz.sh --list)" >&2; exit 1; }
+grep -qx "$target" <<< "$targets" || { echo "fuzz.sh: no target '$target' (scripts/fuzz.sh --list)" >&2; exit 1; }
 [ $build -eq 1 ] && build_sanitized "fuzz_$target"
 
 corpus=$SAN_BUILD_DIR/fuzz-corpus/$target
