@@ -28,10 +28,14 @@ echo
 echo "trees found (from $OUT/tile/trees.csv; heights in metres above the ground; an airborne scan"
 echo "does not see stems, so DBH is 'not_visible' rather than guessed; a tree with too few points"
 echo "for a model is measured only, without a woody volume):"
-awk -F, 'NR == 1 { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", "tree", "x", "y", "height", "DBH", "crown_d", "crown_m3", "wood_m3", "points"; next }
-         { printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $2, $3, $4, $6, ($7 == "" ? $8 : $7 " m"), $10, $12, ($18 == "ok" ? $13 : "-"), $16 }' \
+# Columns by their names in the header (docs/tile.md lists them).
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i
+                   printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", "tree", "x", "y", "height", "DBH", "crown_d", "crown_m3", "wood_m3", "points"; next }
+         { dbh = $c["dbh_m"] == "" ? $c["dbh_quality"] : $c["dbh_m"] " m"
+           printf "%5s %10s %10s %7s %-12s %8s %9s %10s %7s\n", $c["tree_id"], $c["x"], $c["y"], $c["height_m"], dbh, $c["crown_diameter_m"],
+                  $c["crown_volume_m3"], ($c["model"] == "ok" ? $c["woody_volume_m3"] : "-"), $c["points"] }' \
     "$OUT/tile/trees.csv"
-modelled=$(awk -F, 'NR > 1 && $18 == "ok"' "$OUT/tile/trees.csv" | wc -l)
+modelled=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "model") m = i; next } $m == "ok"' "$OUT/tile/trees.csv" | wc -l)
 listed=$(($(wc -l <"$OUT/tile/trees.csv") - 1))
 echo "$listed trees: $modelled modelled, $((listed - modelled)) measured only (fewer than 50 points); the tile holds $(($(wc -l <"$SAMPLE/tile/truth.csv") - 1)) true trees ($SAMPLE/tile/truth.csv)"
 if [[ -f "$OUT/tile/failures.jsonl" ]]; then
