@@ -118,6 +118,8 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"max_crown_radius", &o.max_crown_radius},
                                                   {"min_tree_height", &o.min_tree_height},
                                                   {"max_gap", &o.max_gap},
+                                                  {"attach_gap", &o.attach_gap},
+                                                  {"detached_min_height", &o.detached_min_height},
                                                   {"graph_voxel", &o.graph_voxel},
                                                   {"stem_slice_low", &o.stem_slice_low},
                                                   {"stem_slice_high", &o.stem_slice_high},

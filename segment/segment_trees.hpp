@@ -17,8 +17,9 @@
 // length^graph_beta, its horizontal part times a factor that falls with the stem's radius (a
 // thick trunk's crown reaches farther sideways). The graph is built on a voxel-thinned copy of
 // the non-ground points with no edge longer than `max_gap`, and every point takes the label of
-// its voxel: points no base reaches (understory apart from the trees, clutter beyond a gap)
-// stay 0.
+// its voxel. Pieces of crown the paths do not reach (a sparse top above a gap) join the nearest
+// tree when they hang in the air within `attach_gap` of it; the rest (understory apart from the
+// trees, clutter beyond a gap, stray returns) stays 0.
 // docs/segment.md has the figures and the settings for dense conifer stands.
 #pragma once
 
@@ -94,7 +95,13 @@ struct SegmentOptions {
     // the horizontal part of their edge costs: thick trunks, which carry wide crowns, reach
     // farther sideways (0 = all stems alike).
     float stem_reach_exponent = 1.0f;
-    float max_gap = 1.0f;             // longest graph edge (metres): points beyond wider gaps stay 0
+    float max_gap = 1.0f;             // longest graph edge (metres): points beyond wider gaps stay 0 ...
+    // ... unless they form a piece hanging in the air (lowest point at least detached_min_height
+    // above the ground, at least min_detached_voxels voxels) within attach_gap of a tree's
+    // points: a sparse treetop, a tier of a tiered crown; it joins that tree (0 = never).
+    float attach_gap = 2.0f;
+    float detached_min_height = 2.0f;
+    int min_detached_voxels = 3;
     float ground_clearance = 0.3f;    // points lower than this above the DTM stay out of the graph (metres)
 };
 

@@ -168,6 +168,40 @@ TEST(SegmentTrees, ASparselySeenCrownStaysWithItsTree) {
         }
 }
 
+// A treetop seen as a few clumps above a gap: the graph's edges do not reach them (each clump's
+// nearest voxels are its own), so the paths leave them out; as pieces hanging in the air within
+// attach_gap they join the tree, the upper clump through the lower one. A stray return and a
+// bush on the ground beside the stem stay 0.
+TEST(SegmentTrees, ADetachedTreetopJoinsItsTreeLinkByLink) {
+    ToyTile tile = test::flat_ground(-4, 4, -4, 4);
+    test::add_stem_and_ball(tile, 0, 0, 0.15f, 6, 2.0f, 0.15f, 1);  // crown top at 8 m
+    const auto add_clump = [&tile](float x, float y, float z, std::int32_t id) {
+        for (float dz = 0.0f; dz <= 0.3f; dz += 0.05f)
+            for (float dy = 0.0f; dy <= 0.3f; dy += 0.05f)
+                for (float dx = 0.0f; dx <= 0.3f; dx += 0.05f) tile.add({x + dx, y + dy, z + dz}, id);
+    };
+    add_clump(-0.15f, -0.15f, 9.5f, 1);   // 1.5 m above the crown
+    add_clump(-0.15f, -0.15f, 11.3f, 1);  // 1.5 m above that, 3.3 m above the crown
+    add_clump(1.5f, 1.5f, 0.4f, 0);       // a bush on the ground
+    tile.add({1.8f, 0.0f, 9.3f}, 0);      // a stray return 1.5 m from the crown
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].top.z(), 11.6f, 0.01f);
+    for (std::size_t i = 0; i < tile.truth.size(); ++i)
+        if (tile.cloud.positions[i].z() > 0.35f) {  // above the ground clearance
+            ASSERT_EQ(result.tree_id[i], tile.truth[i]) << "point " << i;
+        }
+
+    SegmentOptions without;
+    without.attach_gap = 0.0f;
+    const TreeSegmentation paths_only = segment_trees(tile.cloud, terrain, without);
+    ASSERT_EQ(paths_only.trees.size(), 1u);
+    EXPECT_NEAR(paths_only.trees[0].top.z(), 7.9f, 0.01f);  // the crown's highest lattice point
+}
+
 // A broad trunk with a root flare (radius 1.1 m at the ground, 0.8 m at 1 m, 0.6 m from 2.5 m up:
 // no single circle holds the slice 1-2 m above the ground) beside an ordinary stem.
 TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
@@ -469,6 +503,17 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
         bad.stem_reach_exponent = exponent;
         EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << exponent;
     }
+    for (const float length : {-1.0f, std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()}) {
+        bad = {};
+        bad.attach_gap = length;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
+        bad = {};
+        bad.detached_min_height = length;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
+    }
+    bad = {};
+    bad.min_detached_voxels = 0;
+    EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
     EXPECT_EQ(test::error_code_of([&] { segment_trees(PointCloud{}, terrain, {}); }), ExitCode::Internal);
 }
 
