@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -112,6 +113,29 @@ TEST(Dbh, ABundleOfSproutsInFrontOfATrunkSeenFromOneSideGivesWay) {
     ASSERT_TRUE(m.diameter) << m.reason;
     EXPECT_EQ(m.quality, DbhQuality::PartialArc);
     EXPECT_NEAR(*m.diameter, 1.2, 0.05);
+}
+
+// A trunk flaring toward its root collar (radius 0.5 m from 1.5 m up, 0.3 m more per metre
+// below), on a 20-degree slope, seen from its downhill half. Breast height above the terrain is
+// an oblique cut there: 1.1 m up the trunk in the middle of the arc, 1.3 m at its ends. The
+// diameter is that of a level cut 1.3 m above the ground at the stem's centre.
+TEST(Dbh, AFlaredTrunkOnASlopeIsCutLevel) {
+    const double slope = std::tan(20.0 * std::numbers::pi / 180.0);
+    const auto radius_at = [](double z) { return 0.5 + 0.3 * std::max(0.0, 1.5 - z); };
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> angle(0.5 * std::numbers::pi, 1.5 * std::numbers::pi), height(0.0, 3.0);
+    std::normal_distribution<double> noise(0.0, 0.005);
+    TreeCloud cloud;
+    for (int i = 0; i < 20000; ++i) {
+        const double a = angle(random), z = height(random), r = radius_at(z) + noise(random);
+        const Eigen::Vector3f p(static_cast<float>(r * std::cos(a)), static_cast<float>(r * std::sin(a)), static_cast<float>(z));
+        cloud.points.push_back(p);
+        cloud.hag.push_back(static_cast<float>(z - slope * p.x()));  // the ground rises along +x through (0, 0, 0)
+    }
+    const DbhMeasure m = measure_dbh(cloud.points, cloud.hag, {0.0, 0.0, 0.0});
+    ASSERT_TRUE(m.diameter) << m.reason;
+    EXPECT_NEAR(*m.diameter, 2.0 * radius_at(1.3), 0.01);
+    EXPECT_EQ(m.quality, DbhQuality::PartialArc);
 }
 
 TEST(Dbh, HalfArcIsPartial) {
