@@ -130,6 +130,7 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     // The root sits on the stem axis continued from the fitted slices to the foot.
     if (sk.base.stem_visible && out.trunk.foot_fitted && (out.trunk.foot_centre - sk.tree.nodes[0].position).norm() < 1.0f)
         sk.tree.nodes[0].position = out.trunk.foot_centre;
+    if (sk.base.stem_visible) align_trunk_base(sk.tree, out.trunk);
     float z_top = sk.base.position.z();
     for (const auto& p : pre.points) z_top = std::max(z_top, p.z());
     s.height = z_top - sk.base.position.z();

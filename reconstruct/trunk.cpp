@@ -126,4 +126,24 @@ TrunkFit fit_trunk(std::span<const Eigen::Vector3f> points, const std::vector<in
     return fit;
 }
 
+std::size_t align_trunk_base(TreeGraph& tree, const TrunkFit& fit) {
+    std::vector<Eigen::Vector3f> anchors;  // points of the stem axis, rising
+    if (fit.foot_fitted) anchors.push_back(fit.foot_centre);
+    for (const StemSlice& slice : fit.slices)
+        if (slice.good && (anchors.empty() || slice.centre.z() > anchors.back().z())) anchors.push_back(slice.centre);
+    if (anchors.size() < 2 || tree.size() < 2) return 0;
+    std::size_t moved = 0;
+    for (int node : main_axis(tree)) {
+        Eigen::Vector3f& p = tree.nodes[node].position;
+        if (p.z() < anchors.front().z() || p.z() > anchors.back().z()) continue;
+        const auto upper = std::upper_bound(anchors.begin(), anchors.end(), p.z(), [](float z, const Eigen::Vector3f& a) { return z < a.z(); });
+        const Eigen::Vector3f& high = upper == anchors.end() ? anchors.back() : *upper;
+        const Eigen::Vector3f& low = upper == anchors.end() ? anchors.back() : *(upper - 1);
+        const float t = high.z() > low.z() ? (p.z() - low.z()) / (high.z() - low.z()) : 0.0f;
+        p.head<2>() = low.head<2>() + t * (high.head<2>() - low.head<2>());
+        ++moved;
+    }
+    return moved;
+}
+
 }  // namespace treelobes

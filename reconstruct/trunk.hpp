@@ -48,4 +48,11 @@ struct TrunkFit {
 TrunkFit fit_trunk(std::span<const Eigen::Vector3f> points, const std::vector<int>& point_internode, const TreeGraph& tree,
                    const TrunkOptions& options = {});
 
+// Moves the main axis's nodes between the foot and the highest good slice onto the stem axis the
+// slices give (their centres, interpolated by height; below the lowest one, the line from the
+// fitted foot). The skeleton's first nodes come from geodesic bins around the root, which cut
+// the stem obliquely and fall apart into pieces, so the axis used to hook inside the stem (0.2 m
+// off a 0.21 m birch trunk's centre at 0.25 m, the rebuild bench's trees). Returns the nodes moved.
+std::size_t align_trunk_base(TreeGraph& tree, const TrunkFit& fit);
+
 }  // namespace treelobes

@@ -80,3 +80,31 @@ TEST(Trunk, APartialArcIsNotTrusted) {
     EXPECT_FALSE(fit.dbh_fitted);
     EXPECT_FALSE(fit.base_fitted);
 }
+
+// A skeleton whose first nodes hook off the stem's axis inside it (as the first geodesic bins
+// around the root give them): the nodes below the highest good slice move onto the axis the
+// slices give; the one above them, and the branch beside, stay where they were.
+TEST(Trunk, AHookedAxisAtTheFootIsAlignedWithTheStem) {
+    Stem s = stem(0.2f, 3.0f, 1.0f, 2.0f);
+    TreeGraph hooked;
+    hooked.add_node({1.0f, 2.0f, 0.0f}, 0.0f, -1);
+    hooked.add_node({0.85f, 2.1f, 0.25f}, 0.0f, 0);
+    hooked.add_node({0.9f, 2.05f, 0.6f}, 0.0f, 1);
+    hooked.add_node({1.02f, 2.0f, 1.2f}, 0.0f, 2);
+    hooked.add_node({1.03f, 2.01f, 3.0f}, 0.0f, 3);
+    hooked.add_node({1.5f, 2.0f, 0.6f}, 0.0f, 2);  // a side branch, not on the main axis
+    for (int& internode : s.internode) internode = 4;
+    const TrunkFit fit = fit_trunk(s.points, s.internode, hooked);
+    ASSERT_TRUE(fit.foot_fitted);
+    EXPECT_EQ(align_trunk_base(hooked, fit), 4u);  // the root and nodes 1-3
+    for (int node = 0; node < 4; ++node) {
+        EXPECT_NEAR(hooked.nodes[node].position.x(), 1.0f, 0.01f) << node;
+        EXPECT_NEAR(hooked.nodes[node].position.y(), 2.0f, 0.01f) << node;
+    }
+    EXPECT_NEAR(hooked.nodes[1].position.z(), 0.25f, 1e-6f);  // heights are kept
+    EXPECT_EQ(hooked.nodes[4].position, Eigen::Vector3f(1.03f, 2.01f, 3.0f));
+    EXPECT_EQ(hooked.nodes[5].position, Eigen::Vector3f(1.5f, 2.0f, 0.6f));
+
+    TrunkFit nothing_fitted;
+    EXPECT_EQ(align_trunk_base(hooked, nothing_fitted), 0u);
+}
