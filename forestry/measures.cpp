@@ -181,6 +181,38 @@ CircleFit level_cut(const CircleFit& circle, std::span<const Eigen::Vector3f> po
     return cut.ok && stem_problem(cut, level, options).empty() ? cut : circle;
 }
 
+// A multi-stemmed tree's trunks part from one collar and lean (a crape myrtle's at 12-24
+// degrees), thin (5-6 cm) and carrying twigs from breast height up: a trunk smeared over the
+// breast-height band with its twigs held circles of 0.10-0.14 m for trunks of 0.05-0.06 m. So
+// each trunk is followed down from breast height in thin layers, each layer's circle looked for
+// around the one above (its radius and 5 cm more: the lean moves it a few centimetres per
+// layer), and its radius is the median of the layers' radii; below the twigs the layers agree
+// (0.05-0.07 m between 0.7 and 1.1 m on the synthetic bench's crape myrtles). Fewer than three
+// layers holding a circle leave the trunk as it was.
+CircleFit follow_trunk_down(const CircleFit& trunk, std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
+                            const DbhOptions& options) {
+    CircleFit current = trunk;
+    std::vector<float> radii;
+    for (int k = 0; k < options.trunk_layers; ++k) {
+        const double middle = options.breast_height - options.trunk_layer * k;
+        const float reach = current.radius + 0.05f;
+        std::vector<Eigen::Vector2f> layer;
+        for (std::size_t i = 0; i < points.size(); ++i)
+            if (std::abs(height_above_ground[i] - middle) <= 0.5 * options.trunk_layer && (points[i].head<2>() - current.centre).norm() <= reach)
+                layer.push_back(points[i].head<2>());
+        if (layer.size() < options.min_inliers) continue;
+        const CircleFit circle = fit_stem_circle(layer, options);
+        if (!circle.ok || !stem_problem(circle, layer, options).empty()) continue;
+        radii.push_back(circle.radius);
+        current = circle;
+    }
+    if (radii.size() < 3) return trunk;
+    CircleFit followed = trunk;
+    std::nth_element(radii.begin(), radii.begin() + static_cast<std::ptrdiff_t>(radii.size() / 2), radii.end());
+    followed.radius = radii[radii.size() / 2];
+    return followed;
+}
+
 DbhMeasure multi_stem(DbhMeasure m, const std::vector<CircleFit>& trunks, const DbhOptions& options) {
     double squared_radii = 0.0;
     m.coverage = 1.0;
@@ -215,7 +247,11 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
     if (trunks.size() >= 2 && std::all_of(trunks.begin(), trunks.end(), [&](const CircleFit& trunk) {
             return reaches_down(trunk, trunk.radius + options.fit_tolerance, options.max_trunk_lean, points, height_above_ground, options);
         }))
-        return multi_stem(m, trunks, options);
+    {
+        std::vector<CircleFit> followed;
+        for (const CircleFit& trunk : trunks) followed.push_back(follow_trunk_down(trunk, points, height_above_ground, options));
+        return multi_stem(m, followed, options);
+    }
     CircleFit fit = fit_stem_circle(slice, options);
     if (!fit.ok) return not_visible(m, "no circle fits the breast-height points");
     // A limb, a sprout or a bundle of twigs crossing breast height can hold more points than a

@@ -35,6 +35,9 @@ struct DbhOptions {
     double max_interior_share = 0.25;  // ...and more of them than this share of the inliers: not a stem
     double trunk_gap = 0.1;            // metres: breast-height points this far apart belong to different trunks
     double max_trunk_lean = 30.0;      // degrees: how far a multi-stemmed tree's trunk may lean below breast height
+    // A multi-stemmed tree's trunks are followed down from breast height in layers this thick ...
+    double trunk_layer = 0.1;  // metres
+    int trunk_layers = 7;      // ... this many (1.3 m down to 0.7 m)
 };
 
 struct DbhMeasure {

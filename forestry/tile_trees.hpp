@@ -54,7 +54,8 @@ std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3
 // keeps a finished tree, and raised whenever a measure's definition changes, so that a tree
 // measured by an older treelobes is measured again (3: stem position and height at the stem,
 // measured-only trees; 4: crown base above the ground at the stem; 5: the DBH of multi-stemmed
-// trees and the stem count; 6: the DBH circle cut level, not along the terrain).
+// trees and the stem count; 6: the DBH circle cut level, not along the terrain, and a
+// multi-stemmed tree's trunks followed down below their twigs).
 inline constexpr int kTreeRecordRevision = 6;
 
 // The record of one finished tree (trees/tree_<id>.json): its row in full precision plus the
