@@ -165,7 +165,7 @@ std::optional<double> terrain_at(std::span<const Eigen::Vector3f> points, std::s
 // the cut spans 0.36 m of a 1 m trunk's height, and where the trunk tapers toward its root collar
 // its points spread 8 cm across, so a circle through the outer ones fits (a flared mahogany of
 // 1.027 m measured 1.257 m on a synthetic slope). The stem is cut again level, at breast height
-// above the ground under it, within the first circle (and the fit tolerance beyond), as a
+// above the ground under it, within the first circle (and twice the fit tolerance beyond), as a
 // forester's tape goes round it; that circle is kept when it holds as a stem.
 CircleFit level_cut(const CircleFit& circle, std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
                     const DbhOptions& options) {
@@ -244,10 +244,10 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
     if (slice.size() < options.min_inliers)
         return not_visible(m, "fewer than " + std::to_string(options.min_inliers) + " points at breast height");
     const std::vector<CircleFit> trunks = separate_trunks(slice, options);
-    if (trunks.size() >= 2 && std::all_of(trunks.begin(), trunks.end(), [&](const CircleFit& trunk) {
-            return reaches_down(trunk, trunk.radius + options.fit_tolerance, options.max_trunk_lean, points, height_above_ground, options);
-        }))
-    {
+    const bool multi_stemmed = trunks.size() >= 2 && std::all_of(trunks.begin(), trunks.end(), [&](const CircleFit& trunk) {
+        return reaches_down(trunk, trunk.radius + options.fit_tolerance, options.max_trunk_lean, points, height_above_ground, options);
+    });
+    if (multi_stemmed) {
         std::vector<CircleFit> followed;
         for (const CircleFit& trunk : trunks) followed.push_back(follow_trunk_down(trunk, points, height_above_ground, options));
         return multi_stem(m, followed, options);
@@ -269,14 +269,15 @@ DbhMeasure measure_dbh(std::span<const Eigen::Vector3f> points, std::span<const 
         if (other.ok && stem_problem(other, rest, options).empty() && stands_on_the_ground(other))
             fit = other;
     }
-    m.centre = fit.centre.cast<double>();
-    m.coverage = fit.coverage;
-    m.rms = fit.rms;
+    const auto describe = [&m](const CircleFit& circle) {
+        m.centre = circle.centre.cast<double>();
+        m.coverage = circle.coverage;
+        m.rms = circle.rms;
+    };
+    describe(fit);
     if (const std::string problem = stem_problem(fit, slice, options); !problem.empty()) return not_visible(m, problem);
     fit = level_cut(fit, points, height_above_ground, options);
-    m.centre = fit.centre.cast<double>();
-    m.coverage = fit.coverage;
-    m.rms = fit.rms;
+    describe(fit);
     m.quality = fit.coverage >= options.ok_coverage ? DbhQuality::Ok : DbhQuality::PartialArc;
     m.diameter = 2.0 * fit.radius;
     m.stems = 1;
