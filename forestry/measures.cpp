@@ -7,8 +7,6 @@
 #include "geometry/alpha_shape.hpp"
 #include "geometry/convex_hull.hpp"
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -133,32 +131,19 @@ bool reaches_down(const CircleFit& trunk, double reach, double lean_degrees, std
 }
 
 // The terrain at `centre` from the DTM heights under the points within `radius` of it (z - HAG):
-// a plane through them, since a trunk seen from one side has all its points' ground on that
-// side, up- or downhill of its centre; their median when they do not span a plane.
+// a least-squares plane through them, since a trunk seen from one side has all its points'
+// ground on that side, up- or downhill of its centre; their median when they lie on a line.
 std::optional<double> terrain_at(std::span<const Eigen::Vector3f> points, std::span<const float> height_above_ground,
                                  const Eigen::Vector2f& centre, float radius) {
-    std::vector<Eigen::Vector3d> ground;
+    std::vector<Eigen::Vector3d> ground;  // relative to the centre, so the plane's constant term is its height there
     for (std::size_t i = 0; i < points.size(); ++i)
         if ((points[i].head<2>() - centre).norm() <= radius)
             ground.emplace_back(points[i].x() - centre.x(), points[i].y() - centre.y(), points[i].z() - height_above_ground[i]);
-    if (ground.size() < 3) return std::nullopt;
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
-    for (const Eigen::Vector3d& g : ground) mean += g.head<2>() / static_cast<double>(ground.size());
-    Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
-    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d right = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& g : ground) {
-        spread += (g.head<2>() - mean) * (g.head<2>() - mean).transpose() / static_cast<double>(ground.size());
-        const Eigen::Vector3d row(1.0, g.x(), g.y());
-        normal += row * row.transpose();
-        right += row * g.z();
-    }
-    if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread).eigenvalues().minCoeff() < 1e-4 * radius * radius) {  // on a line
-        std::vector<double> heights;
-        for (const Eigen::Vector3d& g : ground) heights.push_back(g.z());
-        return quantile(heights, 0.5);
-    }
-    return normal.ldlt().solve(right)(0);  // the plane's height at the centre
+    if (ground.empty()) return std::nullopt;
+    if (const std::optional<Eigen::Vector3d> plane = fit_height_plane_least_squares(ground)) return (*plane)(0);
+    std::vector<double> heights;
+    for (const Eigen::Vector3d& g : ground) heights.push_back(g.z());
+    return quantile(heights, 0.5);
 }
 
 // Points at breast height above the terrain cut a trunk on a slope obliquely: on a 20-degree slope

@@ -163,4 +163,21 @@ std::optional<Circle2d> fit_circle_least_squares(std::span<const Eigen::Vector2d
     return circle;
 }
 
+std::optional<Eigen::Vector3d> fit_height_plane_least_squares(std::span<const Eigen::Vector3d> points) {
+    if (points.size() < 3) return std::nullopt;
+    const auto n = static_cast<Eigen::Index>(points.size());
+    Eigen::MatrixXd a(n, 3);
+    Eigen::VectorXd b(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const Eigen::Vector3d& p = points[static_cast<std::size_t>(i)];
+        a.row(i) << 1.0, p.x(), p.y();
+        b(i) = p.z();
+    }
+    const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(a);
+    if (qr.rank() < 3) return std::nullopt;  // the points lie on a line: any plane through it would be a guess
+    const Eigen::Vector3d plane = qr.solve(b);
+    if (!plane.allFinite()) return std::nullopt;
+    return plane;
+}
+
 }  // namespace treelobes

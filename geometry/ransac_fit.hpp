@@ -1,7 +1,8 @@
 // Robust plane and circle fits (PCL sample consensus, kept in ransac_fit.cpp). Used for ground
 // planes, the "not a tree" check (large planar surfaces) and stem circles. Deterministic: PCL's
 // samplers use a fixed seed. Also the closed-form least-squares circle that cheap stem
-// estimates use (classification's DBH feature, the scan statistics of synthetic trees).
+// estimates use (classification's DBH feature, the scan statistics of synthetic trees), and a
+// least-squares height plane (the ground under a stem, forestry's DBH).
 #pragma once
 
 #include <Eigen/Core>
@@ -48,5 +49,10 @@ struct Circle2d {
 // linear solve, no outlier rejection, so only for slices known to be mostly stem. nullopt with
 // fewer than 3 points, coincident or collinear points, or when the points admit no real circle.
 std::optional<Circle2d> fit_circle_least_squares(std::span<const Eigen::Vector2d> points);
+
+// Least-squares height plane z = a + b x + c y through all points (no outlier rejection: for
+// smooth surfaces such as DTM heights), as (a, b, c). nullopt with fewer than 3 points or when
+// their (x, y) are coincident or collinear.
+std::optional<Eigen::Vector3d> fit_height_plane_least_squares(std::span<const Eigen::Vector3d> points);
 
 }  // namespace treelobes

@@ -60,3 +60,20 @@ TEST(CircleFit, RansacIgnoresOutliersAndReportsCoverage) {
     EXPECT_GT(fit.coverage, 0.9f);
     EXPECT_FALSE(fit_circle(std::vector<Eigen::Vector2f>(points.begin(), points.begin() + 4), 0.01f, 0.05f, 0.5f).ok);
 }
+
+TEST(HeightPlane, LeastSquaresRecoversASlopeAndRefusesALine) {
+    // DTM heights under a trunk seen from one side: a 20-degree slope z = 2 + 0.364 x - 0.1 y,
+    // sampled only on the half x < 0 of a disc.
+    std::vector<Eigen::Vector3d> half;
+    for (double x = -0.8; x <= 0.0; x += 0.1)
+        for (double y = -0.8; y <= 0.8; y += 0.1) half.emplace_back(x, y, 2.0 + 0.364 * x - 0.1 * y);
+    const auto plane = fit_height_plane_least_squares(half);
+    ASSERT_TRUE(plane.has_value());
+    EXPECT_NEAR((*plane)(0), 2.0, 1e-9);  // the height at (0, 0), outside the samples
+    EXPECT_NEAR((*plane)(1), 0.364, 1e-9);
+    EXPECT_NEAR((*plane)(2), -0.1, 1e-9);
+    std::vector<Eigen::Vector3d> line;
+    for (double t = 0.0; t < 1.0; t += 0.1) line.emplace_back(t, 2.0 * t, 1.0 + t);
+    EXPECT_FALSE(fit_height_plane_least_squares(line).has_value());
+    EXPECT_FALSE(fit_height_plane_least_squares(std::vector<Eigen::Vector3d>(half.begin(), half.begin() + 2)).has_value());
+}
