@@ -16,6 +16,7 @@ namespace {
 
 constexpr float kMinScale = 0.5f, kMaxScale = 2.0f;  // patches are stretched at most this much to fit a docking point
 constexpr float kPatchReach = 40.0f;                 // a patch reaches about this many root thicknesses
+constexpr float kMinReseedThickness = 0.004f;        // metres: a re-seed that sticks out is not made thinner than this
 constexpr int kPatchesPerCell = 2;                   // a fill cell takes geometry from this many patches at most
 constexpr std::size_t kFitLeaves = 32;               // leaf tips per patch scored in fitting (a uniform prefix)
 
@@ -215,12 +216,16 @@ std::vector<int> reseed_order(const LobeVolume& fill_grid, const std::vector<cha
     return fill_order;
 }
 
-// A docking point waiting for a patch. Forced docks (the seed and re-seeds) are used even where
-// they sit outside the lobe or add nothing new.
+// A docking point waiting for a patch: the lobe's seed, a re-seed into an empty region, or a
+// docking point of a placed patch. The seed and re-seeds are used even where they sit outside the
+// lobe or add nothing new.
+enum class DockOrigin { Seed, Reseed, Patch };
+
 struct Pending {
     DockingPoint dock;
-    bool forced;
+    DockOrigin origin;
     std::size_t order;
+    bool forced() const { return origin != DockOrigin::Patch; }
 };
 
 // Docking points, thickest first (the large structure is laid before the twigs fill in); ties in
@@ -235,6 +240,7 @@ struct Later {
 struct Fit {
     PatchInstance instance;
     int reached = 0;
+    double inside_share = 0;
 };
 
 // One lobe being textured: the fill plan, the docking-point queue and the patches placed so far.
@@ -269,7 +275,7 @@ public:
     }
 
     LobeTexture run(const DockingPoint& seed) {
-        queue_.push({seed, true, created_++});
+        queue_.push({seed, DockOrigin::Seed, created_++});
         while (affordable()) {
             if (queue_.empty()) {
                 const Refill refill = refill_queue(seed);
@@ -279,12 +285,16 @@ public:
             const Pending pending = queue_.top();
             queue_.pop();
             const DockingPoint& d = pending.dock;
-            if (!pending.forced && !volume_.inside(d.position)) {
+            if (!pending.forced() && !volume_.inside(d.position)) {
                 ++texture_.docks_outside;
                 continue;
             }
-            const Fit best = fit_best(d, select_candidates(d));
-            if (!pending.forced && best.reached == 0) {  // this part of the lobe is filled already
+            const Fit best = fit_at(pending);
+            if (!pending.forced() && best.inside_share < o_.min_inside_share) {  // it would stick out of the lobe
+                ++texture_.docks_outside;
+                continue;
+            }
+            if (!pending.forced() && best.reached == 0) {  // this part of the lobe is filled already
                 ++texture_.docks_redundant;
                 if (layer_ < kPatchesPerCell) deferred_.push_back(pending);
                 continue;
@@ -341,9 +351,24 @@ private:
         if (dir.norm() < 1e-5f) return false;
         // As thick as a twig must be to reach the empty cell, never thicker than the seed.
         const float thickness = std::clamp(dir.norm() / kPatchReach, 0.002f, std::max(seed.thickness, 0.002f));
-        queue_.push({{from, dir.normalized(), thickness}, true, created_++});
+        queue_.push({{from, dir.normalized(), thickness}, DockOrigin::Reseed, created_++});
         ++texture_.reseeds;
         return true;
+    }
+
+    // The best fit at a docking point. A re-seed is sized to reach its empty cell, and from a twig
+    // far from it the patch grows so large that it sticks out of the lobe (straight twigs across
+    // a palm's crown): it is also fitted at half the thickness, and half again down to
+    // kMinReseedThickness, until a fit lies inside; the fit most inside is taken.
+    Fit fit_at(const Pending& pending) {
+        Fit best = fit_best(pending.dock, select_candidates(pending.dock));
+        DockingPoint thinner = pending.dock;
+        while (pending.origin == DockOrigin::Reseed && best.inside_share < o_.min_inside_share && thinner.thickness > kMinReseedThickness) {
+            thinner.thickness *= 0.5f;
+            const Fit fit = fit_best(thinner, select_candidates(thinner));
+            if (fit.inside_share > best.inside_share) best = fit;
+        }
+        return best;
     }
 
     // Patch selection: of the patches that fit the remaining budget, the candidates with the
@@ -377,7 +402,7 @@ private:
             const double score = s.empty() ? 0.0 : (inside + 0.5 * reached) / static_cast<double>(s.size());
             if (score > best_score) {
                 best_score = score;
-                best = {inst, reached};
+                best = {inst, reached, s.empty() ? 0.0 : inside / static_cast<double>(s.size())};
             }
         }
         return best;
@@ -397,7 +422,7 @@ private:
             if (sample.thickness > 0) twigs_.add(p);
         }
         for (const auto& dock : patch.docks)
-            queue_.push({{best.apply(dock.position), best.rotation * dock.direction, dock.thickness * best.scale}, false, created_++});
+            queue_.push({{best.apply(dock.position), best.rotation * dock.direction, dock.thickness * best.scale}, DockOrigin::Patch, created_++});
     }
 
     const PatchLibrary& library_;

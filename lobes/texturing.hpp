@@ -86,6 +86,12 @@ struct TexturingOptions {
     // before it is filled then has its patches spread over all of it instead of a dense ball
     // around the seed: a tall conifer lobe was cut 3-5 m below its top (docs/rebuild.md).
     int reseed_every = 2;
+    // A docking point takes its best-fitting patch only when at least this share of the patch's
+    // geometry lies inside the lobe (Livny et al. 2011, Sec. 5: the fit measures the patch
+    // against the lobe's geometry); otherwise the docking point stays unused. Seeds and re-seeds
+    // always take theirs (a re-seed is first fitted thinner). At 0 a long patch at the lobe's rim
+    // stuck out of the crown: the pine's whorl tips and the terminalia's tiers (docs/rebuild.md).
+    double min_inside_share = 0.7;
 };
 
 struct PatchInstance {
@@ -99,7 +105,7 @@ struct PatchInstance {
 struct LobeTexture {
     std::vector<PatchInstance> instances;
     std::size_t docks_used = 0;
-    std::size_t docks_outside = 0;    // docking points outside the lobe, not used
+    std::size_t docks_outside = 0;    // docking points outside the lobe, or whose best patch would stick out of it: not used
     std::size_t docks_redundant = 0;  // docking points whose best patch reaches no cell short of patches
     std::size_t reseeds = 0;
     double filled = 0;             // fraction of lobe cells (occupied ones, with an occupancy) reached

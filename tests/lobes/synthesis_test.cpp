@@ -344,8 +344,57 @@ TEST(Texturing, ReseedsSpreadATightBudgetOverATallLobe) {
         return static_cast<double>(top) / static_cast<double>(std::max<std::size_t>(all, 1));
     };
     const double from_seed_only = top_quarter_share(0), spread = top_quarter_share(TexturingOptions{}.reseed_every);
-    EXPECT_LT(from_seed_only, 0.05) << spread;
-    EXPECT_GT(spread, 0.1) << from_seed_only;
+    EXPECT_LT(from_seed_only, 0.02) << spread;
+    EXPECT_GT(spread, 0.05) << from_seed_only;
+}
+
+// A patch whose geometry would mostly stick out of the lobe is not placed (Livny et al. 2011,
+// Sec. 5: the fit is measured against the lobe): in a thin lobe, long patches at its rim were
+// placed anyway when they were the best of a poor choice.
+TEST(Texturing, PatchesThatStickOutOfTheLobeAreNotPlaced) {
+    const PatchLibrary lib = build_patch_library(species("pine"));
+    const TriangleMesh thin = box({-0.3f, -0.3f, 2}, {0.3f, 0.3f, 6});
+    const DockingPoint seed{{0, 0, 2}, {0, 0, 1}, 0.03f};
+    const LobeVolume volume(thin, 40);
+    const auto outside_share = [&](double min_inside_share) {
+        TexturingOptions o;
+        o.fill_cell = 0.1;
+        o.min_inside_share = min_inside_share;
+        const LobeTexture t = texture_lobe(thin, seed, lib, o, 0);
+        std::size_t outside = 0, all = 0;
+        for (const auto& inst : t.instances)
+            for (const auto& s : lib.patches[inst.patch].segments) {
+                outside += volume.inside(inst.apply(s.b)) ? 0 : 1;
+                ++all;
+            }
+        return static_cast<double>(outside) / static_cast<double>(std::max<std::size_t>(all, 1));
+    };
+    const double anyway = outside_share(0), fitted = outside_share(TexturingOptions{}.min_inside_share);
+    EXPECT_LT(fitted, 0.5 * anyway) << fitted << " " << anyway;
+    EXPECT_GT(fitted, 0.0) << "seeds and re-seeds keep their patch";
+}
+
+// Palm and willow patches are long: a re-seed sized to reach an empty cell of a thin lobe from
+// a twig far from it grew a patch that stuck out of the lobe (14 % and 8 % of all patch geometry
+// outside measured before re-seeds were made thinner, 7.8 % and 5.0 % after).
+TEST(Texturing, ReseedsAreMadeThinnerToFitAThinLobe) {
+    const TriangleMesh thin = box({-0.3f, -0.3f, 2}, {0.3f, 0.3f, 6});
+    const LobeVolume volume(thin, 40);
+    const DockingPoint seed{{0, 0, 2}, {0, 0, 1}, 0.03f};
+    TexturingOptions o;
+    o.fill_cell = 0.1;
+    for (const auto& [name, most_outside] : {std::pair{"palm", 0.11}, std::pair{"willow", 0.065}}) {
+        const PatchLibrary lib = build_patch_library(species(name));
+        const LobeTexture t = texture_lobe(thin, seed, lib, o, 0);
+        EXPECT_GT(t.reseeds, 50u) << name;
+        std::size_t outside = 0, all = 0;
+        for (const auto& inst : t.instances)
+            for (const auto& s : lib.patches[inst.patch].segments) {
+                outside += volume.inside(inst.apply(s.b)) ? 0 : 1;
+                ++all;
+            }
+        EXPECT_LT(static_cast<double>(outside) / static_cast<double>(all), most_outside) << name;
+    }
 }
 
 // Lobes that know their leaf share (a rebuilt mesh's wood/leaf labels): a bare lobe draws no
