@@ -353,12 +353,12 @@ TEST(Texturing, ReseedsSpreadATightBudgetOverATallLobe) {
 // placed anyway when they were the best of a poor choice.
 TEST(Texturing, PatchesThatStickOutOfTheLobeAreNotPlaced) {
     const PatchLibrary lib = build_patch_library(species("pine"));
-    const TriangleMesh thin = box({-0.3f, -0.3f, 2}, {0.3f, 0.3f, 6});
+    const TriangleMesh thin = box({-0.3f, -0.3f, 2}, {0.3f, 0.3f, 4});
     const DockingPoint seed{{0, 0, 2}, {0, 0, 1}, 0.03f};
     const LobeVolume volume(thin, 40);
     const auto outside_share = [&](double min_inside_share) {
         TexturingOptions o;
-        o.fill_cell = 0.1;
+        o.fill_cell = 0.15;
         o.min_inside_share = min_inside_share;
         const LobeTexture t = texture_lobe(thin, seed, lib, o, 0);
         std::size_t outside = 0, all = 0;
