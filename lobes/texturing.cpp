@@ -182,6 +182,7 @@ void check_texturing(const PatchLibrary& library, const TexturingOptions& o) {
     if (library.patches.empty()) throw Error::usage("lobe texturing: the patch library is empty");
     if (o.candidates < 1) throw Error::usage("lobe texturing: candidates must be >= 1");
     if (!(o.fill_cell > 0) || !(o.max_fill_cells >= 1)) throw Error::usage("lobe texturing: fill cell and cell count must be positive");
+    if (!(o.min_inside_share >= 0 && o.min_inside_share <= 1)) throw Error::usage("lobe texturing: the inside share of a patch must be in 0..1");
 }
 
 // Edge of the fill cells: the volume to fill (the occupied cells', at most the lobe's, with an

@@ -370,6 +370,11 @@ TEST(Texturing, PatchesThatStickOutOfTheLobeAreNotPlaced) {
     const double anyway = outside_share(0), fitted = outside_share(TexturingOptions{}.min_inside_share);
     EXPECT_LT(fitted, 0.5 * anyway) << fitted << " " << anyway;
     EXPECT_GT(fitted, 0.0) << "seeds and re-seeds keep their patch";
+    for (const double bad : {-0.1, 1.5, std::numeric_limits<double>::quiet_NaN()}) {
+        TexturingOptions o;
+        o.min_inside_share = bad;
+        EXPECT_EQ(error_code_of([&] { texture_lobe(thin, seed, lib, o, 0); }), ExitCode::Usage) << bad;
+    }
 }
 
 // Palm and willow patches are long: a re-seed sized to reach an empty cell of a thin lobe from
