@@ -111,20 +111,35 @@ float leaf_share(const PointCloud& cloud, const std::string& attribute, const st
     return static_cast<float>(leaves) / static_cast<float>(points.size());
 }
 
+// d' measured on the input's own wood labels (the bark samples of a CG model), per node; empty
+// when the input has no labels.
+std::vector<float> measured_lobe_diameter(const PointCloud& cloud, const TreeReconstruction& r, const ReconstructOptions& ro,
+                                          const LobeOptions& o) {
+    const ExtraAttribute* labels = o.leaf_label_attribute.empty() ? nullptr : cloud.extra(o.leaf_label_attribute);
+    if (labels == nullptr) return {};
+    std::vector<char> wood(cloud.size());
+    for (std::size_t i = 0; i < wood.size(); ++i) wood[i] = labels->values[i] != 0 ? 1 : 0;
+    return wood_lobe_diameter(r.skeleton, cloud.positions, r.point_internode, wood, r.diameters.lobe_diameter,
+                              static_cast<float>(ro.allometry.fs), o.wood_measurement);
+}
+
 }  // namespace
 
 LobeTree build_lobe_tree(const PointCloud& cloud, const TreeReconstruction& r, const ReconstructOptions& ro, const std::string& species,
                          const LobeOptions& o, LobeReport* report_out) {
     if (o.min_lobe_faces < 4 || o.max_lobe_faces < o.min_lobe_faces) throw Error::usage("lobes: face limits must satisfy 4 <= min <= max");
+    check_wood_measurement(o.wood_measurement);
     if (r.point_internode.size() != cloud.size()) throw Error::usage("lobes: the reconstruction belongs to another cloud");
     LobeReport report;
     StageClock clock(report.seconds);
     const TreeGraph& tree = r.skeleton;
     const std::span<const Eigen::Vector3f> points(cloud.positions);
 
-    const EdgeConfidence confidence = edge_confidence(tree, points, r.point_internode, r.diameters.lobe_diameter);
+    const EdgeConfidence confidence =
+            edge_confidence(tree, points, r.point_internode, r.diameters.lobe_diameter, measured_lobe_diameter(cloud, r, ro, o));
     MainSplit split = split_at_low_confidence(tree, confidence, r.point_internode);
     report.low_confidence_edges = confidence.low_count();
+    report.wood_measured_edges = confidence.measured_raised;
     report.clusters = split.clusters.size();
     clock.mark("confidence");
 

@@ -9,6 +9,7 @@
 #include "core/tree_graph.hpp"
 #include "core/triangle_mesh.hpp"
 #include "geometry/alpha_shape.hpp"
+#include "lobes/lobe_split.hpp"
 #include "lobes/occupancy.hpp"
 #include "reconstruct/reconstruct_tree.hpp"
 
@@ -67,10 +68,14 @@ struct LobeOptions {
     // records its leaf share; empty = none. `treelobes rebuild` names the labels of the mesh's
     // materials; a synthetic scan's `wood` attribute is the generator's truth and is not used.
     std::string leaf_label_attribute;
+    // With those labels, the confidence diameter d' of an edge along bark is raised to what its
+    // wood points measure (lobes/lobe_split.hpp).
+    WoodMeasurement wood_measurement;
 };
 
 struct LobeReport {
     std::size_t low_confidence_edges = 0;
+    std::size_t wood_measured_edges = 0;      // edges whose d' the input's wood labels raised
     std::size_t clusters = 0;                 // before the fallbacks below
     std::size_t kept_small = 0;               // clusters under min_cluster_points kept as branches
     std::size_t kept_no_shape = 0;            // clusters without a 3D alpha shape (flat, collinear) kept as branches

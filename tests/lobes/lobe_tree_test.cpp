@@ -159,3 +159,30 @@ TEST(LobeTree, LobesRecordTheirLeafShareFromWoodLabels) {
     }
     EXPECT_NEAR(leaf / all, 0.5, 0.15);
 }
+
+// A trunk whose bark is labelled wood keeps it on the main structure where Eq. 1's diameter is
+// too small for it: at f_s 0.8 the unlabelled trunk ends 1.8 m up (its bark lies farther from the
+// axis than d'), the labelled one reaches the crown, which stays a lobe.
+TEST(LobeTree, BarkLabelledWoodKeepsTheTrunkOnTheMainStructure) {
+    std::size_t crown = 0;
+    PointCloud cloud = trunk_and_crown(&crown);
+    auto top = [](const LobeTree& t) {
+        float z = 0;
+        for (const auto& node : t.skeleton.nodes) z = std::max(z, node.position.z());
+        return z;
+    };
+    const Built unlabelled = build(cloud, 0.8);
+    ExtraAttribute& wood = cloud.add_extra("wood", AttributeType::UInt8, 1.0);
+    for (std::size_t i = 0; i < cloud.size(); ++i) wood.values[i] = cloud.positions[i].z() > 2.95f ? 0.0 : 1.0;
+    LobeOptions named;
+    named.leaf_label_attribute = "wood";
+    const Built labelled = build(cloud, 0.8, named);
+    EXPECT_LT(top(unlabelled.tree), 2.5f);
+    EXPECT_GT(top(labelled.tree), 2.8f);
+    EXPECT_GT(labelled.report.wood_measured_edges, 0u);
+    EXPECT_EQ(unlabelled.report.wood_measured_edges, 0u);
+    ASSERT_GE(labelled.tree.lobes.size(), 1u);
+    EXPECT_GE(labelled.report.lobe_points, crown * 9 / 10);
+    named.wood_measurement.max_factor = 0.5;
+    EXPECT_THROW(build(cloud, 0.8, named), Error);
+}
