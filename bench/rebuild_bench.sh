@@ -10,23 +10,28 @@
 # IoU ceiling: each original against the same tree with its leaves drawn again (`treelobes compare`).
 # Usage: bench/rebuild_bench.sh [BUILD_DIR] [OUT_DIR] [SPECIES...]   (default: all 12 species)
 # Extra rebuild flags: REBUILD_FLAGS="--scan tls --samples 300000" bench/rebuild_bench.sh
+# Another tree of each species: TREE_SEED=2 bench/rebuild_bench.sh (default 1; outputs in OUT_DIR/SPECIES_SEED
+# for seeds other than 1)
 set -euo pipefail
 here=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-$here/build}
 out=${2:-/tmp/treelobes_rebuild_bench}
 bin=$build/bin/treelobes
 mkdir -p "$out"
+seed=${TREE_SEED:-1}
 species=(mahogany bischofia_polycarpa delonix lagerstroemia ailanthus_altissima palm terminalia pine willow ficus_virens birch oak)
 if [ $# -gt 2 ]; then species=("${@:3}"); fi
 printf '%-20s %8s %9s %8s %7s %7s %7s %7s %7s %5s %5s %5s %5s %5s %5s %6s %7s %7s %7s\n' \
   species in_MB triangles tlobe_kB dbf6_kB factor mean_% p95_% haus_% iouF iouS iouT crF crS crT leafA time_s cpu_s peak_MB
 for s in "${species[@]}"; do
-  if [ ! -s "$out/${s}_1_mesh.obj" ]; then
-    "$bin" synth tree --species "$s" --out "$out" --seed 1 --mesh-format obj --angular-step 1 --log-level error > /dev/null
+  if [ ! -s "$out/${s}_${seed}_mesh.obj" ]; then
+    "$bin" synth tree --species "$s" --out "$out" --seed "$seed" --mesh-format obj --angular-step 1 --log-level error > /dev/null
   fi
+  rebuilt=$out/$s
+  if [ "$seed" != 1 ]; then rebuilt=$out/${s}_$seed; fi
   # shellcheck disable=SC2086
-  "$bin" rebuild "$out/${s}_1_mesh.obj" --out "$out/$s" --species "$s" --log-level error ${REBUILD_FLAGS:-} > /dev/null
-  python3 - "$out/$s/report.json" "$s" <<'PY'
+  "$bin" rebuild "$out/${s}_${seed}_mesh.obj" --out "$rebuilt" --species "$s" --log-level error ${REBUILD_FLAGS:-} > /dev/null
+  python3 - "$rebuilt/report.json" "$s" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 z, f = r["sizes"], r["fidelity"]
@@ -45,11 +50,11 @@ printf '%-20s %8.1f %9s %8.1f %7s %7.0f\n' "paper: Xfrog shrub" 47 - 45 - 1044
 # 0.7 x the default cap of 250 000 leaves, which the heavier species reach).
 printf '\n%-20s %5s %5s %5s %5s %5s %5s  (original against itself re-leafed)\n' species iouF iouS iouT crF crS crT
 for s in "${species[@]}"; do
-  if [ ! -s "$out/releafed/${s}_1_mesh.obj" ]; then
-    "$bin" synth tree --species "$s" --out "$out/releafed" --seed 1 --mesh-format obj --angular-step 1 --leaf-density 0.7 \
+  if [ ! -s "$out/releafed/${s}_${seed}_mesh.obj" ]; then
+    "$bin" synth tree --species "$s" --out "$out/releafed" --seed "$seed" --mesh-format obj --angular-step 1 --leaf-density 0.7 \
       --max-leaves 175000 --log-level error > /dev/null
   fi
-  "$bin" --json compare "$out/${s}_1_mesh.obj" "$out/releafed/${s}_1_mesh.obj" --log-level error | python3 -c '
+  "$bin" --json compare "$out/${s}_${seed}_mesh.obj" "$out/releafed/${s}_${seed}_mesh.obj" --log-level error | python3 -c '
 import json, sys
 f = json.load(sys.stdin)["fidelity"]
 iou, crown = f["silhouette_iou"], f["crown_silhouette_iou"]
