@@ -16,7 +16,7 @@ namespace {
 
 constexpr float kMinScale = 0.5f, kMaxScale = 2.0f;  // patches are stretched at most this much to fit a docking point
 constexpr float kPatchReach = 40.0f;                 // a patch reaches about this many root thicknesses
-constexpr float kMinReseedThickness = 0.004f;        // metres: a re-seed that sticks out is not made thinner than this
+constexpr float kMinRefitThickness = 0.004f;         // metres: a seed or re-seed that sticks out is not made thinner than this
 constexpr int kPatchesPerCell = 2;                   // a fill cell takes geometry from this many patches at most
 constexpr std::size_t kFitLeaves = 32;               // leaf tips per patch scored in fitting (a uniform prefix)
 
@@ -357,14 +357,16 @@ private:
         return true;
     }
 
-    // The best fit at a docking point. A re-seed is sized to reach its empty cell, and from a twig
-    // far from it the patch grows so large that it sticks out of the lobe (straight twigs across
-    // a palm's crown): it is also fitted at half the thickness, and half again down to
-    // kMinReseedThickness, until a fit lies inside; the fit most inside is taken.
+    // The best fit at a docking point. Seeds and re-seeds are placed whatever they fit, and their
+    // thickness is not the lobe's: a re-seed is sized to reach its empty cell, and from a twig far
+    // from it the patch grows so large that it sticks out of the lobe (straight twigs across a
+    // palm's crown); a lobe's seed takes the skeleton's diameter at p_i, and on a palm's trunk top
+    // its patch stood 2 m above the fronds. Both are also fitted at half the thickness, and half
+    // again down to kMinRefitThickness, until a fit lies inside; the fit most inside is taken.
     Fit fit_at(const Pending& pending) {
         Fit best = fit_best(pending.dock, select_candidates(pending.dock));
         DockingPoint thinner = pending.dock;
-        while (pending.origin == DockOrigin::Reseed && best.inside_share < o_.min_inside_share && thinner.thickness > kMinReseedThickness) {
+        while (pending.forced() && best.inside_share < o_.min_inside_share && thinner.thickness > kMinRefitThickness) {
             thinner.thickness *= 0.5f;
             const Fit fit = fit_best(thinner, select_candidates(thinner));
             if (fit.inside_share > best.inside_share) best = fit;

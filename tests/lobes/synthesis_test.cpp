@@ -429,3 +429,19 @@ TEST(Synthesis, LobeLeafSharesMoveLeavesToTheLeafyLobes) {
     EXPECT_LE(shared.triangles(), o.max_triangles);
     EXPECT_EQ(shared.wood.faces.size(), unknown.wood.faces.size());
 }
+
+// A lobe's seed takes the skeleton's diameter at p_i: a palm's crown lobe seeded on its trunk top
+// grew a seed patch standing 2 m above the fronds. The seed is refitted thinner like a re-seed.
+TEST(Texturing, AThickSeedIsMadeThinnerToFitItsLobe) {
+    const PatchLibrary lib = build_patch_library(species("palm"));
+    const TriangleMesh crown = box({-1.5f, -1.5f, 6}, {1.5f, 1.5f, 7.5f});
+    const DockingPoint trunk_top{{0, 0, 6}, {0, 0, 1}, 0.3f};
+    TexturingOptions o;
+    o.max_patches_per_lobe = 1;  // the seed's patch alone
+    const LobeTexture t = texture_lobe(crown, trunk_top, lib, o, 0);
+    ASSERT_EQ(t.instances.size(), 1u);
+    // At the seed's thickness 75 % of the patch lay outside the crown, scaled to the largest
+    // stretch (2); refitted thinner, none of it.
+    EXPECT_LT(share_outside(t, lib, LobeVolume(crown, 40)), 1.0 - TexturingOptions{}.min_inside_share);
+    EXPECT_LT(t.instances[0].scale, 1.5f);
+}
