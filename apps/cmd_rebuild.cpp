@@ -52,6 +52,7 @@ using Clock = std::chrono::steady_clock;
 // (beta = gamma = 1.5, f_s = 1) and the lobes are textured with this species' patches, the
 // profile of Livny et al. 2011, Appendix A (as `treelobes synthesize` does for a file without species).
 constexpr const char* kDefaultPatchSpecies = "lagerstroemia";
+constexpr double kMinBudgetBytes = 2000;  // a skeleton and a few coarse lobes
 
 struct RebuildCliOptions {
     std::string input;
@@ -63,7 +64,8 @@ struct RebuildCliOptions {
     double density = 0;
     int stations = 4;
     std::uint64_t seed = 1;
-    double budget_kb = 60;
+    double budget_kb = 60;  // Livny et al. 2011, §7: 60 kB for a 56 MB Xfrog tree
+    double min_ratio = 500;  // the rebuild job's size target against the input mesh file; 0 = none
     std::string leaf_materials;
     double dbf6_resolution = 5.0;
     std::size_t compare_samples = 20000;
@@ -169,6 +171,16 @@ std::uintmax_t file_bytes(const fs::path& path) {
     return ec ? 0 : size;
 }
 
+// The .tlobe budget: --budget-kb, or the input file's size / --min-ratio where that is less (never
+// under the 2 kB that --budget-kb allows at least).
+lobes::TlobeOptions file_options_for(const RebuildCliOptions& o, std::uintmax_t input_bytes) {
+    lobes::TlobeOptions file;
+    double budget = o.budget_kb * 1000;
+    if (o.min_ratio > 0) budget = std::min(budget, std::max(kMinBudgetBytes, static_cast<double>(input_bytes) / o.min_ratio));
+    file.max_bytes = static_cast<std::size_t>(budget);
+    return file;
+}
+
 void print_summary(const json& r) {
     const json& s = r["sizes"];
     const json& f = r["fidelity"];
@@ -179,8 +191,10 @@ void print_summary(const json& r) {
     std::printf("  samples  %zu (%s), species %s (%s)\n", r["samples"]["points"].get<std::size_t>(),
                 r["samples"]["pattern"].get<std::string>().c_str(), r["species"]["patches"].get<std::string>().c_str(),
                 r["species"]["source"].get<std::string>().c_str());
-    std::printf("  .tlobe   %.1f kB (%.0fx smaller), .dbf6 %.1f kB, %zu lobes\n", s["tlobe_bytes"].get<double>() / 1e3,
-                s["compression_factor"].get<double>(), s["dbf6_bytes"].get<double>() / 1e3, r["lobes"]["count"].get<std::size_t>());
+    std::printf("  .tlobe   %.1f kB (%.0fx smaller; budget %.1f kB%s), .dbf6 %.1f kB, %zu lobes\n", s["tlobe_bytes"].get<double>() / 1e3,
+                s["compression_factor"].get<double>(), s["budget_bytes"].get<double>() / 1e3,
+                s["within_budget"].get<bool>() ? "" : ", exceeded: the skeleton and simplest lobes need more",
+                s["dbf6_bytes"].get<double>() / 1e3, r["lobes"]["count"].get<std::size_t>());
     std::printf("  rebuilt  %zu triangles; distance mean %.3f m (%.2f %% of the diagonal), p95 %.3f m, Hausdorff %.3f m\n",
                 r["rebuilt"]["triangles"].get<std::size_t>(), f["symmetric"]["mean"].get<double>(),
                 100 * f["symmetric"]["mean_of_diagonal"].get<double>(), f["symmetric"]["p95"].get<double>(),
@@ -212,13 +226,12 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     const std::string species_flag = o.flags.species.empty() ? "auto" : o.flags.species;
     if (species_flag != "auto") o.flags.species = find_species(load_species_entries(default_species_file()), species_flag).name;
     if (!o.model.empty() && species_flag != "auto") throw Error::usage("--model chooses the species for --species auto; drop one of them");
-    lobes::TlobeOptions file_options;
-    file_options.max_bytes = static_cast<std::size_t>(o.budget_kb * 1000);
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
     const fs::path input(o.input), dir(o.out);
     const std::string stem = input.stem().string();
+    const lobes::TlobeOptions file_options = file_options_for(o, file_bytes(input));
 
     clock.start("read", "reading " + o.input);
     const NamedMesh named = read_named_mesh(input);
@@ -417,8 +430,12 @@ void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--density", o->density, "Uniform sampling: points per m^2 of surface instead of --samples")->check(PositiveNumber);
     table->add("--stations", o->stations, "TLS stations around the model")->check(CLI::Range(1, 16));
     table->add("--seed", o->seed, "Random seed of sampling and synthesis");
-    table->add("--budget-kb", o->budget_kb, "Size the .tlobe may take (kB); its lobe occupancy grid is coarsened to fit")
-            ->check(CLI::Range(2.0, 10000.0));
+    table->add("--budget-kb", o->budget_kb,
+               "Size the .tlobe may take (kB); its lobe occupancy grid is coarsened, then its lobe surfaces simplified, to fit")
+            ->check(CLI::Range(kMinBudgetBytes / 1000, 10000.0));
+    table->add("--min-ratio", o->min_ratio,
+               "Keep the .tlobe within the input mesh file's size / this where that is below --budget-kb (0: off)")
+            ->check(CLI::Range(0.0, 1e6));
     table->add("--leaf-materials", o->leaf_materials,
                "Comma-separated names (substrings, any case) of leaf materials/groups/objects; other named faces are wood");
     table->add("--max-triangles", o->synthesis.max_triangles, "Triangles of the synthesized tree at most")

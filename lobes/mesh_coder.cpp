@@ -4,6 +4,9 @@
 #include "geometry/closed_mesh.hpp"
 
 #include <cmath>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
 #include <cstring>
 #include <limits>
 
@@ -79,11 +82,13 @@ double ByteReader::f64() {
     return v;
 }
 
-std::string ByteReader::string() {
-    const std::size_t n = count(1, "string length");
-    std::string s(bytes_.substr(pos_, n));
-    pos_ += n;
-    return s;
+std::string ByteReader::string() { return std::string(take(count(1, "string length"))); }
+
+std::string_view ByteReader::take(std::size_t size) {
+    if (size > bytes_.size() - pos_) fail("truncated section");
+    const std::string_view part = bytes_.substr(pos_, size);
+    pos_ += size;
+    return part;
 }
 
 std::size_t ByteReader::count(std::size_t min_bytes, const char* what) {
@@ -99,31 +104,305 @@ std::int64_t quantize(double value, double quantum) {
     return static_cast<std::int64_t>(q);
 }
 
-void encode_mesh(const TriangleMesh& input, double quantum, ByteWriter& out) {
-    TriangleMesh mesh = input;
-    remove_unused_vertices(mesh);  // first-use order: a new corner is always the next index
-    out.varint(mesh.vertices.size());
-    out.varint(mesh.faces.size());
-    std::int64_t previous[3] = {0, 0, 0};
-    for (const auto& v : mesh.vertices)
-        for (int k = 0; k < 3; ++k) {
-            const std::int64_t q = quantize(v[k], quantum);
-            out.svarint(q - previous[k]);
-            previous[k] = q;
+namespace {
+
+enum Corner : std::uint8_t { kNewVertex = 0, kLeftNeighbour = 1, kRightNeighbour = 2, kEarlierVertex = 3, kNoFace = 4 };
+
+std::uint64_t half_edge_key(int from, int to) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(from)) << 32) | static_cast<std::uint32_t>(to);
+}
+
+// What encoder and decoder both know while faces are added in traversal order (docs/tlobe.md):
+// the half-edges of the faces added so far, the gates still to cross, and per vertex the
+// open half-edges (those whose reverse is not added yet) that end or start at it. Both sides run
+// this same state machine, so every symbol means the same to both.
+class Traversal {
+public:
+    struct Gate {
+        int from, to, apex;  // half-edge from -> to of an added face whose third vertex is apex
+    };
+
+    explicit Traversal(std::size_t vertices) : into_(vertices), out_of_(vertices) {}
+
+    void add_face(int a, int b, int c) {
+        faces.push_back({a, b, c});
+        for (const auto& [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+            added_.insert(half_edge_key(u, v));
+            into_[v].push_back(u);
+            out_of_[u].push_back(v);
         }
-    int next = 0;
-    for (const auto& f : mesh.faces)
-        for (int index : f) {
-            if (index == next) {
-                out.varint(0);
-                ++next;
-            } else {
-                out.varint(static_cast<std::uint64_t>(next - index));
+    }
+    // A component's first face: all three edges are gates, the first one popped first.
+    void start_component() {
+        const auto [a, b, c] = faces.back();
+        gates_.push_back({c, a, b});
+        gates_.push_back({b, c, a});
+        gates_.push_back({a, b, c});
+    }
+    // The face (to, from, c) across a gate: its two other edges become gates, from -> c first.
+    void cross(const Gate& g, int c) {
+        add_face(g.to, g.from, c);
+        gates_.push_back({c, g.to, g.from});
+        gates_.push_back({g.from, c, g.to});
+    }
+    // The next gate whose reverse half-edge no added face has yet; none when the stack is empty.
+    std::optional<Gate> next_gate() {
+        while (!gates_.empty()) {
+            const Gate g = gates_.back();
+            gates_.pop_back();
+            if (!added_.contains(half_edge_key(g.to, g.from))) return g;
+        }
+        return std::nullopt;
+    }
+    // The vertex before `from` on the open border (the latest open half-edge x -> from, x != to),
+    // and the one after `to` (the latest open to -> y, y != from); -1 when there is none. Where
+    // the face across closes the border on either side, its third vertex is one of these.
+    int left_of(const Gate& g) const {
+        const auto& sources = into_[g.from];
+        for (auto x = sources.rbegin(); x != sources.rend(); ++x)
+            if (*x != g.to && !added_.contains(half_edge_key(g.from, *x))) return *x;
+        return -1;
+    }
+    int right_of(const Gate& g) const {
+        const auto& targets = out_of_[g.to];
+        for (auto y = targets.rbegin(); y != targets.rend(); ++y)
+            if (*y != g.from && !added_.contains(half_edge_key(*y, g.to))) return *y;
+        return -1;
+    }
+
+    std::vector<std::array<int, 3>> faces;
+
+private:
+    std::unordered_set<std::uint64_t> added_;
+    std::vector<std::vector<int>> into_, out_of_;
+    std::vector<Gate> gates_;
+};
+
+// The three sections of a coded mesh, each deflated well on its own: one byte per corner
+// symbol, back-references to earlier vertices, and position residuals.
+struct MeshSections {
+    std::size_t vertices = 0;  // those the faces use
+    ByteWriter symbols, references, residuals;
+};
+
+using GridPoint = std::array<std::int64_t, 3>;
+
+GridPoint parallelogram(const GridPoint& a, const GridPoint& b, const GridPoint& apex) {
+    return {a[0] + b[0] - apex[0], a[1] + b[1] - apex[1], a[2] + b[2] - apex[2]};
+}
+
+class MeshEncoder {
+public:
+    MeshEncoder(const TriangleMesh& mesh, double quantum) : mesh_(mesh), traversal_(mesh.vertices.size()) {
+        grid_.reserve(mesh.vertices.size());
+        for (const auto& v : mesh.vertices) grid_.push_back({quantize(v[0], quantum), quantize(v[1], quantum), quantize(v[2], quantum)});
+        for (std::size_t f = 0; f < mesh.faces.size(); ++f)
+            for (int k = 0; k < 3; ++k) faces_with_.emplace(half_edge_key(mesh.faces[f][k], mesh.faces[f][(k + 1) % 3]), f);
+        coded_.assign(mesh.faces.size(), false);
+        number_.assign(mesh.vertices.size(), -1);
+    }
+
+    MeshSections run() {
+        for (std::size_t f = 0; f < mesh_.faces.size(); ++f) {
+            if (coded_[f]) continue;
+            code_start_face(f);
+            while (remaining_ > 0) {
+                const auto gate = traversal_.next_gate();
+                if (!gate) break;
+                code_face_across(*gate);
             }
         }
+        out_.vertices = original_.size();
+        return std::move(out_);
+    }
+
+private:
+    void code_start_face(std::size_t f) {
+        coded_[f] = true;
+        --remaining_;
+        std::array<int, 3> local{};
+        for (int k = 0; k < 3; ++k) {
+            const int v = mesh_.faces[f][k];
+            local[k] = is_new(v) ? introduce(v, previous_) : refer(v);
+        }
+        traversal_.add_face(local[0], local[1], local[2]);
+        traversal_.start_component();
+    }
+
+    void code_face_across(const Traversal::Gate& gate) {
+        const int from = original_[gate.from], to = original_[gate.to];
+        const auto face = uncoded_face_with(to, from);
+        if (!face) {
+            out_.symbols.u8(kNoFace);
+            return;
+        }
+        coded_[*face] = true;
+        --remaining_;
+        const auto& corners = mesh_.faces[*face];
+        int at = 0;
+        while (!(corners[at] == to && corners[(at + 1) % 3] == from)) ++at;
+        const int c = corners[(at + 2) % 3];
+        int local;
+        if (is_new(c)) {
+            local = introduce(c, parallelogram(grid_[from], grid_[to], grid_[original_[gate.apex]]));
+        } else if (number_[c] == traversal_.left_of(gate)) {
+            out_.symbols.u8(kLeftNeighbour);
+            local = number_[c];
+        } else if (number_[c] == traversal_.right_of(gate)) {
+            out_.symbols.u8(kRightNeighbour);
+            local = number_[c];
+        } else {
+            local = refer(c);
+        }
+        traversal_.cross(gate, local);
+    }
+
+    // The first face not coded yet that holds the half-edge from -> to.
+    std::optional<std::size_t> uncoded_face_with(int from, int to) const {
+        std::optional<std::size_t> first;
+        const auto [begin, end] = faces_with_.equal_range(half_edge_key(from, to));
+        for (auto it = begin; it != end; ++it)
+            if (!coded_[it->second] && (!first || it->second < *first)) first = it->second;
+        return first;
+    }
+
+    bool is_new(int v) const { return number_[v] < 0; }
+
+    int introduce(int v, const GridPoint& predicted) {
+        out_.symbols.u8(kNewVertex);
+        for (int k = 0; k < 3; ++k) out_.residuals.svarint(grid_[v][k] - predicted[k]);
+        number_[v] = static_cast<int>(original_.size());
+        original_.push_back(v);
+        previous_ = grid_[v];
+        return number_[v];
+    }
+
+    int refer(int v) {
+        out_.symbols.u8(kEarlierVertex);
+        out_.references.varint(static_cast<std::uint64_t>(static_cast<int>(original_.size()) - 1 - number_[v]));
+        return number_[v];
+    }
+
+    const TriangleMesh& mesh_;
+    Traversal traversal_;
+    std::vector<GridPoint> grid_;
+    std::unordered_multimap<std::uint64_t, std::size_t> faces_with_;
+    std::vector<bool> coded_;
+    std::vector<int> number_;    // original vertex -> number in order of introduction (-1: not yet)
+    std::vector<int> original_;  // number -> original vertex
+    GridPoint previous_{0, 0, 0};
+    std::size_t remaining_ = mesh_.faces.size();
+    MeshSections out_;
+};
+
+void write_section(const ByteWriter& section, ByteWriter& out) {
+    out.varint(section.bytes().size());
+    for (char b : section.bytes()) out.u8(static_cast<std::uint8_t>(b));
+}
+
+std::string_view read_section(ByteReader& in) {
+    const std::size_t size = in.count(1, "mesh section size");
+    return in.take(size);
+}
+
+class MeshDecoder {
+public:
+    MeshDecoder(std::size_t vertices, std::size_t faces, double quantum, std::string_view symbols, std::string_view references,
+                std::string_view residuals, const ByteReader& context)
+        : vertices_(vertices), faces_(faces), quantum_(quantum), traversal_(vertices), symbols_(context.part(symbols)),
+          references_(context.part(references)), residuals_(context.part(residuals)) {}
+
+    TriangleMesh run() {
+        while (traversal_.faces.size() < faces_) {
+            decode_start_face();
+            while (traversal_.faces.size() < faces_) {
+                const auto gate = traversal_.next_gate();
+                if (!gate) break;
+                decode_face_across(*gate);
+            }
+        }
+        if (grid_.size() != vertices_) symbols_.fail("mesh has vertices no face uses");
+        if (!symbols_.at_end() || !references_.at_end() || !residuals_.at_end()) symbols_.fail("trailing bytes in a lobe mesh");
+        TriangleMesh mesh;
+        mesh.vertices.reserve(grid_.size());
+        for (const auto& q : grid_)
+            mesh.vertices.emplace_back(static_cast<float>(static_cast<double>(q[0]) * quantum_),
+                                       static_cast<float>(static_cast<double>(q[1]) * quantum_),
+                                       static_cast<float>(static_cast<double>(q[2]) * quantum_));
+        mesh.faces = std::move(traversal_.faces);
+        return mesh;
+    }
+
+private:
+    void decode_start_face() {
+        std::array<int, 3> local{};
+        for (int& v : local) {
+            const std::uint8_t symbol = symbols_.u8();
+            if (symbol == kNewVertex)
+                v = introduce(grid_.empty() ? GridPoint{0, 0, 0} : grid_.back());
+            else if (symbol == kEarlierVertex)
+                v = earlier_vertex();
+            else
+                symbols_.fail("invalid corner symbol of a lobe mesh's first face");
+        }
+        traversal_.add_face(local[0], local[1], local[2]);
+        traversal_.start_component();
+    }
+
+    void decode_face_across(const Traversal::Gate& gate) {
+        int c = -1;
+        switch (symbols_.u8()) {
+            case kNoFace: return;
+            case kNewVertex: c = introduce(parallelogram(grid_[gate.from], grid_[gate.to], grid_[gate.apex])); break;
+            case kLeftNeighbour: c = traversal_.left_of(gate); break;
+            case kRightNeighbour: c = traversal_.right_of(gate); break;
+            case kEarlierVertex: c = earlier_vertex(); break;
+            default: symbols_.fail("invalid corner symbol in a lobe mesh");
+        }
+        if (c < 0) symbols_.fail("lobe mesh refers to a border neighbour that does not exist");
+        traversal_.cross(gate, c);
+    }
+
+    int introduce(const GridPoint& predicted) {
+        if (grid_.size() >= vertices_) symbols_.fail("mesh face refers to a vertex beyond the vertex count");
+        grid_.push_back({residuals_.delta_coordinate(predicted[0]), residuals_.delta_coordinate(predicted[1]),
+                         residuals_.delta_coordinate(predicted[2])});
+        return static_cast<int>(grid_.size()) - 1;
+    }
+
+    int earlier_vertex() {
+        const std::uint64_t back = references_.varint();
+        if (back >= grid_.size()) references_.fail("mesh face refers to a vertex before the first");
+        return static_cast<int>(grid_.size() - 1 - back);
+    }
+
+    std::size_t vertices_, faces_;
+    double quantum_;
+    Traversal traversal_;
+    ByteReader symbols_, references_, residuals_;
+    std::vector<GridPoint> grid_;
+};
+
+}  // namespace
+
+void encode_mesh(const TriangleMesh& mesh, double quantum, ByteWriter& out) {
+    const MeshSections sections = MeshEncoder(mesh, quantum).run();
+    out.varint(sections.vertices);
+    out.varint(mesh.faces.size());
+    write_section(sections.symbols, out);
+    write_section(sections.references, out);
+    write_section(sections.residuals, out);
 }
 
 TriangleMesh decode_mesh(ByteReader& in, double quantum) {
+    const std::uint64_t vertices = in.varint(), faces = in.varint();
+    const std::string_view symbols = read_section(in), references = read_section(in), residuals = read_section(in);
+    // Every face takes at least one symbol byte, and a face brings at most 3 vertices.
+    if (faces > symbols.size() || vertices > 3 * faces) in.fail("implausible lobe mesh size");
+    return MeshDecoder(vertices, faces, quantum, symbols, references, residuals, in).run();
+}
+
+TriangleMesh decode_mesh_v3(ByteReader& in, double quantum) {
     TriangleMesh mesh;
     const std::size_t vertices = in.count(3, "vertex count");
     const std::size_t faces = in.count(3, "face count");

@@ -2,6 +2,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "geometry/alpha_shape.hpp"
 #include "lobes/mesh_coder.hpp"
 #include "lobes/occupancy.hpp"
 
@@ -10,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 namespace treelobes::lobes {
 
@@ -90,6 +92,9 @@ void check_options(const TlobeOptions& o) {
     if (!(o.quantum > 0 && o.quantum <= 1) || !(o.diameter_quantum > 0 && o.diameter_quantum <= 1))
         throw Error::usage("tlobe: quanta must be in (0, 1] metres");
     if (o.compression_level < 1 || o.compression_level > 9) throw Error::usage("tlobe: compression level must be 1..9");
+    for (double fraction : o.lobe_face_fractions)
+        if (!(fraction > 0 && fraction < 1)) throw Error::usage("tlobe: lobe face fractions must be in (0, 1)");
+    if (o.min_lobe_faces < 4) throw Error::usage("tlobe: lobes keep at least 4 faces");
 }
 
 }  // namespace
@@ -147,17 +152,12 @@ std::string pack(const std::string& raw, int level) {
 
 }  // namespace
 
-std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
-    check_options(o);
+namespace {
+
+// The file on the finest occupancy grid at which it fits max_bytes; none when no grid fits (a
+// grid that some lobe's extent makes too large is skipped).
+std::optional<std::string> finest_fitting_file(const LobeTree& tree, const TlobeOptions& o) {
     const double quantum = static_cast<float>(o.quantum);
-    std::vector<const Occupancy*> stored(tree.lobes.size());
-    bool from_points = false;
-    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
-        stored[i] = &tree.lobes[i].occupancy;
-        from_points = from_points || !tree.lobes[i].cluster_points.empty();
-    }
-    if (!from_points) return pack(encode_payload(tree, o, stored), o.compression_level);
-    // Finest grid first; a grid that some lobe's extent makes too large is skipped.
     std::vector<Occupancy> grids(tree.lobes.size());
     std::vector<const Occupancy*> use(tree.lobes.size());
     for (double size : o.occupancy_cells) {
@@ -172,18 +172,53 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
         std::string file = pack(encode_payload(tree, o, use), o.compression_level);
         if (file.size() <= o.max_bytes) return file;
     }
+    return std::nullopt;
+}
+
+// The tree with every lobe surface simplified to `fraction` of its faces (at least min_faces).
+LobeTree with_coarser_lobes(const LobeTree& tree, double fraction, std::size_t min_faces) {
+    LobeTree coarse = tree;
+    for (Lobe& lobe : coarse.lobes) {
+        SimplifyOptions simplify;
+        simplify.tolerance = 0;  // the face count alone decides
+        simplify.max_faces = std::max<std::size_t>(min_faces, std::llround(fraction * static_cast<double>(lobe.mesh.faces.size())));
+        simplify.min_faces = min_faces;
+        simplify_closed_mesh(lobe.mesh, simplify);  // false = kept as it is (still closed)
+    }
+    return coarse;
+}
+
+}  // namespace
+
+std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
+    check_options(o);
+    std::vector<const Occupancy*> stored(tree.lobes.size());
+    bool from_points = false;
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        stored[i] = &tree.lobes[i].occupancy;
+        from_points = from_points || !tree.lobes[i].cluster_points.empty();
+    }
+    if (!from_points) return pack(encode_payload(tree, o, stored), o.compression_level);
+    if (auto file = finest_fitting_file(tree, o)) return *file;
+    // No grid fits: the lobe surfaces give up detail, halving their faces until one does.
+    LobeTree coarse;
+    for (double fraction : o.lobe_face_fractions) {
+        coarse = with_coarser_lobes(tree, fraction, o.min_lobe_faces);
+        if (auto file = finest_fitting_file(coarse, o)) return *file;
+    }
     const Occupancy none;
-    for (auto& p : use) p = &none;
-    return pack(encode_payload(tree, o, use), o.compression_level);
+    std::vector<const Occupancy*> use(tree.lobes.size(), &none);
+    return pack(encode_payload(o.lobe_face_fractions.empty() ? tree : coarse, o, use), o.compression_level);
 }
 
 LobeTree decode_tlobe(std::string_view file, const std::string& name) {
     if (file.size() < kHeaderSize || std::memcmp(file.data(), kMagic.data(), 4) != 0)
         throw Error::input(name, "not a .tlobe file (no TLOB header)");
     const int major = static_cast<unsigned char>(file[4]), minor = static_cast<unsigned char>(file[5]);
-    if (major != kTlobeMajorVersion)
+    if (major < kTlobeOldestMajorVersion || major > kTlobeMajorVersion)
         throw Error::input(name, ".tlobe version " + std::to_string(major) + "." + std::to_string(minor) +
-                                         " is not supported (this build reads version " + std::to_string(kTlobeMajorVersion) +
+                                         " is not supported (this build reads versions " +
+                                         std::to_string(kTlobeOldestMajorVersion) + ".x to " + std::to_string(kTlobeMajorVersion) +
                                          ".x; run `treelobes lobes` on the scan again)");
     const std::uint32_t raw_size = get_u32(file, 8), packed_size = get_u32(file, 12);
     if (packed_size != file.size() - kHeaderSize) throw Error::input(name, "truncated .tlobe file (payload size mismatch)");
@@ -197,10 +232,18 @@ LobeTree decode_tlobe(std::string_view file, const std::string& name) {
                    packed_size) != Z_OK ||
         unpacked != raw_size)
         throw Error::input(name, "corrupt .tlobe payload (inflate failed)");
-    return decode_tlobe_payload(raw, name, minor);
+    return decode_tlobe_payload(raw, name, major, minor);
 }
 
-LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int minor) {
+namespace {
+
+// Fields appended after the lobes: 3.1 added the leaf area, 3.2 the lobes' leaf shares; 4.0
+// has both.
+int appended_fields(int major, int minor) { return major == 3 ? minor : 2 + minor; }
+
+}  // namespace
+
+LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int major, int minor) {
     ByteReader in(raw, name);
     LobeTree tree;
     Eigen::Vector3d origin;
@@ -226,17 +269,18 @@ LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int
         Eigen::Vector3f d;
         for (int k = 0; k < 3; ++k) d[k] = static_cast<float>(in.svarint());
         lobe.seed_direction = d.norm() > 0 ? Eigen::Vector3f(d.normalized()) : Eigen::Vector3f::UnitZ();
-        lobe.mesh = decode_mesh(in, quantum);
+        lobe.mesh = major == 3 ? decode_mesh_v3(in, quantum) : decode_mesh(in, quantum);
         lobe.occupancy = decode_occupancy(in, quantum);
     }
-    if (minor >= 1) {
+    const int fields = appended_fields(major, minor);
+    if (fields >= 1) {
         tree.leaf_area_m2 = in.f32();
         if (!(tree.leaf_area_m2 >= 0 && tree.leaf_area_m2 < kMaxLeafArea)) in.fail("invalid leaf area");
     }
-    if (minor >= 2)
+    if (fields >= 2)
         for (Lobe& lobe : tree.lobes) lobe.leaf_share = decode_leaf_share(in.u8());
     // A later minor version appends fields this build does not know: they are skipped.
-    if (minor <= kTlobeMinorVersion && !in.at_end()) in.fail("trailing bytes after the last field");
+    if (fields <= appended_fields(kTlobeMajorVersion, kTlobeMinorVersion) && !in.at_end()) in.fail("trailing bytes after the last field");
     return tree;
 }
 

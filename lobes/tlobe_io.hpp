@@ -17,8 +17,9 @@
 
 namespace treelobes::lobes {
 
-inline constexpr std::uint8_t kTlobeMajorVersion = 3;
-inline constexpr std::uint8_t kTlobeMinorVersion = 2;  // 3.1 appended the leaf area, 3.2 the lobes' leaf shares
+inline constexpr std::uint8_t kTlobeMajorVersion = 4;  // 4.0 codes lobe meshes in traversal order
+inline constexpr std::uint8_t kTlobeMinorVersion = 0;
+inline constexpr std::uint8_t kTlobeOldestMajorVersion = 3;  // 3.1 appended the leaf area, 3.2 the lobes' leaf shares
 
 struct TlobeOptions {
     double quantum = 0.005;            // metres: grid of skeleton positions and lobe vertices
@@ -28,19 +29,26 @@ struct TlobeOptions {
     // Metres, finest first, steps of about 1.2 (each one costs an encoding pass).
     std::vector<double> occupancy_cells{0.03, 0.035, 0.04, 0.05, 0.06, 0.07, 0.085, 0.1, 0.12, 0.14,
                                         0.17, 0.2,   0.24, 0.3,  0.35, 0.4,  0.5,   0.6, 0.8};
+    // When no grid fits, the lobe surfaces are simplified to these fractions of their faces (each
+    // keeps min_lobe_faces at least) and every grid is tried again, largest fraction first.
+    std::vector<double> lobe_face_fractions{0.5, 0.25, 0.125, 0.0625};
+    std::size_t min_lobe_faces = 12;
 };
 
 // Bytes of the file. Lobes with cluster_points get their occupancy on the finest grid of
-// occupancy_cells (rounded to the quantum) at which the file fits max_bytes; none if no grid
-// fits. Lobes without cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
+// occupancy_cells (rounded to the quantum) at which the file fits max_bytes; if none fits, their
+// surfaces are simplified (lobe_face_fractions) until one does, and if none does even then, the
+// most simplified surfaces are stored without occupancy. Lobes without cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
 std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {});
 // Parses a file's bytes; any inconsistency throws Error(InvalidInput) naming `name`.
 // Decoded lobes have origin 0 (the tree's frame), the skeleton the stored origin.
 LobeTree decode_tlobe(std::string_view bytes, const std::string& name);
 // The inflated payload behind the header, size and CRC checks (what decode_tlobe parses once
 // they pass; fuzz/ feeds it directly so that mutations reach the parser). Same errors.
-// `minor`: the header's minor version, which says which appended fields the payload holds.
-LobeTree decode_tlobe_payload(std::string_view payload, const std::string& name, int minor = kTlobeMinorVersion);
+// `major`, `minor`: the header's version, which says how lobe meshes are coded and which
+// appended fields the payload holds.
+LobeTree decode_tlobe_payload(std::string_view payload, const std::string& name, int major = kTlobeMajorVersion,
+                              int minor = kTlobeMinorVersion);
 
 void write_tlobe(const LobeTree& tree, const std::filesystem::path& path, const TlobeOptions& options = {});
 LobeTree read_tlobe(const std::filesystem::path& path);

@@ -62,6 +62,8 @@ if [ "$target" = laz ] && [ -d "$real" ]; then
   find "$real" -name '*.laz' -size -64k 2>/dev/null | sort | xargs -r cp -t "$corpus-real"
   seeds+=("$corpus-real")
 fi
+# The .tlobe file target also starts from the version 3 file the tests keep (the older mesh coding).
+if [ "$target" = tlobe ]; then seeds+=(tests/data/tlobe); fi
 flags=(-max_total_time="$seconds" -timeout=10 -rss_limit_mb=2560 -malloc_limit_mb=1024
        -artifact_prefix="$artifacts/" -print_final_stats=1)
 [ -f "fuzz/dicts/$target.dict" ] && flags+=(-dict="fuzz/dicts/$target.dict")

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 using namespace treelobes;
 using test::quoted;
@@ -57,6 +58,9 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     EXPECT_LE(sizes["tlobe_bytes"].get<double>(), 60000);
     EXPECT_NEAR(sizes["compression_factor"].get<double>(), sizes["original_bytes"].get<double>() / sizes["tlobe_bytes"].get<double>(), 0.1);
     EXPECT_GT(sizes["compression_factor"].get<double>(), 10);
+    // 0.48 MB / 500 is under the 2 kB floor: the budget is the floor, and the file keeps it.
+    EXPECT_EQ(sizes["budget_bytes"].get<double>(), 2000);
+    EXPECT_TRUE(sizes["within_budget"].get<bool>());
     const auto& symmetric = report["fidelity"]["symmetric"];
     EXPECT_GT(symmetric["mean"].get<double>(), 0);
     EXPECT_LT(symmetric["mean_of_diagonal"].get<double>(), 0.1);  // the rebuilt tree stands where the original stood
@@ -138,6 +142,29 @@ TEST(RebuildCli, SpeciesAutoTakesTheClassifiersChoiceElseTheDefault) {
 
     EXPECT_EQ(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(without_model.path()) + " --species palm --model " + model).exit_code,
               1);
+}
+
+// The .tlobe budget is --budget-kb or the input's size / --min-ratio, whichever is smaller; a
+// tighter budget keeps the file within it by coarser occupancy and then simpler lobe surfaces.
+TEST(RebuildCli, TheBudgetIsTheSmallerOfBudgetKbAndTheInputOverMinRatio) {
+    TempDir in, by_ratio, by_kb;
+    const auto mesh = small_tree_obj(in);
+    const double input_bytes = static_cast<double>(std::filesystem::file_size(mesh));
+    const auto run = [&](const TempDir& out, const std::string& flags) {
+        const auto r = run_cli("rebuild " + quoted(mesh) + " --out " + quoted(out.path()) + " --species palm" + kFastRebuild + flags);
+        EXPECT_EQ(r.exit_code, 0) << r.err;
+        return nlohmann::json::parse(read_file(out / "report.json"))["sizes"];
+    };
+    const auto ratio = run(by_ratio, " --min-ratio 100");
+    EXPECT_EQ(ratio["budget_bytes"].get<double>(), std::floor(input_bytes / 100));
+    const auto kb = run(by_kb, " --min-ratio 0 --budget-kb 12");
+    EXPECT_EQ(kb["budget_bytes"].get<double>(), 12000);
+    for (const auto& sizes : {ratio, kb}) {
+        EXPECT_TRUE(sizes["within_budget"].get<bool>());
+        EXPECT_LE(sizes["tlobe_bytes"].get<double>(), sizes["budget_bytes"].get<double>());
+    }
+    EXPECT_LT(ratio["tlobe_bytes"].get<double>(), kb["tlobe_bytes"].get<double>());
+    EXPECT_NE(run_cli("rebuild " + quoted(mesh) + " --out " + quoted(by_kb.path()) + " --min-ratio -1").exit_code, 0);
 }
 
 TEST(RebuildCli, SameInputSameOutputs) {
