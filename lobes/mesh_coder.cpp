@@ -154,25 +154,29 @@ public:
         }
         return std::nullopt;
     }
-    // The vertex before `from` on the open border (the latest open half-edge x -> from, x != to),
-    // and the one after `to` (the latest open to -> y, y != from); -1 when there is none. Where
-    // the face across closes the border on either side, its third vertex is one of these.
-    int left_of(const Gate& g) const {
-        const auto& sources = into_[g.from];
-        for (auto x = sources.rbegin(); x != sources.rend(); ++x)
-            if (*x != g.to && !added_.contains(half_edge_key(g.from, *x))) return *x;
-        return -1;
+    // The vertex before `from` on the open border (the latest-added open half-edge x -> from) and
+    // the one after `to` (the latest-added open to -> y); -1 when there is none. Where the face
+    // across closes the border on either side, its third vertex is one of these. (x is never
+    // `to`: to -> from would be the gate's reverse, which next_gate() has found not added.)
+    // Closed half-edges stay closed, so they are dropped as they are met: every entry is passed
+    // over at most once, and a damaged file's fans cannot make the lookups quadratic.
+    int left_of(const Gate& g) {
+        return latest_open(into_[g.from], [&](int x) { return half_edge_key(g.from, x); });
     }
-    int right_of(const Gate& g) const {
-        const auto& targets = out_of_[g.to];
-        for (auto y = targets.rbegin(); y != targets.rend(); ++y)
-            if (*y != g.from && !added_.contains(half_edge_key(*y, g.to))) return *y;
-        return -1;
+    int right_of(const Gate& g) {
+        return latest_open(out_of_[g.to], [&](int y) { return half_edge_key(y, g.to); });
     }
 
     std::vector<std::array<int, 3>> faces;
 
 private:
+    // The last of `partners` whose half-edge is still open (its reverse, `reverse_key`, not added).
+    template <class ReverseKey>
+    int latest_open(std::vector<int>& partners, ReverseKey reverse_key) const {
+        while (!partners.empty() && added_.contains(reverse_key(partners.back()))) partners.pop_back();
+        return partners.empty() ? -1 : partners.back();
+    }
+
     std::unordered_set<std::uint64_t> added_;
     std::vector<std::vector<int>> into_, out_of_;
     std::vector<Gate> gates_;

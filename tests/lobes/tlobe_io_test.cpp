@@ -194,6 +194,28 @@ TEST(MeshCoder, OpenNonManifoldAndSeveralPartsRoundTrip) {
     expect_same_faces(d, m, 0.0025f);
 }
 
+// A closed double cone with 3000 faces around each apex: the border lookups of the traversal
+// pass over closed half-edges once, so high-degree vertices cost nothing special.
+TEST(MeshCoder, HighDegreeVerticesRoundTrip) {
+    TriangleMesh m;
+    const int ring = 3000;
+    m.vertices.emplace_back(0, 0, 1);
+    m.vertices.emplace_back(0, 0, -1);
+    for (int j = 0; j < ring; ++j) {
+        const float phi = 6.2831853f * j / ring;
+        m.vertices.emplace_back(std::cos(phi), std::sin(phi), 0);
+    }
+    for (int j = 0; j < ring; ++j) {
+        const int a = 2 + j, b = 2 + (j + 1) % ring;
+        m.faces.push_back({0, a, b});
+        m.faces.push_back({1, b, a});
+    }
+    ASSERT_TRUE(check_closed(m).closed());
+    const TriangleMesh d = decoded(m, 0.0001);
+    EXPECT_TRUE(check_closed(d).closed());
+    expect_same_faces(d, m, 0.00005f);
+}
+
 // Damaged mesh bytes are bad input, never a crash or a hang: every truncation and every
 // single-byte change of a coded sphere either decodes or throws Error.
 TEST(MeshCoder, DamagedBytesAreRefused) {
