@@ -64,7 +64,7 @@ struct RebuildCliOptions {
     double density = 0;
     int stations = 4;
     std::uint64_t seed = 1;
-    double budget_kb = 60;  // Livny et al. 2011, §7: 60 kB for a 56 MB Xfrog tree
+    double budget_kb = 60;   // Livny et al. 2011, §7: 60 kB for a 56 MB Xfrog tree
     double min_ratio = 500;  // the rebuild job's size target against the input mesh file; 0 = none
     std::string leaf_materials;
     double dbf6_resolution = 5.0;

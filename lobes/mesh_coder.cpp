@@ -313,8 +313,13 @@ class MeshDecoder {
 public:
     MeshDecoder(std::size_t vertices, std::size_t faces, double quantum, std::string_view symbols, std::string_view references,
                 std::string_view residuals, const ByteReader& context)
-        : vertices_(vertices), faces_(faces), quantum_(quantum), traversal_(vertices), symbols_(context.part(symbols)),
-          references_(context.part(references)), residuals_(context.part(residuals)) {}
+            : vertices_(vertices),
+              faces_(faces),
+              quantum_(quantum),
+              traversal_(vertices),
+              symbols_(context.part(symbols)),
+              references_(context.part(references)),
+              residuals_(context.part(residuals)) {}
 
     TriangleMesh run() {
         while (traversal_.faces.size() < faces_) {
@@ -356,12 +361,22 @@ private:
     void decode_face_across(const Traversal::Gate& gate) {
         int c = -1;
         switch (symbols_.u8()) {
-            case kNoFace: return;
-            case kNewVertex: c = introduce(parallelogram(grid_[gate.from], grid_[gate.to], grid_[gate.apex])); break;
-            case kLeftNeighbour: c = traversal_.left_of(gate); break;
-            case kRightNeighbour: c = traversal_.right_of(gate); break;
-            case kEarlierVertex: c = earlier_vertex(); break;
-            default: symbols_.fail("invalid corner symbol in a lobe mesh");
+            case kNoFace:
+                return;
+            case kNewVertex:
+                c = introduce(parallelogram(grid_[gate.from], grid_[gate.to], grid_[gate.apex]));
+                break;
+            case kLeftNeighbour:
+                c = traversal_.left_of(gate);
+                break;
+            case kRightNeighbour:
+                c = traversal_.right_of(gate);
+                break;
+            case kEarlierVertex:
+                c = earlier_vertex();
+                break;
+            default:
+                symbols_.fail("invalid corner symbol in a lobe mesh");
         }
         if (c < 0) symbols_.fail("lobe mesh refers to a border neighbour that does not exist");
         traversal_.cross(gate, c);

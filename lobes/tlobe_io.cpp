@@ -217,9 +217,8 @@ LobeTree decode_tlobe(std::string_view file, const std::string& name) {
     const int major = static_cast<unsigned char>(file[4]), minor = static_cast<unsigned char>(file[5]);
     if (major < kTlobeOldestMajorVersion || major > kTlobeMajorVersion)
         throw Error::input(name, ".tlobe version " + std::to_string(major) + "." + std::to_string(minor) +
-                                         " is not supported (this build reads versions " +
-                                         std::to_string(kTlobeOldestMajorVersion) + ".x to " + std::to_string(kTlobeMajorVersion) +
-                                         ".x; run `treelobes lobes` on the scan again)");
+                                         " is not supported (this build reads versions " + std::to_string(kTlobeOldestMajorVersion) +
+                                         ".x to " + std::to_string(kTlobeMajorVersion) + ".x; run `treelobes lobes` on the scan again)");
     const std::uint32_t raw_size = get_u32(file, 8), packed_size = get_u32(file, 12);
     if (packed_size != file.size() - kHeaderSize) throw Error::input(name, "truncated .tlobe file (payload size mismatch)");
     if (get_u32(file, 16) != file_crc(file)) throw Error::input(name, "corrupt .tlobe file (CRC-32 mismatch)");

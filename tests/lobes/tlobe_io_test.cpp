@@ -333,8 +333,7 @@ TEST(Tlobe, LeafAreaAndLobeLeafSharesRoundTrip) {
     EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, kTlobeMinorVersion, append), "x"); }), ExitCode::InvalidInput);
     const std::size_t shares = t.lobes.size();
     const auto without_shares = [shares](std::string& payload) { payload.resize(payload.size() - shares); };
-    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, kTlobeMinorVersion, without_shares), "x"); }),
-              ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, kTlobeMinorVersion, without_shares), "x"); }), ExitCode::InvalidInput);
     for (const float bad : {-1.0f, std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
         const auto overwrite = [bad, shares](std::string& payload) { std::memcpy(payload.data() + payload.size() - shares - 4, &bad, 4); };
         EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(bytes, kTlobeMinorVersion, overwrite), "x"); }), ExitCode::InvalidInput)
