@@ -50,6 +50,7 @@ struct LobesCliOptions {
     ReconstructOptions stage;
     lobes::LobeOptions lobes;
     lobes::TlobeOptions file;
+    double budget_kb = 39;  // Livny et al. 2011, Table 2: under 40 kB per tree
 };
 
 nlohmann::json lobe_json(const lobes::LobeTree& tree, const lobes::Lobe& lobe) {
@@ -156,6 +157,7 @@ nlohmann::json run_one(const LobesCliOptions& o, const OptionTable& table, const
 
 int run_lobes(LobesCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     apply_species_flags(o.flags, o.stage);
+    o.file.max_bytes = static_cast<std::size_t>(o.budget_kb * 1000);
     std::error_code ec;
     fs::create_directories(o.out, ec);
     if (!fs::is_directory(o.out)) throw Error::usage("--out " + o.out + ": cannot create the output folder");
@@ -380,6 +382,9 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--face-budget", o->lobes.face_budget, "Lobe faces over the whole tree after simplification")
             ->check(CLI::Range(100, 10000000));
     table->add("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")->check(CLI::Range(0.0001, 0.1));
+    table->add("--budget-kb", o->budget_kb,
+               "Size each .tlobe may take (kB); its lobe occupancy grid is coarsened, then its lobe surfaces simplified, to fit")
+            ->check(CLI::Range(2.0, 10000.0));
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_lobes(*o, *table, global); }; });
 
     auto so = std::make_shared<SynthesizeCliOptions>();

@@ -68,6 +68,7 @@ struct TileCliOptions {
     TerrainOptions terrain;
     SegmentOptions segment;
     forestry::TreePipelineOptions trees;
+    double budget_kb = 39;  // each tree's .tlobe (Livny et al. 2011, Table 2: under 40 kB)
     std::string outlier_test = "auto";
     int map_px = 1600;
     double buffer = 0;       // metres; 0 = no buffer
@@ -375,6 +376,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     if (o.max_crown_radius) o.segment.max_crown_radius = *o.max_crown_radius;
     o.trees.reconstruct.preprocess.outlier_test = parse_outlier_test(o.outlier_test);
     o.trees.reconstruct.preprocess.ground = GroundMode::Keep;  // the terrain stage removed the ground already
+    o.trees.tlobe.max_bytes = static_cast<std::size_t>(o.budget_kb * 1000);
     std::optional<classify::JointBoostModel> model;
     if (!o.model.empty()) {
         model = classify::load_jointboost(o.model);
@@ -628,6 +630,9 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--lobe-shape-points", o->trees.lobes.max_shape_points,
                "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
             ->check(CLI::Range(100, 10000000));
+    table->add("--budget-kb", o->budget_kb,
+               "Size each tree's .tlobe may take (kB); its lobe occupancy grid is coarsened, then its lobe surfaces simplified, to fit")
+            ->check(CLI::Range(2.0, 10000.0));
     table->add("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")->check(CLI::Range(1.0, 64.0));
     table->add("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16));
     table->add("--map-size", o->map_px, "Longer side of top_view.png, pixels")->check(CLI::Range(200, 20000));

@@ -5,6 +5,7 @@
 #include "core/cloud_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
+#include "lobes/tlobe_io.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
@@ -132,6 +133,23 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
     EXPECT_EQ(points.source.las_scale, input.source.las_scale);
     EXPECT_EQ(points.source.las_offset, input.source.las_offset);
     EXPECT_NEAR((points.global(0) - input.global(0)).norm(), 0.0, 1e-3);
+}
+
+// --budget-kb bounds every tree's .tlobe (2.0-3.8 kB at the default 39 kB on this tile): the
+// encoder coarsens the occupancy and simplifies the lobes until each fits 2 kB.
+TEST(TileCli, EveryTreesTlobeKeepsTheBudget) {
+    TempDir dir;
+    const auto r = run_cli("--json " + run_tile(dir / "out", "--use-input-segmentation --budget-kb 2"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["options"]["budget_kb"].get<double>(), 2.0);
+    std::size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(dir / "out" / "trees")) {
+        if (entry.path().extension() != ".tlobe") continue;
+        ++files;
+        EXPECT_LE(fs::file_size(entry.path()), 2000u) << entry.path();
+        EXPECT_NO_THROW(lobes::read_tlobe(entry.path()));
+    }
+    EXPECT_EQ(files, 5u);
 }
 
 TEST(TileCli, ResumeKeepsFinishedOutputsAndOverwriteRedoesThemIdentically) {

@@ -60,6 +60,11 @@ TEST(LobesReal, CliWritesTlobeMeshesAndSummary) {
     EXPECT_TRUE(std::filesystem::exists(dir / "tree1_points_lobes.ply"));
     EXPECT_TRUE(std::filesystem::exists(dir / "tree1_points_main.ply"));
     EXPECT_EQ(read_tlobe(dir / "tree1_points.tlobe").lobes.size(), summary["lobe_count"].get<std::size_t>());
+    // A smaller --budget-kb is kept: coarser occupancy, then simpler lobe surfaces (the same lobes).
+    const auto tight = test::run_cli("lobes " + input.string() + " --out " + (dir / "tight").string() + " --fs 0.8 --budget-kb 4");
+    ASSERT_EQ(tight.exit_code, 0) << tight.err;
+    EXPECT_LE(std::filesystem::file_size(dir / "tight" / "tree1_points.tlobe"), 4000u);
+    EXPECT_EQ(read_tlobe(dir / "tight" / "tree1_points.tlobe").lobes.size(), summary["lobe_count"].get<std::size_t>());
 
     // Synthesis from the file: full tree with fidelity metrics and preview, then a 25 % LOD.
     const std::string tlobe = (dir / "tree1_points.tlobe").string();
