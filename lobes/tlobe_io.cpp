@@ -97,10 +97,6 @@ void check_options(const TlobeOptions& o) {
     if (o.min_lobe_faces < 4) throw Error::usage("tlobe: lobes keep at least 4 faces");
 }
 
-}  // namespace
-
-namespace {
-
 // The payload with lobe i's occupancy taken from `occupancy[i]`.
 std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const std::vector<const Occupancy*>& occupancy) {
     ByteWriter w;
@@ -149,10 +145,6 @@ std::string pack(const std::string& raw, int level) {
     put_u32(file, 16, file_crc(file));
     return file;
 }
-
-}  // namespace
-
-namespace {
 
 // The file on the finest occupancy grid at which it fits max_bytes; none when no grid fits (a
 // grid that some lobe's extent makes too large is skipped).
