@@ -194,8 +194,9 @@ TEST(MeshCoder, OpenNonManifoldAndSeveralPartsRoundTrip) {
     expect_same_faces(d, m, 0.0025f);
 }
 
-// A closed double cone with 3000 faces around each apex: the border lookups of the traversal
-// pass over closed half-edges once, so high-degree vertices cost nothing special.
+// A closed double cone with 3000 faces around each apex round-trips: the border lookups drop the
+// closed half-edges they pass (so that a damaged file's fans cannot make decoding quadratic) and
+// must still find the open ones.
 TEST(MeshCoder, HighDegreeVerticesRoundTrip) {
     TriangleMesh m;
     const int ring = 3000;
