@@ -1,5 +1,5 @@
 // `treelobes eval skeleton --skeleton S.ply --reference R`: distances in both directions,
-// length ratio, trunk radius error, connected pieces and (for tree references with radii)
+// length ratio, trunk radius error at breast height, connected pieces and (for tree references with radii)
 // branch detection precision/recall. R is a skeleton PLY, a TreeQSM cylinder table or a
 // WoodSKE-style point list (reconstruct/skeleton_eval.hpp).
 #include "apps/command.hpp"
@@ -51,6 +51,7 @@ nlohmann::json to_json(const EvalSkeletonOptions& o, const OptionTable& table, c
                         {"length", c.length},
                         {"reference_length", optional_json(c.reference_length)},
                         {"length_ratio", optional_json(c.length_ratio)},
+                        {"breast_height", o.eval.breast_height},
                         {"trunk_radius", optional_json(c.trunk_radius)},
                         {"reference_trunk_radius", optional_json(c.reference_trunk_radius)},
                         {"trunk_radius_error", optional_json(c.trunk_radius_error)},
@@ -80,8 +81,8 @@ void print_human(const EvalSkeletonOptions& o, const SkeletonGraph& ref, const S
     if (c.length_ratio) std::printf(", ratio %.3f", *c.length_ratio);
     std::printf("\n");
     if (c.trunk_radius && c.reference_trunk_radius)
-        std::printf("  trunk radius %.4f m, reference %.4f m, error %+.1f %%\n", *c.trunk_radius, *c.reference_trunk_radius,
-                    c.trunk_radius_error ? 100.0 * *c.trunk_radius_error : 0.0);
+        std::printf("  trunk radius at %.2f m %.4f m, reference %.4f m, error %+.1f %%\n", o.eval.breast_height, *c.trunk_radius,
+                    *c.reference_trunk_radius, c.trunk_radius_error ? 100.0 * *c.trunk_radius_error : 0.0);
     std::printf("  connected components %zu", c.components);
     if (ref.kind != "points") std::printf(" (reference %zu)", c.reference_components);
     std::printf("\n");
@@ -144,6 +145,9 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--match-distance", options->eval.match_distance, "Branch matching tolerance in metres")->check(cli::PositiveNumber);
     table->add("--min-branch-diameter", options->eval.min_branch_diameter,
                "Reference branches thinner than this are not scored, nor the thinner end of a scored one")
+            ->check(cli::NonNegativeNumber);
+    table->add("--breast-height", options->eval.breast_height,
+               "Metres above the reference stem's base at which trunk radii are compared (1.3: where DBH is measured)")
             ->check(cli::NonNegativeNumber);
     table->add("--visible-in", options->visible_in,
                "A synthetic scan of the reference (points labelled with `internode`): score against the part of the "

@@ -60,7 +60,6 @@ SkeletonGraph read_ply_graph(const fs::path& path) {
             g.edges.emplace_back(static_cast<int>(u), static_cast<int>(v));
         }
     }
-    if (r) g.trunk_radius = g.radius[0];
     if (g.edges.size() + 1 == g.vertices.size()) {
         try {
             g.tree = read_skeleton_ply(path);
@@ -68,6 +67,7 @@ SkeletonGraph read_ply_graph(const fs::path& path) {
             // Not one tree (cycles, pieces): distances still work, branch detection does not.
         }
     }
+    if (r) g.stem = g.tree ? main_stem(*g.tree) : std::vector<StemSample>{{g.vertices[0], g.radius[0]}};
     return g;
 }
 
@@ -116,7 +116,7 @@ std::vector<std::vector<double>> read_table(const fs::path& path) {
 SkeletonGraph qsm_graph(const QsmModel& model) {
     SkeletonGraph g;
     g.kind = "treeqsm";
-    double stem_radius = 0;
+    std::vector<const QsmCylinder*> stem;
     for (const auto& c : model.cylinders) {
         const int a = static_cast<int>(g.vertices.size());
         g.vertices.push_back(c.start);
@@ -124,9 +124,14 @@ SkeletonGraph qsm_graph(const QsmModel& model) {
         g.radius.insert(g.radius.end(), 2, static_cast<float>(c.radius));
         g.edges.emplace_back(a, a + 1);
         if (c.parent >= 0) g.links.emplace_back(a, 2 * c.parent + 1);
-        if (c.branch_order == 0) stem_radius = std::max(stem_radius, c.radius);
+        if (c.branch_order == 0) stem.push_back(&c);
     }
-    g.trunk_radius = stem_radius;
+    std::stable_sort(stem.begin(), stem.end(),
+                     [](const QsmCylinder* a, const QsmCylinder* b) { return a->position_in_branch < b->position_in_branch; });
+    for (const QsmCylinder* c : stem) {
+        g.stem.push_back({c->start, c->radius});
+        g.stem.push_back({c->end(), c->radius});
+    }
     return g;
 }
 
@@ -237,6 +242,23 @@ std::vector<float> distances(const Samples& from, const NearestSegment& to) {
     return d;
 }
 
+// The stem's radius where it reaches height z, interpolated between the samples around it; the
+// radius of the sample nearest in height when the stem does not span z.
+std::optional<double> stem_radius_at(const std::vector<StemSample>& stem, double z) {
+    if (stem.empty()) return std::nullopt;
+    for (std::size_t i = 1; i < stem.size(); ++i) {
+        const double z0 = stem[i - 1].position.z(), z1 = stem[i].position.z();
+        if (z0 <= z && z <= z1 && z1 > z0) {
+            const double t = (z - z0) / (z1 - z0);
+            return (1 - t) * stem[i - 1].radius + t * stem[i].radius;
+        }
+    }
+    const auto nearest = std::min_element(stem.begin(), stem.end(), [z](const StemSample& a, const StemSample& b) {
+        return std::abs(a.position.z() - z) < std::abs(b.position.z() - z);
+    });
+    return nearest->radius;
+}
+
 // ---- branch detection ------------------------------------------------------------------------
 
 // Axes of a tree: root-to-tip along main children, and for each lateral child fork-to-tip.
@@ -311,6 +333,15 @@ BranchDetection detect_branches(const SkeletonGraph& ours, const SkeletonGraph& 
 
 }  // namespace
 
+std::vector<StemSample> main_stem(const TreeGraph& tree) {
+    std::vector<StemSample> stem;
+    if (tree.nodes.empty()) return stem;
+    for (int v = 0;; v = tree.nodes[v].children.front()) {
+        stem.push_back({tree.origin + tree.nodes[v].position.cast<double>(), tree.nodes[v].radius});
+        if (tree.nodes[v].children.empty()) return stem;
+    }
+}
+
 std::size_t SkeletonGraph::components() const {
     if (kind == "points") return 0;
     UnionFind sets(vertices.size());
@@ -341,6 +372,7 @@ SkeletonGraph read_skeleton_graph(const fs::path& path, const std::string& kind)
 SkeletonComparison compare_skeletons(const SkeletonGraph& ours, const SkeletonGraph& ref, const EvalOptions& o) {
     if (ours.vertices.empty() || ref.vertices.empty()) throw Error::input("", "cannot compare an empty skeleton");
     if (!(o.sample_step > 0)) throw Error::usage("eval: the sample step must be > 0");
+    if (!(o.breast_height >= 0)) throw Error::usage("eval: the breast height must be >= 0");
     // A common local frame keeps float precision for georeferenced coordinates.
     const Eigen::Vector3d origin = ours.vertices.front();
     const NearestSegment to_ref(ref, origin, o.sample_step);
@@ -355,10 +387,13 @@ SkeletonComparison compare_skeletons(const SkeletonGraph& ours, const SkeletonGr
         c.reference_length = ref.total_length();
         if (*c.reference_length > 0) c.length_ratio = c.length / *c.reference_length;
     }
-    c.trunk_radius = ours.trunk_radius;
-    c.reference_trunk_radius = ref.trunk_radius;
-    if (ours.trunk_radius && ref.trunk_radius && *ref.trunk_radius > 0)
-        c.trunk_radius_error = (*ours.trunk_radius - *ref.trunk_radius) / *ref.trunk_radius;
+    if (!ref.stem.empty()) {
+        const double breast_z = ref.stem.front().position.z() + o.breast_height;
+        c.trunk_radius = stem_radius_at(ours.stem, breast_z);
+        c.reference_trunk_radius = stem_radius_at(ref.stem, breast_z);
+    }
+    if (c.trunk_radius && c.reference_trunk_radius && *c.reference_trunk_radius > 0)
+        c.trunk_radius_error = (*c.trunk_radius - *c.reference_trunk_radius) / *c.reference_trunk_radius;
     c.components = ours.components();
     c.reference_components = ref.components();
     const bool ref_has_radii = ref.tree && std::any_of(ref.radius.begin(), ref.radius.end(), [](float r) { return r > 0; });

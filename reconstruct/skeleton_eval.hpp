@@ -9,6 +9,9 @@
 //   points    a dense list of skeleton points "x y z" (WoodSKE), commas or whitespace.
 // Both sides are sampled every `sample_step` along their segments (points are used as they are)
 // and distances are measured from each sample to the nearest segment (or point) of the other.
+// Trunk radius: both stems' radii at breast height, `breast_height` above the reference stem's
+// base (where DBH is measured), interpolated along each stem; the radius at the stem base would
+// compare a root flare (synthetic palms, TreeQSM's first cylinder) with a fitted trunk.
 // Branch detection (reference trees with radii): the axes of a tree are root-to-tip along main
 // children plus fork-to-tip for every lateral child. A reference axis is a scored branch when it
 // leaves its fork thicker than `min_branch_diameter`, and it is detected when at least
@@ -30,6 +33,12 @@
 
 namespace treelobes {
 
+// A point of a main stem, from its base up, with the stem's radius there.
+struct StemSample {
+    Eigen::Vector3d position;
+    double radius = 0;
+};
+
 // A skeleton as a general graph (possibly several pieces), in double global coordinates.
 struct SkeletonGraph {
     std::string kind;  // "skeleton", "treeqsm", "points"
@@ -37,11 +46,16 @@ struct SkeletonGraph {
     std::vector<float> radius;  // per vertex (0 when unknown)
     std::vector<std::pair<int, int>> edges;
     std::vector<std::pair<int, int>> links;  // connections without length (TreeQSM child -> parent cylinder)
-    std::optional<double> trunk_radius;      // skeleton: radius of vertex 0; treeqsm: largest stem (order 0) cylinder
-    std::optional<TreeGraph> tree;           // when the edges form one tree rooted at vertex 0
-    std::size_t components() const;          // connected pieces (isolated vertices count, except for point lists)
+    // The main stem with radii (empty without radii): a skeleton tree's root-to-tip axis along main
+    // children, another skeleton's vertex 0 alone, a QSM's stem (order 0) cylinders.
+    std::vector<StemSample> stem;
+    std::optional<TreeGraph> tree;   // when the edges form one tree rooted at vertex 0
+    std::size_t components() const;  // connected pieces (isolated vertices count, except for point lists)
     double total_length() const;
 };
+
+// The root-to-tip axis of a tree along main children, in global coordinates, with radii.
+std::vector<StemSample> main_stem(const TreeGraph& tree);
 
 // kind: "auto" (by extension and column count), "skeleton", "treeqsm" or "points".
 // Throws Error(InvalidInput) naming the file for anything malformed, Error(Usage) for a bad kind.
@@ -64,9 +78,10 @@ struct SkeletonComparison {
     DistanceStats to_reference;    // skeleton samples -> reference
     DistanceStats from_reference;  // reference samples -> skeleton
     double length = 0;
-    std::optional<double> reference_length;                                          // not for point lists
-    std::optional<double> length_ratio;                                              // length / reference_length
-    std::optional<double> trunk_radius, reference_trunk_radius, trunk_radius_error;  // error relative to the reference
+    std::optional<double> reference_length;  // not for point lists
+    std::optional<double> length_ratio;      // length / reference_length
+    // At breast height (EvalOptions::breast_height above the reference stem's base); error relative to the reference.
+    std::optional<double> trunk_radius, reference_trunk_radius, trunk_radius_error;
     std::size_t components = 0, reference_components = 0;
     std::optional<BranchDetection> branches;  // when the reference is a tree with radii
     // Skeleton samples (global coordinates) and their distance to the reference, to see where
@@ -81,6 +96,7 @@ struct EvalOptions {
     double match_distance = 0.05;       // metres: a sample within max(this, the branch radius) is matched
     double min_matched_fraction = 0.5;  // of a branch's (thick part's) length, to count it detected / correct
     double min_branch_length = 0.1;     // metres: shorter axes of the skeleton are not scored for precision
+    double breast_height = 1.3;         // metres above the reference stem's base where trunk radii are compared
 };
 
 SkeletonComparison compare_skeletons(const SkeletonGraph& skeleton, const SkeletonGraph& reference, const EvalOptions& options = {});

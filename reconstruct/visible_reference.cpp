@@ -38,7 +38,7 @@ SkeletonGraph visible_reference(const SkeletonGraph& reference, std::span<const 
         visible.radius.push_back(kept.nodes[i].radius);
         if (kept.nodes[i].parent >= 0) visible.edges.emplace_back(kept.nodes[i].parent, static_cast<int>(i));
     }
-    if (reference.trunk_radius) visible.trunk_radius = kept.nodes[0].radius;
+    visible.stem = reference.stem;  // the trunk is on every seen internode's way to the root
     visible.tree = std::move(kept);
     return visible;
 }

@@ -2,8 +2,8 @@
 # Set-up (scripts/setup.sh), then the main job on the bundled synthetic sample (data/synthetic/):
 # `treelobes tile` on a forest tile (ground, trees, a model and measures per tree, a table and a
 # top-view picture), then the single-tree stages: reconstruct two scanned trees (skeleton,
-# allometric radii, branch mesh), score the skeletons against the part of their true skeletons
-# the scans see, build the lobe-based representation and a full synthesized tree, compress a
+# allometric radii, branch mesh), score a skeleton against the part of its true skeleton the
+# scan sees, build the lobe-based representation and a full synthesized tree, compress a
 # skeleton as DBF6, and draw a preview. Outputs go to ./demo-out/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,6 +15,7 @@ rm -rf "$OUT"
 mkdir -p "$OUT"
 
 step() { echo; echo "== $*"; }
+truth_dbh() { awk -F': *' '/"dbh_m"/ { printf "%.3f", $2 }' "$SAMPLE/$1_truth.json"; }
 
 step "info: the sample's scans"
 "$BIN" info "$SAMPLE"/*.las "$SAMPLE/tile/tile.las"
@@ -45,30 +46,30 @@ echo "picture: $OUT/tile/top_view.png (each tree in its colour, stems as dots wi
 echo "also: $OUT/tile/points.las (treeID, HeightAboveGround), trees.geojson, tile.forest, trees/ (per tree skeleton, mesh, .tlobe, .dbf6)"
 
 step "reconstruct: skeleton, radii and branch mesh of two scanned trees"
-"$BIN" reconstruct "$SAMPLE/lagerstroemia_2.las" --species lagerstroemia --out "$OUT/reconstruct"
+# A leaf-off tree of heaven (a winter scan, as QSM campaigns take them) and a leafy palm.
+"$BIN" reconstruct "$SAMPLE/ailanthus_altissima_5.las" --species ailanthus_altissima --out "$OUT/reconstruct"
 "$BIN" reconstruct "$SAMPLE/palm_1.las" --species palm --out "$OUT/reconstruct"
+echo "true DBH: ailanthus $(truth_dbh ailanthus_altissima_5) m, palm $(truth_dbh palm_1) m ($SAMPLE/*_truth.json)"
 
-step "eval: reconstructed skeletons against the part of the true ones their scans see"
-# The true skeletons hold every twig, also those hidden in leaves; --visible-in keeps the
-# internodes whose bark the scan hit (and their way to the root).
-for tree in lagerstroemia_2 palm_1; do
-    args=(eval skeleton --skeleton "$OUT/reconstruct/${tree}_skeleton.ply" --reference "$SAMPLE/${tree}_skeleton.ply"
-          --visible-in "$SAMPLE/${tree}.las")
-    "$BIN" "${args[@]}"
-    "$BIN" --json "${args[@]}" > "$OUT/eval_${tree}.json"
-done
+step "eval: the reconstructed skeleton against the part of the true one its scan sees"
+# The true skeleton holds every twig, also those too thin for the scan to hit; --visible-in keeps
+# the internodes the scan hit (and their way to the root). Trunk radii are compared at 1.3 m.
+args=(eval skeleton --skeleton "$OUT/reconstruct/ailanthus_altissima_5_skeleton.ply"
+      --reference "$SAMPLE/ailanthus_altissima_5_skeleton.ply" --visible-in "$SAMPLE/ailanthus_altissima_5.las")
+"$BIN" "${args[@]}"
+"$BIN" --json "${args[@]}" > "$OUT/eval_ailanthus_altissima_5.json"
 
 step "lobes + synthesize: lobe-based representation and full tree of the Lagerstroemia"
 "$BIN" lobes "$SAMPLE/lagerstroemia_2.las" --species lagerstroemia --out "$OUT/lobes"
 "$BIN" synthesize "$OUT/lobes/lagerstroemia_2.tlobe" --out "$OUT/lobes/lagerstroemia_2_synthesized.ply"
 
 step "encode: DBF6 chain code with 3 levels of detail, decoded back"
-"$BIN" encode "$OUT/reconstruct/lagerstroemia_2_skeleton.ply" --resolution 5 --lods 3 --out "$OUT/lagerstroemia_2.dbf6" --stats
-"$BIN" decode "$OUT/lagerstroemia_2.dbf6" --lod 0 --out "$OUT/lagerstroemia_2_lod0.ply"
+"$BIN" encode "$OUT/reconstruct/ailanthus_altissima_5_skeleton.ply" --resolution 5 --lods 3 --out "$OUT/ailanthus_altissima_5.dbf6" --stats
+"$BIN" decode "$OUT/ailanthus_altissima_5.dbf6" --lod 0 --out "$OUT/ailanthus_altissima_5_lod0.ply"
 
 step "render: scan, reconstruction and truth side by side"
-"$BIN" render "$SAMPLE/lagerstroemia_2.las" "$OUT/reconstruct/lagerstroemia_2_skeleton.ply" \
-    "$SAMPLE/lagerstroemia_2_skeleton.ply" --out "$OUT/lagerstroemia_2.png"
+"$BIN" render "$SAMPLE/ailanthus_altissima_5.las" "$OUT/reconstruct/ailanthus_altissima_5_skeleton.ply" \
+    "$SAMPLE/ailanthus_altissima_5_skeleton.ply" --out "$OUT/ailanthus_altissima_5.png"
 
 echo
 echo "demo: outputs in $OUT/"

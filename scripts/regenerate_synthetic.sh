@@ -20,12 +20,15 @@ generate() {
     local out=$1
     mkdir -p "$out"
     rm -rf "$out/tile" "$out"/*.las "$out"/*.ply "$out"/*_truth.json
-    # Three small single trees: two terrestrial scans (the palm with its mesh), one airborne.
+    # Small single trees: terrestrial scans (the palm with its mesh) and one airborne.
     "$BIN" --log-level warn synth tree --species palm --seed 1 --height 8 --angular-step 0.8 --max-leaves 1500 --out "$out" >/dev/null
     # The Lagerstroemia at a finer raster (0.4 degrees) with little ground around it: at 0.8 degrees
     # the scan hits too few of its thin stems for a skeleton worth scoring.
     "$BIN" --log-level warn synth tree --species lagerstroemia --seed 2 --height 5 --angular-step 0.4 --ground-margin 0.5 --max-leaves 3000 --no-mesh --out "$out" >/dev/null
     "$BIN" --log-level warn synth tree --species birch --seed 3 --height 9 --scanner als --pulse-density 80 --max-leaves 4000 --no-mesh --out "$out" >/dev/null
+    # A leaf-off terrestrial scan (as QSM campaigns scan broadleaves in winter) of an 8 m tree of
+    # heaven: the demo's skeleton is scored on it, every branch thicker than 2 cm in sight.
+    "$BIN" --log-level warn synth tree --species ailanthus_altissima --seed 5 --height 8 --angular-step 0.4 --ground-margin 0.5 --no-leaves --no-mesh --out "$out" >/dev/null
     # The demo's forest tile: an airborne scan (20 pulses/m^2) of 30 trees of five species on 55 x 55 m
     # of sloping ground with understory and noise; stems at least 0.9 x their summed crown radii
     # apart, so neighbouring crowns touch as in a closed stand instead of growing through each

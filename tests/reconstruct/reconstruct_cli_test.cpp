@@ -141,6 +141,35 @@ TEST(EvalCli, SkeletonAgainstItselfAndBadReference) {
     EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 }
 
+// The demo's single-tree score (scripts/demo.sh): the leaf-off sample reconstructed and scored
+// against the part of its true skeleton the scan sees, trunks compared at breast height.
+TEST(EvalCli, TheDemosLeafOffSampleScoresWell) {
+    TempDir dir;
+    const auto sample = test::source_dir() / "data" / "synthetic";
+    const auto rec = run_cli("reconstruct " + quoted(sample / "ailanthus_altissima_5.las") + " --species ailanthus_altissima --out " +
+                             quoted(dir / "out"));
+    ASSERT_EQ(rec.exit_code, 0) << rec.err;
+    const std::string eval = "eval skeleton --skeleton " + quoted(dir / "out" / "ailanthus_altissima_5_skeleton.ply") + " --reference " +
+                             quoted(sample / "ailanthus_altissima_5_skeleton.ply") + " --visible-in " +
+                             quoted(sample / "ailanthus_altissima_5.las") + " --json";
+    const auto r = run_cli(eval);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_LT(j["skeleton_to_reference"]["median"].get<double>(), 0.03);
+    EXPECT_LT(j["reference_to_skeleton"]["median"].get<double>(), 0.03);
+    EXPECT_NEAR(j["length_ratio"].get<double>(), 1.0, 0.2);
+    EXPECT_DOUBLE_EQ(j["breast_height"].get<double>(), 1.3);
+    EXPECT_LT(std::abs(j["trunk_radius_error"].get<double>()), 0.1);
+    EXPECT_GE(j["branches"]["recall"].get<double>(), 0.9);
+    EXPECT_GE(j["branches"]["reference_branches"].get<int>(), 10);
+    // At the base the true skeleton's root node (wider than the trunk above) is compared instead.
+    const auto base = nlohmann::json::parse(run_cli(eval + " --breast-height 0").out);
+    EXPECT_GT(base["reference_trunk_radius"].get<double>(), j["reference_trunk_radius"].get<double>());
+    const auto bad = run_cli(eval + " --breast-height -1");
+    EXPECT_EQ(bad.exit_code, 1);  // a usage error
+    EXPECT_NE(bad.err.find("--breast-height"), std::string::npos) << bad.err;
+}
+
 TEST(ReconstructCli, RecentreOptionsReachTheSummary) {
     TempDir dir;
     write_y_tree(dir / "y.xyz");

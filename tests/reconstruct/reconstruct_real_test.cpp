@@ -30,7 +30,7 @@ SkeletonGraph as_graph(const TreeGraph& tree) {
         g.radius.push_back(node.radius);
     }
     for (std::size_t i = 1; i < tree.size(); ++i) g.edges.emplace_back(tree.nodes[i].parent, static_cast<int>(i));
-    g.trunk_radius = tree.nodes[0].radius;
+    g.stem = main_stem(tree);
     g.tree = tree;
     return g;
 }
@@ -141,10 +141,11 @@ TEST(ReconstructReal, EveryLazFileReconstructsFromTheCli) {
                                           (ground_only ? " --ground keep" : ""));
         EXPECT_EQ(result.exit_code, 0) << entry.path() << ": " << result.err;
         if (!ground_only) continue;
-        const auto without_ground = test::run_cli("reconstruct " + test::quoted(entry.path()) + " --out " + test::quoted(out / (stem + "g")));
+        const auto without_ground =
+                test::run_cli("reconstruct " + test::quoted(entry.path()) + " --out " + test::quoted(out / (stem + "g")));
         EXPECT_EQ(without_ground.exit_code, 2);
         EXPECT_NE(without_ground.err.find("too few points left after removing duplicates, outliers and ground"), std::string::npos)
-            << without_ground.err;
+                << without_ground.err;
         std::ifstream summary(out / stem / "plane_summary.json");
         const std::string text{std::istreambuf_iterator<char>(summary), {}};
         EXPECT_NE(text.find("\"not_a_tree\": true"), std::string::npos);

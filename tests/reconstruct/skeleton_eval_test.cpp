@@ -112,8 +112,9 @@ TEST(SkeletonEval, TreeQsmTableAndPointList) {
     const SkeletonGraph qsm = read_skeleton_graph(dir / "cyl.txt");
     EXPECT_EQ(qsm.kind, "treeqsm");
     EXPECT_NEAR(qsm.total_length(), 2.5, 1e-9);
-    ASSERT_TRUE(qsm.trunk_radius);
-    EXPECT_DOUBLE_EQ(*qsm.trunk_radius, 0.2);
+    ASSERT_EQ(qsm.stem.size(), 4u);  // start and end of each stem cylinder
+    EXPECT_DOUBLE_EQ(qsm.stem.front().radius, 0.2);
+    EXPECT_DOUBLE_EQ(qsm.stem.back().radius, 0.15);
     EXPECT_EQ(qsm.components(), 1u);
 
     test::write_text(dir / "ref.txt", "x,y,z\n0,0,0\n0,0,0.5\n0,0,1\n0,0,1.5\n0,0,2\n");
@@ -127,9 +128,41 @@ TEST(SkeletonEval, TreeQsmTableAndPointList) {
     EXPECT_FALSE(c.reference_length);
     EXPECT_LT(c.to_reference.median, 0.26);  // up to 25 cm from the nearest listed point
     EXPECT_NEAR(c.from_reference.max, 0.01, 1e-4);
+    // At 1.3 m: the second stem cylinder (0.15) against our tapering stem (0.2 - 0.65 x 0.1).
     const SkeletonComparison q = compare_skeletons(ours, qsm);
-    ASSERT_TRUE(q.trunk_radius_error);
-    EXPECT_NEAR(*q.trunk_radius_error, 0.0, 1e-6);
+    ASSERT_TRUE(q.reference_trunk_radius && q.trunk_radius && q.trunk_radius_error);
+    EXPECT_NEAR(*q.reference_trunk_radius, 0.15, 1e-9);
+    EXPECT_NEAR(*q.trunk_radius, 0.135, 1e-6);
+    EXPECT_NEAR(*q.trunk_radius_error, -0.1, 1e-5);
+}
+
+TEST(SkeletonEval, TrunkRadiiAreComparedAtBreastHeightNotAtTheFlaredBase) {
+    test::TempDir dir;
+    // Reference: a root flare of 0.3 m narrowing to a 0.15 m trunk from 0.6 m up; ours: a
+    // straight 0.15 m trunk whose base lies 0.1 m higher (the scan's stem foot).
+    TreeGraph flared;
+    flared.add_node({0, 0, 0}, 0.30f, -1);
+    flared.add_node({0, 0, 0.6f}, 0.15f, 0);
+    flared.add_node({0, 0, 4}, 0.12f, 1);
+    TreeGraph straight;
+    straight.add_node({0, 0, 0.1f}, 0.15f, -1);
+    straight.add_node({0, 0, 4}, 0.15f, 0);
+    const SkeletonGraph ref = write_and_read(flared, dir, "flared.ply");
+    const SkeletonGraph ours = write_and_read(straight, dir, "straight.ply");
+    const SkeletonComparison c = compare_skeletons(ours, ref);
+    ASSERT_TRUE(c.trunk_radius_error);
+    EXPECT_NEAR(*c.reference_trunk_radius, 0.15 - 0.03 * 0.7 / 3.4, 1e-6);
+    EXPECT_NEAR(*c.trunk_radius, 0.15, 1e-6);
+    EXPECT_LT(std::abs(*c.trunk_radius_error), 0.05);
+    EvalOptions at_base;
+    at_base.breast_height = 0;  // the reference's base: its flare, and our lowest radius
+    const SkeletonComparison b = compare_skeletons(ours, ref, at_base);
+    EXPECT_NEAR(*b.trunk_radius_error, -0.5, 1e-6);
+    EvalOptions above;
+    above.breast_height = 10;  // above both stems: their top radii
+    EXPECT_NEAR(*compare_skeletons(ours, ref, above).trunk_radius_error, 0.15 / 0.12 - 1, 1e-6);
+    at_base.breast_height = -1;
+    EXPECT_THROW(compare_skeletons(ours, ref, at_base), Error);
 }
 
 TEST(SkeletonEval, BadReferencesAreInputErrors) {

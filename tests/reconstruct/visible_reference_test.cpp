@@ -26,7 +26,7 @@ SkeletonGraph y_reference() {
         g.radius.push_back(n.radius);
         if (n.parent >= 0) g.edges.emplace_back(n.parent, static_cast<int>(g.vertices.size() - 1));
     }
-    g.trunk_radius = 0.2;
+    g.stem = main_stem(tree);
     g.tree = tree;
     return g;
 }
@@ -41,6 +41,7 @@ TEST(VisibleReference, KeepsSeenInternodesAndTheirWayToTheRoot) {
     EXPECT_NEAR(visible.total_length(), 1.0 + 2.0 * std::sqrt(2.0), 1e-6);
     EXPECT_EQ(visible.tree->tip_count(), 1u);
     EXPECT_FLOAT_EQ(visible.radius[0], 0.2f);
+    EXPECT_EQ(visible.stem.size(), 3u);  // the whole trunk, seen or not: its radius is compared at breast height
     EXPECT_EQ(visible_reference(y_reference(), labels, 1).vertices.size(), 5u);  // the trunk tip too
 }
 
