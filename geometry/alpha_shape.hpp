@@ -44,4 +44,10 @@ struct SimplifyOptions {
 // again. Returns false and leaves `mesh` unchanged when the mesh cannot be simplified safely.
 bool simplify_closed_mesh(TriangleMesh& mesh, const SimplifyOptions& options = {});
 
+// Moves the vertices of `coarse` (a simplification of `fine`, same frame) out along their normals
+// until the vertices of `fine` lie on or inside the faces nearest to them. Edge collapse cuts the
+// tips and caps of a shape (a collapsed tip ends at its base, a face spans a chord); this gives
+// the coarse surface back the extent of the fine one it came from. Faces are left as they are.
+void inflate_to_contain(TriangleMesh& coarse, const TriangleMesh& fine);
+
 }  // namespace treelobes

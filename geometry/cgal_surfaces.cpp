@@ -2,7 +2,8 @@
 // compile; DESIGN.md keeps third-party types inside .cpp files):
 //   - alpha shapes of point clusters: the lobes (Livny et al. 2011, §4.2) and crown volumes
 //     (geometry/alpha_shape.hpp),
-//   - edge-collapse simplification of closed surfaces (geometry/alpha_shape.hpp),
+//   - edge-collapse simplification of closed surfaces, and their inflation back to the extent
+//     of the surface they came from (geometry/alpha_shape.hpp),
 //   - AABB-tree distances from points to a mesh (geometry/mesh_distance.hpp).
 // The kernel is Exact_predicates_inexact_constructions: exact orientation and in-sphere tests
 // keep the Delaunay triangulation valid on scanner data with duplicates and coplanar runs.
@@ -204,6 +205,51 @@ bool simplify_closed_mesh(TriangleMesh& mesh, const SimplifyOptions& options) {
     if (!check_closed(simplified).closed() || simplified.signed_volume() <= 0) return false;
     mesh = std::move(simplified);
     return true;
+}
+
+namespace {
+
+// Area-weighted vertex normals, unit length (zero for a vertex no face uses).
+std::vector<Eigen::Vector3f> vertex_normals(const TriangleMesh& mesh) {
+    std::vector<Eigen::Vector3f> normal(mesh.vertices.size(), Eigen::Vector3f::Zero());
+    for (const auto& f : mesh.faces) {
+        const Eigen::Vector3f n = (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]);
+        for (int v : f) normal[v] += n;
+    }
+    for (auto& n : normal) n.normalize();
+    return normal;
+}
+
+Point to_point(const Eigen::Vector3f& p) { return Point(p.x(), p.y(), p.z()); }
+
+}  // namespace
+
+void inflate_to_contain(TriangleMesh& coarse, const TriangleMesh& fine) {
+    std::vector<Triangle> triangles;
+    std::vector<int> face_of;  // coarse face of each (non-degenerate) triangle
+    for (std::size_t i = 0; i < coarse.faces.size(); ++i) {
+        const auto& f = coarse.faces[i];
+        const Triangle t(to_point(coarse.vertices[f[0]]), to_point(coarse.vertices[f[1]]), to_point(coarse.vertices[f[2]]));
+        if (t.is_degenerate()) continue;
+        triangles.push_back(t);
+        face_of.push_back(static_cast<int>(i));
+    }
+    if (triangles.empty()) return;
+    const AabbTree tree(triangles.cbegin(), triangles.cend());
+    const std::vector<Eigen::Vector3f> normal = vertex_normals(coarse);
+    std::vector<float> push(coarse.vertices.size(), 0.0f);
+    for (const Eigen::Vector3f& p : fine.vertices) {
+        const auto [closest, primitive] = tree.closest_point_and_primitive(to_point(p));
+        const auto& f = coarse.faces[face_of[primitive - triangles.cbegin()]];
+        const Eigen::Vector3f face_normal =
+                (coarse.vertices[f[1]] - coarse.vertices[f[0]]).cross(coarse.vertices[f[2]] - coarse.vertices[f[0]]).normalized();
+        const float outside = (p - to_eigen(closest)).dot(face_normal);
+        if (!(outside > 0)) continue;
+        // Each corner moves along its own normal far enough to carry the face's plane past p
+        // (steep corners are capped, so a sharp edge does not shoot out).
+        for (int v : f) push[v] = std::max(push[v], outside / std::max(0.5f, normal[v].dot(face_normal)));
+    }
+    for (std::size_t v = 0; v < coarse.vertices.size(); ++v) coarse.vertices[v] += push[v] * normal[v];
 }
 
 struct MeshDistance::Impl {

@@ -167,7 +167,8 @@ std::optional<std::string> finest_fitting_file(const LobeTree& tree, const Tlobe
     return std::nullopt;
 }
 
-// The tree with every lobe surface simplified to `fraction` of its faces (at least min_faces).
+// The tree with every lobe surface simplified to `fraction` of its faces (at least min_faces) and
+// inflated back to the extent of the surface it came from.
 LobeTree with_coarser_lobes(const LobeTree& tree, double fraction, std::size_t min_faces) {
     LobeTree coarse = tree;
     for (Lobe& lobe : coarse.lobes) {
@@ -175,7 +176,8 @@ LobeTree with_coarser_lobes(const LobeTree& tree, double fraction, std::size_t m
         simplify.tolerance = 0;  // the face count alone decides
         simplify.max_faces = std::max<std::size_t>(min_faces, std::llround(fraction * static_cast<double>(lobe.mesh.faces.size())));
         simplify.min_faces = min_faces;
-        simplify_closed_mesh(lobe.mesh, simplify);  // false = kept as it is (still closed)
+        const TriangleMesh fine = lobe.mesh;
+        if (simplify_closed_mesh(lobe.mesh, simplify)) inflate_to_contain(lobe.mesh, fine);  // false = kept as it is
     }
     return coarse;
 }

@@ -83,6 +83,39 @@ TEST(SimplifyClosedMesh, StaysClosedAndWithinTheFaceLimit) {
     EXPECT_NEAR(mesh.signed_volume(), volume, 0.15 * volume);
 }
 
+// How far `mesh` falls short of `target`'s bounding box, the largest shortfall over the six sides.
+float extent_shortfall(const TriangleMesh& mesh, const TriangleMesh& target) {
+    Eigen::Vector3f lo = mesh.vertices[0], hi = lo, tlo = target.vertices[0], thi = tlo;
+    for (const auto& v : mesh.vertices) lo = lo.cwiseMin(v), hi = hi.cwiseMax(v);
+    for (const auto& v : target.vertices) tlo = tlo.cwiseMin(v), thi = thi.cwiseMax(v);
+    return std::max((lo - tlo).maxCoeff(), (thi - hi).maxCoeff());
+}
+
+TEST(InflateToContain, ASimplifiedSurfaceGetsBackTheExtentItLost) {
+    const TriangleMesh fine = alpha_shape(ball(0.5f, 3000)).mesh;
+    TriangleMesh coarse = fine;
+    SimplifyOptions o;
+    o.max_faces = 24;
+    o.tolerance = 0.0;
+    ASSERT_TRUE(simplify_closed_mesh(coarse, o));
+    // Edge collapse cut the ball's caps: the coarse surface is smaller and narrower.
+    EXPECT_LT(coarse.signed_volume(), 0.9 * fine.signed_volume());
+    EXPECT_GT(extent_shortfall(coarse, fine), 0.02f);
+    const auto faces = coarse.faces;
+    inflate_to_contain(coarse, fine);
+    EXPECT_EQ(coarse.faces, faces);
+    EXPECT_TRUE(check_closed(coarse).closed());
+    EXPECT_GT(coarse.signed_volume(), fine.signed_volume());
+    EXPECT_LT(extent_shortfall(coarse, fine), 0.01f);
+    // A surface that already holds the fine one stays as it is.
+    TriangleMesh wider = fine;
+    const Eigen::Vector3f centre(2, 3, 4);
+    for (auto& v : wider.vertices) v = centre + 1.3f * (v - centre);
+    const auto before = wider.vertices;
+    inflate_to_contain(wider, fine);
+    EXPECT_EQ(wider.vertices, before);
+}
+
 TEST(ClosedMesh, TwoTetrahedraSharingAnEdgeAreSplitIntoAManifold) {
     // Tetrahedra (0,1,2,3) and (0,1,4,5) share edge 0-1: four faces around it.
     TriangleMesh m;

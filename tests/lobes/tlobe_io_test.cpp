@@ -456,6 +456,7 @@ TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
         lobe.cluster_points = corner_points(centre);
     }
     const std::size_t full_faces = t.lobes[0].mesh.faces.size();
+    const double full_volume = t.lobes[0].mesh.signed_volume();
     TlobeOptions unsimplified;
     unsimplified.lobe_face_fractions.clear();
     unsimplified.max_bytes = 100;
@@ -473,7 +474,8 @@ TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
         EXPECT_LT(lobe.mesh.faces.size(), full_faces);
         EXPECT_GE(lobe.mesh.faces.size(), tight.min_lobe_faces);
         EXPECT_TRUE(check_closed(lobe.mesh).closed());
-        EXPECT_GT(lobe.mesh.signed_volume(), 0.5 * 4.18879 * 0.216);  // still about the 0.6 m ball
+        // Inflated back after the edge collapse: it still holds the whole 0.6 m ball.
+        EXPECT_GE(lobe.mesh.signed_volume(), full_volume);
     }
     for (const double bad : {0.0, 1.0, -0.5}) {
         TlobeOptions o;
