@@ -87,13 +87,19 @@ TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& optio
         return outcome;
     }
 
-    const TreeReconstruction reconstruction = reconstruct_tree(tree.points, options.reconstruct, name);
+    outcome.measures = measure_tree(tree, options);
+    outcome.seconds.emplace_back("measures", seconds_since(mark));
+
+    // An airborne crown's skeleton is joined to the ground at the stem's position.
+    ReconstructOptions reconstruct = options.reconstruct;
+    reconstruct.hidden_stem_foot = outcome.measures.position.cast<float>();
+    const TreeReconstruction reconstruction = reconstruct_tree(tree.points, reconstruct, name);
     outcome.seconds.emplace_back("reconstruct", seconds_since(mark));
     products.skeleton = reconstruction.skeleton;
     products.branches = build_branch_mesh(reconstruction.skeleton, options.mesh);
     outcome.seconds.emplace_back("branch mesh", seconds_since(mark));
 
-    const lobes::LobeTree lobe_tree = lobes::build_lobe_tree(tree.points, reconstruction, options.reconstruct, {}, options.lobes);
+    const lobes::LobeTree lobe_tree = lobes::build_lobe_tree(tree.points, reconstruction, reconstruct, {}, options.lobes);
     products.tlobe = lobes::encode_tlobe(lobe_tree, options.tlobe);
     products.lobes = lobe_tree.lobes.size();
     outcome.seconds.emplace_back("lobes", seconds_since(mark));
@@ -102,9 +108,7 @@ TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& optio
     products.dbf6 = encode::write_tree_file_bytes(stored);
     outcome.seconds.emplace_back("dbf6", seconds_since(mark));
 
-    outcome.measures = measure_tree(tree, options);
     outcome.measures.woody_volume = woody_volume(reconstruction.skeleton);
-    outcome.seconds.emplace_back("measures", seconds_since(mark));
 
     if (options.model) {
         outcome.measures.species_probabilities = species_probabilities(tree.points, options, name);

@@ -131,9 +131,18 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     if (sk.base.stem_visible && out.trunk.foot_fitted && (out.trunk.foot_centre - sk.tree.nodes[0].position).norm() < 1.0f)
         sk.tree.nodes[0].position = out.trunk.foot_centre;
     if (sk.base.stem_visible) align_trunk_base(sk.tree, out.trunk);
-    float z_top = sk.base.position.z();
+    Eigen::Vector3f foot = sk.base.position;
+    if (!sk.base.stem_visible && o.hidden_stem_foot) {
+        s.hidden_trunk_nodes = add_hidden_trunk(sk.tree, *o.hidden_stem_foot, sk.internode_length);
+        if (s.hidden_trunk_nodes > 0) {
+            foot = *o.hidden_stem_foot;
+            for (int& v : sk.point_internode)
+                if (v >= 0) v += static_cast<int>(s.hidden_trunk_nodes);
+        }
+    }
+    float z_top = foot.z();
     for (const auto& p : pre.points) z_top = std::max(z_top, p.z());
-    s.height = z_top - sk.base.position.z();
+    s.height = z_top - foot.z();
     s.dbh_fitted = out.trunk.dbh_fitted && s.stem_visible;
     s.dbh = s.dbh_fitted ? out.trunk.dbh : 0.0f;
     s.crown_width = crown_width(pre.points);

@@ -13,6 +13,7 @@
 #include "reconstruct/tree_quality.hpp"
 #include "reconstruct/trunk.hpp"
 
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,6 +29,9 @@ struct ReconstructOptions {
     AllometryOptions allometry;
     QualityOptions quality;
     double root_diameter = 0.0;  // metres; 0 = from the stem fit (else height / 50 when the stem is hidden)
+    // Where the stem meets the ground when the scan may not show it (a tile's airborne crowns), in
+    // the cloud's local frame: a hidden stem is added from there to the skeleton (add_hidden_trunk).
+    std::optional<Eigen::Vector3f> hidden_stem_foot;
 };
 
 struct TreeSummary {
@@ -60,6 +64,7 @@ struct TreeSummary {
     std::size_t bridges = 0;
     float longest_bridge = 0.0f;
     bool stem_visible = false;
+    std::size_t hidden_trunk_nodes = 0;  // nodes of the trunk laid from ReconstructOptions::hidden_stem_foot
     QualityReport quality;
     std::vector<std::pair<std::string, double>> seconds;  // wall time per stage
 };

@@ -136,7 +136,8 @@ std::size_t align_trunk_base(TreeGraph& tree, const TrunkFit& fit) {
     for (int node : main_axis(tree)) {
         Eigen::Vector3f& p = tree.nodes[node].position;
         if (p.z() < anchors.front().z() || p.z() > anchors.back().z()) continue;
-        const auto upper = std::upper_bound(anchors.begin(), anchors.end(), p.z(), [](float z, const Eigen::Vector3f& a) { return z < a.z(); });
+        const auto upper =
+                std::upper_bound(anchors.begin(), anchors.end(), p.z(), [](float z, const Eigen::Vector3f& a) { return z < a.z(); });
         const Eigen::Vector3f& high = upper == anchors.end() ? anchors.back() : *upper;
         const Eigen::Vector3f& low = upper == anchors.end() ? anchors.back() : *(upper - 1);
         const float t = high.z() > low.z() ? (p.z() - low.z()) / (high.z() - low.z()) : 0.0f;
@@ -144,6 +145,32 @@ std::size_t align_trunk_base(TreeGraph& tree, const TrunkFit& fit) {
         ++moved;
     }
     return moved;
+}
+
+std::size_t add_hidden_trunk(TreeGraph& tree, const Eigen::Vector3f& foot, float internode_length) {
+    if (tree.empty() || !(internode_length > 0)) return 0;
+    const Eigen::Vector3f root = tree.nodes[0].position;
+    if (!(root.z() - foot.z() > internode_length)) return 0;
+    const int added = static_cast<int>(std::ceil((root - foot).norm() / internode_length));
+    TreeGraph out;
+    out.origin = tree.origin;
+    out.nodes.resize(static_cast<std::size_t>(added) + tree.size());
+    for (int i = 0; i < added; ++i) {
+        TreeNode& n = out.nodes[i];
+        n.position = foot + (root - foot) * (static_cast<float>(i) / static_cast<float>(added));
+        n.parent = i - 1;
+        n.children = {i + 1};
+    }
+    for (std::size_t v = 0; v < tree.size(); ++v) {
+        const TreeNode& old = tree.nodes[v];
+        TreeNode& n = out.nodes[v + added];
+        n.position = old.position;
+        n.radius = old.radius;
+        n.parent = old.parent < 0 ? added - 1 : old.parent + added;
+        for (int c : old.children) n.children.push_back(c + added);
+    }
+    tree = std::move(out);
+    return static_cast<std::size_t>(added);
 }
 
 }  // namespace treelobes

@@ -55,4 +55,13 @@ TrunkFit fit_trunk(std::span<const Eigen::Vector3f> points, const std::vector<in
 // off a 0.21 m birch trunk's centre at 0.25 m, the rebuild bench's trees). Returns the nodes moved.
 std::size_t align_trunk_base(TreeGraph& tree, const TrunkFit& fit);
 
+// Airborne crowns show no stem: the skeleton starts at the crown's lowest points, metres above
+// the ground. Given the stem's foot (a tile's segmentation places it on the ground), lays a
+// straight trunk of internodes at most `internode_length` long from the foot to the skeleton's
+// root, so the model stands on the ground and its stem counts in the woody volume. The foot
+// becomes node 0 and the old nodes keep their order after the trunk's (pre-order holds): old
+// node v is node v + the returned count afterwards. Returns 0 (and changes nothing) when the
+// root is not more than one internode above the foot.
+std::size_t add_hidden_trunk(TreeGraph& tree, const Eigen::Vector3f& foot, float internode_length);
+
 }  // namespace treelobes

@@ -158,6 +158,38 @@ TEST(ReconstructTree, StemFitRadiiAndSummary) {
     EXPECT_NEAR(reconstruct_tree(cloud, o).summary.root_diameter, 0.5f, 1e-6f);
 }
 
+// An airborne crown: foliage 8-12 m up and no stem. Given the stem's foot, the skeleton starts
+// there and climbs a hidden trunk to the crown; heights and the guessed root diameter are
+// measured from the foot, and no scan point is put on the trunk.
+TEST(ReconstructTree, AnAirborneCrownIsJoinedToItsStemFoot) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    PointCloud crown;
+    while (crown.size() < 4000) {
+        const Eigen::Vector3f p(u(rng), u(rng), u(rng));
+        if (p.norm() <= 1.0f) crown.positions.push_back({2.0f * p.x(), 2.0f * p.y(), 10.0f + 2.0f * p.z()});
+    }
+    ReconstructOptions o;
+    const TreeReconstruction floating = reconstruct_tree(crown, o, "crown");
+    ASSERT_FALSE(floating.summary.stem_visible);
+    EXPECT_GT(floating.skeleton.nodes[0].position.z(), 7.5f);
+    EXPECT_EQ(floating.summary.hidden_trunk_nodes, 0u);
+
+    o.hidden_stem_foot = Eigen::Vector3f(0.1f, 0, 0);
+    const TreeReconstruction r = reconstruct_tree(crown, o, "crown");
+    const TreeSummary& s = r.summary;
+    EXPECT_GT(s.hidden_trunk_nodes, 10u);
+    EXPECT_EQ(r.skeleton.nodes[0].position, *o.hidden_stem_foot);
+    EXPECT_NEAR(s.height, 12.0f, 0.1f);
+    EXPECT_EQ(s.root_diameter_source, "height / 50");
+    EXPECT_NEAR(s.root_diameter, s.height / 50.0f, 1e-6f);
+    int lowest_internode = static_cast<int>(r.skeleton.size());  // of the crown's points
+    for (int v : r.point_internode)
+        if (v >= 0) lowest_internode = std::min(lowest_internode, v);
+    EXPECT_GT(lowest_internode, static_cast<int>(s.hidden_trunk_nodes));  // no scan point on the trunk
+    EXPECT_GT(r.skeleton.total_length(), floating.skeleton.total_length() + 7.0f);
+}
+
 TEST(TreeQuality, HouseIsNotATreeButATreeIs) {
     const QualityReport h = assess_planarity(house().positions);
     EXPECT_TRUE(h.not_a_tree);

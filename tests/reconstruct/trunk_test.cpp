@@ -108,3 +108,36 @@ TEST(Trunk, AHookedAxisAtTheFootIsAlignedWithTheStem) {
     TrunkFit nothing_fitted;
     EXPECT_EQ(align_trunk_base(hooked, nothing_fitted), 0u);
 }
+
+TEST(Trunk, AHiddenTrunkJoinsTheFootToTheRoot) {
+    // A crown skeleton beginning 10 m up: the root, its main child and a lateral with a twig.
+    TreeGraph crown;
+    crown.add_node({0.2f, 0, 10}, 0.1f, -1);
+    crown.add_node({1, 0, 11}, 0.05f, 0);
+    crown.add_node({0, 0, 11}, 0.08f, 0);
+    crown.add_node({0, 0.5f, 11.5f}, 0.02f, 1);
+    crown.nodes[0].children = {2, 1};  // main child first, not in index order
+    const Eigen::Vector3f foot(0, 0, 0);
+    TreeGraph tree = crown;
+    const std::size_t added = add_hidden_trunk(tree, foot, 0.5f);
+    ASSERT_EQ(added, 21u);  // ceil(10.002 / 0.5): internodes of at most 0.5 m
+    ASSERT_EQ(tree.size(), crown.size() + added);
+    tree.validate("hidden trunk");
+    EXPECT_EQ(tree.nodes[0].position, foot);
+    for (std::size_t i = 1; i < added; ++i) {
+        EXPECT_EQ(tree.nodes[i].parent, static_cast<int>(i) - 1);
+        EXPECT_LE(tree.edge_length(static_cast<int>(i)), 0.5f + 1e-5f);
+    }
+    for (std::size_t v = 0; v < crown.size(); ++v) {  // the old nodes, shifted, with their order of children
+        const TreeNode& n = tree.nodes[v + added];
+        EXPECT_EQ(n.position, crown.nodes[v].position);
+        EXPECT_EQ(n.parent, v == 0 ? static_cast<int>(added) - 1 : crown.nodes[v].parent + static_cast<int>(added));
+        ASSERT_EQ(n.children.size(), crown.nodes[v].children.size());
+        for (std::size_t k = 0; k < n.children.size(); ++k) EXPECT_EQ(n.children[k], crown.nodes[v].children[k] + static_cast<int>(added));
+    }
+    // A root within one internode of the foot, or below it, gets no trunk.
+    TreeGraph low = crown;
+    EXPECT_EQ(add_hidden_trunk(low, {0, 0, 9.6f}, 0.5f), 0u);
+    EXPECT_EQ(add_hidden_trunk(low, {0, 0, 12}, 0.5f), 0u);
+    EXPECT_EQ(low.size(), crown.size());
+}
