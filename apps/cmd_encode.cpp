@@ -370,7 +370,8 @@ int run_lod(const LodCliOptions& options, const OptionTable& table, const Global
     // LOD reduction does not depend on the code kind: F6 and DBF6 prune identically.
     const ChainCode code = code_from_options(options.code, options.radii, CodeKind::DBF6);
     const bool by_levels = options.levels > 0;
-    const std::vector<double> thresholds = by_levels ? lod_thresholds(code.radii, options.levels) : std::vector<double>{options.threshold};
+    const std::vector<double> thresholds =
+            by_levels ? lod_thresholds(branch_thicknesses(code), options.levels) : std::vector<double>{options.threshold};
     const std::vector<ChainCode> levels = lod_chain(code, thresholds, "--code");
     if (global.json) {
         nlohmann::json j = {{"treelobes", kVersion}, {"options", table.json()}, {"input_length", code.symbols.size()}};
@@ -595,8 +596,10 @@ void add_lod(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--code", options->code, "Chain code (F6 or DBF6)")->required();
     table->add("--radii", options->radii, "Comma-separated radii, one per internode")->required();
     auto* threshold = table->add("--threshold", options->threshold, "Prune laterals whose first radius is below T (radius units)");
-    auto* levels = table->add("--levels", options->levels, "Print K LODs with thresholds at uniform positions of the sorted unique radii")
-                           ->check(cli::PositiveNumber);
+    auto* levels =
+            table->add("--levels", options->levels,
+                       "Print K LODs with thresholds at uniform positions of the sorted unique branch thicknesses (laterals' first radii)")
+                    ->check(cli::PositiveNumber);
     threshold->excludes(levels);
     levels->excludes(threshold);
     sub->callback([options, table, threshold, levels, &global, &job] {

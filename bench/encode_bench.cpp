@@ -55,7 +55,7 @@ BENCHMARK(BM_DecodeDbf6)->Arg(3)->Arg(5)->Arg(10)->Unit(benchmark::kMillisecond)
 
 void BM_LodChain(benchmark::State& state) {
     const EncodedTree encoded = encode_tree(bench_tree(), options_for(5.0));
-    const std::vector<double> thresholds = lod_thresholds(encoded.code.radii, 4);
+    const std::vector<double> thresholds = lod_thresholds(branch_thicknesses(encoded.code), 4);
     for (auto _ : state) benchmark::DoNotOptimize(lod_chain(encoded.code, thresholds));
     state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(encoded.code.radii.size()));
 }

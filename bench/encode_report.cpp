@@ -1,7 +1,7 @@
 // Strnad et al. 2020, §4, Experiment 1 (Tables 3 and 4) and the Fig. 5 error figures for our trees:
 //   encode_report [--quick] [SKELETON.ply ...]
 // For every tree and r = 3, 5, 10: DBF6 code lengths at LOD 0..3 (thresholds at uniform
-// positions of the sorted unique radii), the DBF6 length relative to F6 at each LOD, and the
+// positions of the sorted unique branch thicknesses), the DBF6 length relative to F6 at each LOD, and the
 // maximum/average Hausdorff distance of the decoded full-detail skeleton, normalised by the
 // bounding-box diagonal, with the √3·d/2 vertex bound checked.
 //
@@ -95,7 +95,7 @@ Row measure(const Subject& subject, double resolution) {
     ChainCode f6 = encoded.code;
     f6.kind = CodeKind::F6;
     f6.symbols = write_symbols(encoded.internodes, CodeKind::F6);
-    const std::vector<double> thresholds = lod_thresholds(encoded.code.radii, kLevels);
+    const std::vector<double> thresholds = lod_thresholds(branch_thicknesses(encoded.code), kLevels);
     const std::vector<ChainCode> dbf6_levels = lod_chain(encoded.code, thresholds);
     const std::vector<ChainCode> f6_levels = lod_chain(f6, thresholds);
     for (int k = 0; k < kLevels; ++k) {

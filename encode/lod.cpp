@@ -50,9 +50,25 @@ ChainCode reduce_lod(const ChainCode& code, double threshold, const std::string&
     return out;
 }
 
-std::vector<double> lod_thresholds(const std::vector<int>& radii, int levels) {
+std::vector<int> branch_thicknesses(const ChainCode& code) {
+    // Branches follow one another in the code, each ending with its tip: the internode after a
+    // tip is the first of the next lateral.
+    std::vector<int> thicknesses;
+    std::size_t radius = 0;
+    bool after_tip = false;
+    for (const char c : code.symbols) {
+        if (c != kFork && c != kTip && c != kEndOfInternode) continue;
+        if (radius >= code.radii.size()) break;
+        if (after_tip) thicknesses.push_back(code.radii[radius]);
+        after_tip = c == kTip;
+        ++radius;
+    }
+    return thicknesses;
+}
+
+std::vector<double> lod_thresholds(const std::vector<int>& thicknesses, int levels) {
     if (levels < 1) throw Error::usage("the number of LODs must be at least 1 (got " + std::to_string(levels) + ")");
-    std::vector<int> unique = radii;
+    std::vector<int> unique = thicknesses;
     std::sort(unique.begin(), unique.end());
     unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
     std::vector<double> thresholds;

@@ -22,10 +22,16 @@ namespace treelobes::encode {
 // `context` for a corrupt code or a radius list of the wrong length.
 ChainCode reduce_lod(const ChainCode& code, double threshold, const std::string& context = "chain code");
 
+// The thickness of every lateral branch, in code order: the radius of its first internode, the
+// value Pseudocode 2 compares with T. Reads as much of a damaged code as it can.
+std::vector<int> branch_thicknesses(const ChainCode& code);
+
 // Thresholds for `levels` LODs (LOD 0 = full detail) as in §4 Experiment 1: the values at
-// levels-1 uniformly spaced positions i*n/levels (i = 1..levels-1) of the n sorted unique radii.
-// Non-decreasing; fewer unique radii than levels repeat values. Throws Error(Usage) for levels < 1.
-std::vector<double> lod_thresholds(const std::vector<int>& radii, int levels);
+// levels-1 uniformly spaced positions i*n/levels (i = 1..levels-1) of the n sorted unique branch
+// thicknesses (branch_thicknesses; the trunk's radii, never pruned, would put the upper
+// thresholds above every lateral and make those LODs the same). Non-decreasing; fewer unique
+// values than levels repeat values. Throws Error(Usage) for levels < 1.
+std::vector<double> lod_thresholds(const std::vector<int>& thicknesses, int levels);
 
 // LOD 0..thresholds.size(): the full code, then successive reductions (each from the previous
 // one, which equals reducing the full code by the larger threshold).

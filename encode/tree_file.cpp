@@ -111,7 +111,7 @@ StoredTree store_tree(const TreeGraph& tree, const TreeFileOptions& options, con
     stored.radius_unit = encoded.geometry.radius_unit;
     stored.root_position = encoded.geometry.origin + encoded.geometry.root_position.cast<double>();
     stored.root_radius = encoded.geometry.root_radius;
-    const std::vector<double> thresholds = lod_thresholds(encoded.code.radii, options.lods);
+    const std::vector<double> thresholds = lod_thresholds(branch_thicknesses(encoded.code), options.lods);
     for (double t : thresholds) stored.thresholds.push_back(static_cast<int>(t));  // radii values: integral
     stored.lods = lod_chain(encoded.code, thresholds, context);
     return stored;

@@ -20,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             code.kind = kind;
             treelobes::fuzz::expect_only_input_errors([&] { decode_tree(code, geometry, "--code"); });
         }
-        treelobes::fuzz::expect_only_input_errors([&] { lod_chain(code, lod_thresholds(code.radii, 3), "--code"); });
+        treelobes::fuzz::expect_only_input_errors([&] { lod_chain(code, lod_thresholds(branch_thicknesses(code), 3), "--code"); });
     });
     return 0;
 }

@@ -61,10 +61,14 @@ TEST(EncodeCli, LodPrintsTheReducedCodeAndRadii) {
     ASSERT_EQ(levels.exit_code, 0) << levels.err;
     const auto json = nlohmann::json::parse(levels.out);
     ASSERT_EQ(json["levels"].size(), 4u);
-    EXPECT_EQ(json["levels"][1]["threshold"], 2.0);
-    EXPECT_EQ(json["levels"][2]["threshold"], 5.0);
-    EXPECT_EQ(json["levels"][1]["code"], "11166346171333700118373337");
-    EXPECT_EQ(json["levels"][2]["code"], "1118834817");
+    // Thresholds from the laterals' first radii 2, 4, 2, 1 (unique 1 2 4): 1, 2, 4. The last
+    // level is the paper's C' of Fig. 7 (its T = 3 prunes the same branches).
+    EXPECT_EQ(json["levels"][1]["threshold"], 1.0);
+    EXPECT_EQ(json["levels"][2]["threshold"], 2.0);
+    EXPECT_EQ(json["levels"][3]["threshold"], 4.0);
+    EXPECT_EQ(json["levels"][1]["code"], "1116634617133370011637333700047");
+    EXPECT_EQ(json["levels"][2]["code"], "11166346171333700118373337");
+    EXPECT_EQ(json["levels"][3]["code"], "11186348170011837");
 }
 
 TEST(EncodeCli, DecodeCodeWritesASkeletonThatEncodesToTheSameCode) {

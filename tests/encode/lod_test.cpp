@@ -1,8 +1,10 @@
-// LOD reduction on the code (Pseudocode 2, Fig. 7) and the LOD thresholds of Experiment 1.
+// LOD reduction on the code (Pseudocode 2, Fig. 7) and the LOD thresholds of Experiment 1 (from
+// the branch thicknesses).
 #include "core/error.hpp"
 #include "encode/hausdorff.hpp"
 #include "encode/lod.hpp"
 #include "encode/tree_code.hpp"
+#include "encode/tree_file.hpp"
 #include "random_tree.hpp"
 
 #include <gtest/gtest.h>
@@ -98,12 +100,41 @@ TEST(Lod, ReducedCodesDecodeToSubtreesOfTheFullTree) {
     }
 }
 
-TEST(Lod, ThresholdsSitAtUniformPositionsOfTheSortedUniqueRadii) {
-    // Unique radii 1 2 4 5 9 10 (n = 6), 4 LODs: positions 6/4, 12/4, 18/4 -> 1, 3, 4.
+TEST(Lod, ThresholdsSitAtUniformPositionsOfTheSortedUniqueBranchThicknesses) {
+    // Fig. 7: the trunk (radii 10 9 5 2), then four laterals whose first internodes are 2, 4, 2, 1.
+    EXPECT_EQ(branch_thicknesses(kFig7), (std::vector<int>{2, 4, 2, 1}));
+    // Unique thicknesses 1 2 4 (n = 3), 3 LODs: positions 3/3, 6/3 -> 1, 2.
+    EXPECT_EQ(lod_thresholds(branch_thicknesses(kFig7), 3), (std::vector<double>{2, 4}));
+    // Any list: unique 1 2 4 5 9 10 (n = 6), 4 LODs: positions 6/4, 12/4, 18/4 -> 1, 3, 4.
     EXPECT_EQ(lod_thresholds(kFig7.radii, 4), (std::vector<double>{2, 5, 9}));
     EXPECT_EQ(lod_thresholds(kFig7.radii, 1), std::vector<double>{});
     EXPECT_EQ(lod_thresholds({3, 3, 3}, 3), (std::vector<double>{3, 3}));
     EXPECT_THROW(lod_thresholds({1}, 0), Error);
+}
+
+// A thick trunk with thin laterals of eight thicknesses: thresholds from every radius (the
+// trunk's many values among them) would lie above every lateral from LOD 2 on, and LOD 3 would
+// be LOD 2 again; from the branch thicknesses each LOD prunes more than the one before.
+TEST(Lod, EachLodPrunesMoreWhenTheTrunkIsThick) {
+    TreeGraph tree;
+    tree.add_node({0, 0, 0}, 0.40f, -1);
+    for (int i = 1; i <= 40; ++i) tree.add_node({0, 0, 0.25f * static_cast<float>(i)}, 0.40f - 0.008f * static_cast<float>(i), i - 1);
+    for (int b = 0; b < 8; ++b) {
+        const float angle = 0.8f * static_cast<float>(b);
+        int parent = 4 * b + 4;
+        for (int k = 1; k <= 4; ++k)
+            parent = tree.add_node(tree.nodes[4 * b + 4].position +
+                                           0.25f * static_cast<float>(k) * Eigen::Vector3f(std::cos(angle), std::sin(angle), 0.5f),
+                                   0.01f * static_cast<float>(b + 1) - 0.001f * static_cast<float>(k), parent);
+    }
+    TreeFileOptions options;
+    options.lods = 4;
+    const StoredTree stored = store_tree(tree, options, "thick trunk");
+    ASSERT_EQ(stored.lods.size(), 4u);
+    for (std::size_t k = 1; k < stored.lods.size(); ++k) EXPECT_LT(stored.lods[k].radii.size(), stored.lods[k - 1].radii.size()) << k;
+    const EncodedTree encoded = encode_tree(tree, options.encode);
+    const std::vector<ChainCode> by_every_radius = lod_chain(encoded.code, lod_thresholds(encoded.code.radii, 4));
+    EXPECT_EQ(by_every_radius[3].radii.size(), by_every_radius[2].radii.size());  // what the thresholds were before
 }
 
 TEST(Lod, SuccessiveReductionEqualsDirectReduction) {
