@@ -27,7 +27,8 @@ status=0
 ((status == 0 || status == 3)) || exit "$status"
 echo
 echo "trees found (from $OUT/tile/trees.csv; heights in metres above the ground; an airborne scan"
-echo "does not see stems, so DBH is 'not_visible' rather than guessed; a tree with too few points"
+echo "does not see stems, so DBH is 'not_visible' rather than guessed, and the woody volume is an"
+echo "estimate: the crown's skeleton on a stem of height / 50 at its foot; a tree with too few points"
 echo "for a model is measured only, without a woody volume):"
 # Columns by their names in the header (docs/tile.md lists them).
 awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) c[$i] = i
