@@ -30,4 +30,14 @@ double TriangleMesh::area() const {
     return sum;
 }
 
+std::vector<Eigen::Vector3f> TriangleMesh::vertex_normals() const {
+    std::vector<Eigen::Vector3f> normals(vertices.size(), Eigen::Vector3f::Zero());
+    for (const auto& f : faces) {
+        const Eigen::Vector3f n = (vertices[f[1]] - vertices[f[0]]).cross(vertices[f[2]] - vertices[f[0]]);
+        for (int v : f) normals[v] += n;
+    }
+    for (auto& n : normals) n.normalize();  // Eigen leaves a zero vector as it is
+    return normals;
+}
+
 }  // namespace treelobes

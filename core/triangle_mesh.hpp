@@ -22,6 +22,8 @@ struct TriangleMesh {
     // Signed volume (positive for a closed, outward-oriented mesh) and surface area.
     double signed_volume() const;
     double area() const;
+    // Area-weighted vertex normals, unit length; zero for a vertex no face uses.
+    std::vector<Eigen::Vector3f> vertex_normals() const;
 };
 
 }  // namespace treelobes

@@ -26,18 +26,10 @@ constexpr int kLeafTextureSize = 64;
 // Our z-up frame to glTF's y-up frame.
 Eigen::Vector3f y_up(const Eigen::Vector3f& p) { return {p.x(), p.z(), -p.y()}; }
 
-// Area-weighted vertex normals (y-up), unit length; vertices without faces get +y.
+// The mesh's vertex normals in glTF's y-up frame; vertices without faces get +y.
 std::vector<Eigen::Vector3f> vertex_normals(const TriangleMesh& mesh) {
-    std::vector<Eigen::Vector3f> normals(mesh.vertices.size(), Eigen::Vector3f::Zero());
-    for (const auto& f : mesh.faces) {
-        const Eigen::Vector3f n = (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]);
-        for (int v : f) normals[v] += n;
-    }
-    for (auto& n : normals) {
-        const float length = n.norm();
-        n = length > 1e-20f ? Eigen::Vector3f(y_up(n / length)) : Eigen::Vector3f::UnitY();
-        n.normalize();
-    }
+    std::vector<Eigen::Vector3f> normals = mesh.vertex_normals();
+    for (auto& n : normals) n = n.isZero() ? Eigen::Vector3f::UnitY() : y_up(n).normalized();
     return normals;
 }
 

@@ -209,17 +209,6 @@ bool simplify_closed_mesh(TriangleMesh& mesh, const SimplifyOptions& options) {
 
 namespace {
 
-// Area-weighted vertex normals, unit length (zero for a vertex no face uses).
-std::vector<Eigen::Vector3f> vertex_normals(const TriangleMesh& mesh) {
-    std::vector<Eigen::Vector3f> normal(mesh.vertices.size(), Eigen::Vector3f::Zero());
-    for (const auto& f : mesh.faces) {
-        const Eigen::Vector3f n = (mesh.vertices[f[1]] - mesh.vertices[f[0]]).cross(mesh.vertices[f[2]] - mesh.vertices[f[0]]);
-        for (int v : f) normal[v] += n;
-    }
-    for (auto& n : normal) n.normalize();
-    return normal;
-}
-
 Point to_point(const Eigen::Vector3f& p) { return Point(p.x(), p.y(), p.z()); }
 
 }  // namespace
@@ -236,7 +225,7 @@ void inflate_to_contain(TriangleMesh& coarse, const TriangleMesh& fine) {
     }
     if (triangles.empty()) return;
     const AabbTree tree(triangles.cbegin(), triangles.cend());
-    const std::vector<Eigen::Vector3f> normal = vertex_normals(coarse);
+    const std::vector<Eigen::Vector3f> normal = coarse.vertex_normals();
     std::vector<float> push(coarse.vertices.size(), 0.0f);
     for (const Eigen::Vector3f& p : fine.vertices) {
         const auto [closest, primitive] = tree.closest_point_and_primitive(to_point(p));
