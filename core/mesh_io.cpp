@@ -15,8 +15,10 @@
 #include <OpenMesh/Core/Mesh/PolyMesh_ArrayKernelT.hh>
 #include <OpenMesh/Core/System/omstream.hh>
 
+#include <algorithm>
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -52,10 +54,13 @@ Eigen::Vector3d origin_for(const PolyMesh& mesh) {
 }
 
 // OpenMesh's PLY reader loops forever on a header it cannot parse (found by fuzz/mesh_fuzz.cpp:
-// a header that never ends; a format line whose version is not a number, after which its stream
-// fails and its keyword loop no longer advances). So the header is checked first: it starts with
-// "ply", reaches end_header within 64 kB, and each line is a PLY header line with readable values,
-// properties after an element and of PLY's types.
+// a header that never ends; a format line whose version is not a number, or is nan, inf or beyond
+// a float, after which its stream fails and its keyword loop no longer advances). It reads the
+// header word by word, so an obj_info line's words are keywords to it: "element" there made it
+// spin the same way, "property" before any element crashed it. So the header is checked first: it
+// starts with "ply", reaches end_header within 64 kB, and each line is a PLY header line with
+// readable values, properties after an element and of PLY's types, and obj_info lines without
+// header keywords.
 void check_ply_header(const fs::path& path, const std::string& name) {
     std::ifstream in(path, std::ios::binary);
     static const std::set<std::string> kPlyTypes{"char", "uchar", "short", "ushort", "int",   "uint",   "float",   "double",
@@ -73,20 +78,25 @@ void check_ply_header(const fs::path& path, const std::string& name) {
         const auto bad = [&](const std::string& what) {
             throw Error::input(name, "PLY header line " + std::to_string(number) + ": " + what);
         };
-        const auto is_number = [](const std::string& text) {
-            double value = 0;
+        const auto is_float = [](const std::string& text) {  // what OpenMesh reads the version into
+            float value = 0;
             const auto [end, error] = std::from_chars(text.data(), text.data() + text.size(), value);
-            return error == std::errc() && end == text.data() + text.size();
+            return error == std::errc() && end == text.data() + text.size() && std::isfinite(value);
         };
         if (number == 1) {
             if (line != "ply") bad("the file does not start with 'ply'");
             continue;
         }
-        if (word.empty() || word[0] == "comment" || word[0] == "obj_info") continue;
+        if (word.empty() || word[0] == "comment") continue;
+        if (word[0] == "obj_info") {
+            for (const char* keyword : {"element", "property", "end_header"})
+                if (std::find(word.begin() + 1, word.end(), keyword) != word.end()) bad("obj_info holds the keyword '" + std::string(keyword) + "'");
+            continue;
+        }
         if (word[0] == "end_header") return;
         if (word[0] == "format") {
             if (word.size() != 3 || (word[1] != "ascii" && word[1] != "binary_little_endian" && word[1] != "binary_big_endian") ||
-                !is_number(word[2]))
+                !is_float(word[2]))
                 bad("expected 'format ascii|binary_little_endian|binary_big_endian VERSION'");
         } else if (word[0] == "element") {
             std::uint64_t count = 0;

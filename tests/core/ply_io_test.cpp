@@ -252,6 +252,30 @@ TEST(MeshRead, PlyFormatVersionNotANumberIsBadInputNotAHang) {
               ExitCode::InvalidInput);
 }
 
+// Found by fuzzing in CI: OpenMesh reads the version into a float and its header word by word, so
+// a version of nan, inf or beyond a float, and an obj_info line naming a header keyword, left it
+// spinning on a failed stream (or, for "property" before any element, crashed it).
+TEST(MeshRead, PlyHeadersOpenMeshMisreadsAreBadInputNotAHang) {
+    TempDir dir;
+    const std::string elements = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+                                 "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const std::map<std::string, std::string> misread{
+            {"version_nan.ply", "ply\nformat ascii nan\n" + elements},
+            {"version_inf.ply", "ply\nformat ascii inf\n" + elements},
+            {"version_beyond_float.ply", "ply\nformat ascii 1e39\n" + elements},
+            {"obj_info_element.ply", "ply\nformat ascii 1.0\nobj_info element\n" + elements},
+            {"obj_info_property.ply", "ply\nformat ascii 1.0\nobj_info property list uchar int a\n" + elements},
+            {"obj_info_end_header.ply", "ply\nformat ascii 1.0\nobj_info end_header\n" + elements},
+    };
+    for (const auto& [file, text] : misread) {
+        const auto path = dir / file;  // clang 14 (the sanitizer build) cannot capture a structured binding
+        write_text(path, text);
+        EXPECT_EQ(error_code_of([&] { read_mesh(path); }), ExitCode::InvalidInput) << file;
+    }
+    write_text(dir / "plain.ply", "ply\nformat ascii 1.0\nobj_info scanned by a test\n" + elements);
+    EXPECT_EQ(read_mesh(dir / "plain.ply").faces.size(), 1u);
+}
+
 // Found by fuzzing: OpenMesh's OFF reader asked for 1.6 GB on a small OFF file whose vertex lines
 // were damaged (and, after a header check, again on another), so OFF has its own reader.
 TEST(MeshRead, DamagedOffIsBadInput) {
