@@ -51,6 +51,7 @@ nlohmann::json to_json(const EvalSkeletonOptions& o, const OptionTable& table, c
                         {"length", c.length},
                         {"reference_length", optional_json(c.reference_length)},
                         {"length_ratio", optional_json(c.length_ratio)},
+                        {"touched_reference_length", optional_json(c.touched_reference_length)},
                         {"breast_height", o.eval.breast_height},
                         {"trunk_radius", optional_json(c.trunk_radius)},
                         {"reference_trunk_radius", optional_json(c.reference_trunk_radius)},
@@ -73,12 +74,17 @@ void print_stats(const char* label, const DistanceStats& s) {
 
 void print_human(const EvalSkeletonOptions& o, const SkeletonGraph& ref, const SkeletonComparison& c) {
     std::printf("%s vs %s (%s%s)\n", o.skeleton.c_str(), o.reference.c_str(), ref.kind.c_str(),
-                o.visible_in.empty() ? "" : ", the part the scan sees");
+                o.visible_in.empty() ? "" : ", the part the scan sees: touched for the skeleton's side, by enough points for the reference's");
     print_stats("skeleton -> reference:", c.to_reference);
     print_stats("reference -> skeleton:", c.from_reference);
     std::printf("  length %.2f m", c.length);
-    if (c.reference_length) std::printf(", reference %.2f m", *c.reference_length);
-    if (c.length_ratio) std::printf(", ratio %.3f", *c.length_ratio);
+    if (c.touched_reference_length && c.reference_length && c.length_ratio)
+        std::printf("; reference %.2f m seen well, %.2f m touched by the scan; ratio to the part seen well %.3f", *c.reference_length,
+                    *c.touched_reference_length, *c.length_ratio);
+    else {
+        if (c.reference_length) std::printf(", reference %.2f m", *c.reference_length);
+        if (c.length_ratio) std::printf(", ratio %.3f", *c.length_ratio);
+    }
     std::printf("\n");
     if (c.trunk_radius && c.reference_trunk_radius)
         std::printf("  trunk radius at %.2f m %.4f m, reference %.4f m, error %+.1f %%\n", o.eval.breast_height, *c.trunk_radius,
@@ -104,17 +110,19 @@ void write_samples(const SkeletonComparison& c, const std::string& path) {
 
 int run_eval_skeleton(const EvalSkeletonOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const SkeletonGraph skeleton = read_skeleton_graph(o.skeleton, o.skeleton_kind);
-    SkeletonGraph reference = read_skeleton_graph(o.reference, o.reference_kind);
-    if (!o.visible_in.empty()) {
+    const SkeletonGraph reference = read_skeleton_graph(o.reference, o.reference_kind);
+    SkeletonComparison c;
+    if (o.visible_in.empty()) {
+        c = compare_skeletons(skeleton, reference, o.eval);
+    } else {
         const PointCloud scan = read_point_cloud(o.visible_in);
         const ExtraAttribute* internode = scan.extra("internode");
         if (!internode)
             throw Error::input(o.visible_in, "--visible-in needs a scan with the `internode` attribute (a `treelobes synth` scan)");
         // Leaf points count too: they carry the internode of the twig they grow on, whose place
         // they show (a skeleton through a leafy twig is right).
-        reference = visible_reference(reference, internode->values, o.visible_points);
+        c = compare_with_visible_part(skeleton, reference, internode->values, o.visible_points, o.eval);
     }
-    const SkeletonComparison c = compare_skeletons(skeleton, reference, o.eval);
     if (!o.samples_out.empty()) write_samples(c, o.samples_out);
     if (global.json)
         std::cout << to_json(o, table, reference, c).dump(2) << "\n";
@@ -151,8 +159,11 @@ void add_eval_command(CLI::App& app, const GlobalOptions& global, Job& job) {
             ->check(cli::NonNegativeNumber);
     table->add("--visible-in", options->visible_in,
                "A synthetic scan of the reference (points labelled with `internode`): score against the part of the "
-               "reference it sees, i.e. the internodes holding --visible-points of its points (bark or leaves) and their way to the root");
-    table->add("--visible-points", options->visible_points, "Scan points an internode needs to count as seen")
+               "reference it sees, each internode with its way to the root: the skeleton's parts (skeleton -> reference, "
+               "precision) against every internode the scan touched, the reference's (reference -> skeleton, recall, length, "
+               "trunk) against those holding --visible-points of its points (bark or leaves)");
+    table->add("--visible-points", options->visible_points,
+               "Scan points an internode needs to count as seen well enough to be expected in the skeleton")
             ->check(CLI::Range(1, 1000000));
     table->add("--samples-out", options->samples_out, "Write the skeleton samples with scalar_distance to this point cloud file");
     sub->callback(

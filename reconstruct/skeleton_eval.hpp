@@ -80,6 +80,7 @@ struct SkeletonComparison {
     double length = 0;
     std::optional<double> reference_length;  // not for point lists
     std::optional<double> length_ratio;      // length / reference_length
+    std::optional<double> touched_reference_length;  // compare_with_visible_part: every internode the scan touched
     // At breast height (EvalOptions::breast_height above the reference stem's base); error relative to the reference.
     std::optional<double> trunk_radius, reference_trunk_radius, trunk_radius_error;
     std::size_t components = 0, reference_components = 0;

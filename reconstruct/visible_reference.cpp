@@ -43,4 +43,22 @@ SkeletonGraph visible_reference(const SkeletonGraph& reference, std::span<const 
     return visible;
 }
 
+SkeletonComparison compare_with_visible_part(const SkeletonGraph& skeleton, const SkeletonGraph& reference,
+                                             std::span<const double> point_internode, std::size_t min_points,
+                                             const EvalOptions& options) {
+    SkeletonComparison seen = compare_skeletons(skeleton, visible_reference(reference, point_internode, min_points), options);
+    if (min_points <= 1) return seen;
+    SkeletonComparison touched = compare_skeletons(skeleton, visible_reference(reference, point_internode, 1), options);
+    seen.touched_reference_length = touched.reference_length;
+    seen.to_reference = touched.to_reference;
+    seen.sample_positions = std::move(touched.sample_positions);
+    seen.sample_distances = std::move(touched.sample_distances);
+    if (seen.branches && touched.branches) {
+        seen.branches->skeleton_branches = touched.branches->skeleton_branches;
+        seen.branches->correct = touched.branches->correct;
+        seen.branches->precision = touched.branches->precision;
+    }
+    return seen;
+}
+
 }  // namespace treelobes

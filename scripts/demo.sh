@@ -53,8 +53,9 @@ step "reconstruct: skeleton, radii and branch mesh of two scanned trees"
 echo "true DBH: ailanthus $(truth_dbh ailanthus_altissima_5) m, palm $(truth_dbh palm_1) m ($SAMPLE/*_truth.json)"
 
 step "eval: the reconstructed skeleton against the part of the true one its scan sees"
-# The true skeleton holds every twig, also those too thin for the scan to hit; --visible-in keeps
-# the internodes the scan hit (and their way to the root). Trunk radii are compared at 1.3 m.
+# The true skeleton holds every twig, also those too thin for the scan to hit; --visible-in scores
+# the skeleton's parts against the internodes the scan touched and asks for those it saw with 5
+# points or more (each with its way to the root). Trunk radii are compared at 1.3 m.
 args=(eval skeleton --skeleton "$OUT/reconstruct/ailanthus_altissima_5_skeleton.ply"
       --reference "$SAMPLE/ailanthus_altissima_5_skeleton.ply" --visible-in "$SAMPLE/ailanthus_altissima_5.las")
 "$BIN" "${args[@]}"

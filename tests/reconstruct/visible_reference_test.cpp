@@ -45,6 +45,25 @@ TEST(VisibleReference, KeepsSeenInternodesAndTheirWayToTheRoot) {
     EXPECT_EQ(visible_reference(y_reference(), labels, 1).vertices.size(), 5u);  // the trunk tip too
 }
 
+// The skeleton's side against what the scan touched, the reference's against what it saw well: a
+// skeleton that follows a twig of two returns is not wrong there, nor is a skeleton without it
+// penalised.
+TEST(VisibleReference, EachSideIsScoredAgainstItsOwnPart) {
+    const std::vector<double> labels{4, 4, 4, 4, 4, 2, 2, 2, 2, 2, 5, 5};  // twig 5 touched by 2 points
+    const SkeletonGraph reference = y_reference();
+    const SkeletonComparison both = compare_with_visible_part(reference, reference, labels, 5);
+    const SkeletonComparison seen_only = compare_skeletons(reference, visible_reference(reference, labels, 5));
+    EXPECT_GT(seen_only.to_reference.max, 0.5);  // the twig lies away from the well-seen part
+    EXPECT_NEAR(both.to_reference.max, 0.0, 1e-6);
+    EXPECT_EQ(both.from_reference.samples, seen_only.from_reference.samples);
+    ASSERT_TRUE(both.branches && seen_only.branches);
+    EXPECT_DOUBLE_EQ(both.branches->precision, 1.0);
+    EXPECT_LT(seen_only.branches->precision, 1.0);
+    EXPECT_EQ(both.branches->reference_branches, seen_only.branches->reference_branches);
+    EXPECT_NEAR(*both.reference_length, *seen_only.reference_length, 1e-9);
+    EXPECT_NEAR(*both.touched_reference_length, reference.total_length(), 1e-6);
+}
+
 TEST(VisibleReference, NothingSeenOrNotATreeIsAnError) {
     EXPECT_THROW(visible_reference(y_reference(), std::vector<double>{-1, 9}, 1), Error);
     SkeletonGraph points = y_reference();
