@@ -1,7 +1,9 @@
 // `treelobes info FILE...`: format, version, counts, bounds, attributes and CRS of point
-// clouds, meshes and skeletons. Every file is reported; the exit code is 2 if any failed.
+// clouds, meshes and skeletons, and what treelobes' own files hold (apps/product_file_info.hpp).
+// Every file is reported; the exit code is 2 if any failed.
 #include "apps/command.hpp"
 #include "apps/option_table.hpp"
+#include "apps/product_file_info.hpp"
 #include "core/error.hpp"
 #include "core/file_info.hpp"
 #include "core/version.hpp"
@@ -110,6 +112,15 @@ int run_info(const InfoOptions& options, const OptionTable& table, const GlobalO
     if (!options.bounds.empty()) bounds = parse_bounds(options.bounds);
     for (const auto& file : options.files) {
         try {
+            if (is_product_file(file)) {
+                if (bounds) throw Error::usage("--bounds applies to point clouds, not to " + file);
+                const nlohmann::json info = describe_product_file(file);
+                if (global.json)
+                    files.push_back(info);
+                else
+                    print_product_file(info);
+                continue;
+            }
             const FileInfo info = describe_file(file, bounds);
             if (global.json)
                 files.push_back(to_json(info));
@@ -130,7 +141,9 @@ int run_info(const InfoOptions& options, const OptionTable& table, const GlobalO
 void add_info_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto options = std::make_shared<InfoOptions>();
     CLI::App* sub = app.add_subcommand(
-            "info", "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes (PLY, OBJ, OFF, glb), skeletons, QSMs and CityJSON");
+            "info",
+            "Describe point clouds (LAS, LAZ, COPC, PLY, PCD, XYZ/CSV), meshes (PLY, OBJ, OFF, glb), skeletons, QSMs, CityJSON and "
+            "treelobes' own .dbf6 trees, .forest files and .tlobe lobe trees");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("files", options->files, "Files to describe")->required();
     table->add("--bounds", options->bounds,
