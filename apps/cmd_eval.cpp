@@ -73,8 +73,9 @@ void print_stats(const char* label, const DistanceStats& s) {
 }
 
 void print_human(const EvalSkeletonOptions& o, const SkeletonGraph& ref, const SkeletonComparison& c) {
-    std::printf("%s vs %s (%s%s)\n", o.skeleton.c_str(), o.reference.c_str(), ref.kind.c_str(),
-                o.visible_in.empty() ? "" : ", the part the scan sees: touched for the skeleton's side, by enough points for the reference's");
+    std::printf(
+            "%s vs %s (%s%s)\n", o.skeleton.c_str(), o.reference.c_str(), ref.kind.c_str(),
+            o.visible_in.empty() ? "" : ", the part the scan sees: touched for the skeleton's side, by enough points for the reference's");
     print_stats("skeleton -> reference:", c.to_reference);
     print_stats("reference -> skeleton:", c.from_reference);
     std::printf("  length %.2f m", c.length);

@@ -149,8 +149,8 @@ nlohmann::json run_one(const LobesCliOptions& o, const OptionTable& table, const
     write_file_atomically(summary_path, summary.dump(2) + "\n");
     if (!global.json)
         std::printf("%s: %zu %s (%zu closed, %zu faces), %zu main nodes, %.1f kB .tlobe; reconstruct %.2f s, lobes %.2f s\n",
-                    input.string().c_str(), tree.lobes.size(), tree.lobes.size() == 1 ? "lobe" : "lobes", closed, faces, tree.skeleton.size(), bytes.size() / 1000.0,
-                    std::chrono::duration<double>(reconstructed - start).count(),
+                    input.string().c_str(), tree.lobes.size(), tree.lobes.size() == 1 ? "lobe" : "lobes", closed, faces,
+                    tree.skeleton.size(), bytes.size() / 1000.0, std::chrono::duration<double>(reconstructed - start).count(),
                     std::chrono::duration<double>(lobed - reconstructed).count());
     return summary;
 }
@@ -349,8 +349,8 @@ int run_synthesize(const SynthesizeCliOptions& o, const OptionTable& table, cons
     if (global.json) {
         std::cout << summary.dump(2) << "\n";
     } else {
-        std::printf("%s: %zu %s textured with %zu %s patches -> %zu triangles (%zu leaves) in %.2f s", o.input.c_str(),
-                    tree.lobes.size(), tree.lobes.size() == 1 ? "lobe" : "lobes", instances, profile.entry.name.c_str(), mesh.triangles(), mesh.leaf_count,
+        std::printf("%s: %zu %s textured with %zu %s patches -> %zu triangles (%zu leaves) in %.2f s", o.input.c_str(), tree.lobes.size(),
+                    tree.lobes.size() == 1 ? "lobe" : "lobes", instances, profile.entry.name.c_str(), mesh.triangles(), mesh.leaf_count,
                     texturing_seconds + mesh_seconds);
         if (summary.contains("fidelity"))
             std::printf("; input points to mesh: median %.3f m, p95 %.3f m", summary["fidelity"]["median_point_to_mesh"].get<double>(),

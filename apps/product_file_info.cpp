@@ -181,8 +181,9 @@ void print_forest(const nlohmann::json& j) {
     constexpr std::size_t kListed = 10;
     for (std::size_t i = 0; i < std::min(kListed, trees.size()); ++i) {
         const auto& t = trees[i];
-        std::printf("  %4zu %-24s %12.3f %12.3f %9.3f  %6zu bytes\n", i, t["name"].get<std::string>().c_str(), t["position"][0].get<double>(),
-                    t["position"][1].get<double>(), t["position"][2].get<double>(), t["bytes"].get<std::size_t>());
+        std::printf("  %4zu %-24s %12.3f %12.3f %9.3f  %6zu bytes\n", i, t["name"].get<std::string>().c_str(),
+                    t["position"][0].get<double>(), t["position"][1].get<double>(), t["position"][2].get<double>(),
+                    t["bytes"].get<std::size_t>());
     }
     if (trees.size() > kListed) std::printf("  ... %zu more (info --json lists every tree)\n", trees.size() - kListed);
 }
@@ -223,7 +224,8 @@ nlohmann::json describe_product_file(const fs::path& path) {
 }
 
 void print_product_file(const nlohmann::json& info) {
-    const std::string version = info["version"].is_string() ? info["version"].get<std::string>() : std::to_string(info["version"].get<int>());
+    const std::string version =
+            info["version"].is_string() ? info["version"].get<std::string>() : std::to_string(info["version"].get<int>());
     std::printf("%s\n  %s, .%s version %s\n", info["path"].get<std::string>().c_str(), info["kind"].get<std::string>().c_str(),
                 info["format"].get<std::string>().c_str(), version.c_str());
     const std::string format = info["format"];

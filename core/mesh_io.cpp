@@ -90,7 +90,8 @@ void check_ply_header(const fs::path& path, const std::string& name) {
         if (word.empty() || word[0] == "comment") continue;
         if (word[0] == "obj_info") {
             for (const char* keyword : {"element", "property", "end_header"})
-                if (std::find(word.begin() + 1, word.end(), keyword) != word.end()) bad("obj_info holds the keyword '" + std::string(keyword) + "'");
+                if (std::find(word.begin() + 1, word.end(), keyword) != word.end())
+                    bad("obj_info holds the keyword '" + std::string(keyword) + "'");
             continue;
         }
         if (word[0] == "end_header") return;

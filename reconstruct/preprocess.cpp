@@ -313,7 +313,7 @@ Preprocessed preprocess_cloud(const PointCloud& cloud, const PreprocessOptions& 
         removed = outliers(out.local_outlier_test, {});
     }
     std::vector<bool> ground = find_ground(merged, removed, options, out);
-    std::vector<bool> on_plane;  // every point of the ground plane, outlier or not: none sets the outlier limit
+    std::vector<bool> on_plane;        // every point of the ground plane, outlier or not: none sets the outlier limit
     if (filter && out.ground_found) {  // the test again, with the limit from the points off the plane
         on_plane = on_ground_plane(merged, std::vector<bool>(merged.size(), false), out.ground_plane, options.ground_tolerance);
         removed = outliers(out.local_outlier_test, on_plane);

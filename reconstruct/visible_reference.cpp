@@ -44,8 +44,7 @@ SkeletonGraph visible_reference(const SkeletonGraph& reference, std::span<const 
 }
 
 SkeletonComparison compare_with_visible_part(const SkeletonGraph& skeleton, const SkeletonGraph& reference,
-                                             std::span<const double> point_internode, std::size_t min_points,
-                                             const EvalOptions& options) {
+                                             std::span<const double> point_internode, std::size_t min_points, const EvalOptions& options) {
     SkeletonComparison seen = compare_skeletons(skeleton, visible_reference(reference, point_internode, min_points), options);
     if (min_points <= 1) return seen;
     SkeletonComparison touched = compare_skeletons(skeleton, visible_reference(reference, point_internode, 1), options);

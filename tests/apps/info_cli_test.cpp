@@ -86,16 +86,19 @@ TEST(Cli, InfoDescribesTreelobesOwnFiles) {
     const auto skeleton = sample / "ailanthus_altissima_5_skeleton.ply";
     ASSERT_EQ(run_cli("encode " + quoted(skeleton) + " --resolution 5 --lods 3 --out " + quoted(dir / "tree.dbf6")).exit_code, 0);
     write_text(dir / "trees.txt", skeleton.string() + " 10 20 1 90\n" + skeleton.string() + " 30 5 2\n");
-    ASSERT_EQ(run_cli("encode --forest " + quoted(dir / "trees.txt") + " --resolution 5 --out " + quoted(dir / "stand.forest")).exit_code, 0);
+    ASSERT_EQ(run_cli("encode --forest " + quoted(dir / "trees.txt") + " --resolution 5 --out " + quoted(dir / "stand.forest")).exit_code,
+              0);
     ASSERT_EQ(run_cli("lobes " + quoted(sample / "birch_3.las") + " --species birch --out " + quoted(dir.path())).exit_code, 0);
 
-    const auto human = run_cli("info " + quoted(dir / "tree.dbf6") + " " + quoted(dir / "stand.forest") + " " + quoted(dir / "birch_3.tlobe"));
+    const auto human =
+            run_cli("info " + quoted(dir / "tree.dbf6") + " " + quoted(dir / "stand.forest") + " " + quoted(dir / "birch_3.tlobe"));
     ASSERT_EQ(human.exit_code, 0) << human.err;
     for (const char* text : {"tree, .dbf6 version", "LOD 2:", "forest, .forest version", "2 trees in", "lobe tree, .tlobe version",
                              "species birch", "main skeleton:"})
         EXPECT_NE(human.out.find(text), std::string::npos) << text << "\n" << human.out;
 
-    const auto r = run_cli("--json info " + quoted(dir / "tree.dbf6") + " " + quoted(dir / "stand.forest") + " " + quoted(dir / "birch_3.tlobe"));
+    const auto r =
+            run_cli("--json info " + quoted(dir / "tree.dbf6") + " " + quoted(dir / "stand.forest") + " " + quoted(dir / "birch_3.tlobe"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto files = nlohmann::json::parse(r.out)["files"];
     ASSERT_EQ(files.size(), 3u);

@@ -257,8 +257,9 @@ TEST(MeshRead, PlyFormatVersionNotANumberIsBadInputNotAHang) {
 // spinning on a failed stream (or, for "property" before any element, crashed it).
 TEST(MeshRead, PlyHeadersOpenMeshMisreadsAreBadInputNotAHang) {
     TempDir dir;
-    const std::string elements = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
-                                 "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    const std::string elements =
+            "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+            "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
     const std::map<std::string, std::string> misread{
             {"version_nan.ply", "ply\nformat ascii nan\n" + elements},
             {"version_inf.ply", "ply\nformat ascii inf\n" + elements},
