@@ -127,6 +127,13 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"min_arc_coverage", &o.min_arc_coverage},
                                                   {"circle_tolerance", &o.circle_tolerance},
                                                   {"ground_clearance", &o.ground_clearance}};
+    const std::map<std::string, int*> counts = {{"graph_neighbours", &o.graph_neighbours},
+                                                {"min_stem_points", &o.min_stem_points},
+                                                {"min_detached_voxels", &o.min_detached_voxels}};
+    if (const auto count = counts.find(name); count != counts.end()) {
+        *count->second = static_cast<int>(v);
+        return;
+    }
     const auto field = fields.find(name);
     if (field == fields.end()) throw Error::usage("--set: unknown option " + name);
     *field->second = v;

@@ -60,6 +60,7 @@ TreeBase find_tree_base(std::span<const Eigen::Vector3f> points, const Neighbour
         z_high = std::max(z_high, p.z());
     }
     const float slab = o.slab_height > 0 ? o.slab_height : std::clamp(0.03f * (z_high - z_low), 0.2f, 0.6f);
+    const float max_stem_radius = std::max(o.max_stem_radius, o.max_stem_radius_per_height * (z_high - z_low));
     std::vector<Piece> pieces = bottom_pieces(points, graph, z_low + slab);
     TreeBase base;
     base.bottom_pieces = pieces.size();
@@ -79,7 +80,7 @@ TreeBase find_tree_base(std::span<const Eigen::Vector3f> points, const Neighbour
         mean /= static_cast<float>(pieces[k].members.size());
         piece_mean[k] = mean;
         piece_radius[k] = horizontal_radius(points, pieces[k].members, mean);
-        narrow[k] = pieces[k].members.size() >= 10 && piece_radius[k] <= o.max_stem_radius;
+        narrow[k] = pieces[k].members.size() >= 10 && piece_radius[k] <= max_stem_radius;
     }
     std::size_t pick = 0;
     bool any_narrow = false;
@@ -106,7 +107,7 @@ TreeBase find_tree_base(std::span<const Eigen::Vector3f> points, const Neighbour
     std::vector<Eigen::Vector2f> lower_xy;
     for (int i : stem.members)
         if (points[i].z() < stem.z_min + std::max(o.foot_height, 0.5f * slab)) lower_xy.push_back(points[i].head<2>());
-    const CircleFit circle = fit_circle(lower_xy, 0.02f, 0.01f, o.max_stem_radius);
+    const CircleFit circle = fit_circle(lower_xy, 0.02f, 0.01f, max_stem_radius);
     // A circle wider than the piece itself was fitted to clutter at the foot (ground left over).
     // Without a trusted circle the centre of the whole piece is nearer the stem axis than the
     // centroid of its lowest points (which may be that clutter).

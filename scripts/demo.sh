@@ -61,9 +61,11 @@ args=(eval skeleton --skeleton "$OUT/reconstruct/ailanthus_altissima_5_skeleton.
 "$BIN" "${args[@]}"
 "$BIN" --json "${args[@]}" > "$OUT/eval_ailanthus_altissima_5.json"
 
-step "lobes + synthesize: lobe-based representation and full tree of the Lagerstroemia"
-"$BIN" lobes "$SAMPLE/lagerstroemia_2.las" --species lagerstroemia --out "$OUT/lobes"
-"$BIN" synthesize "$OUT/lobes/lagerstroemia_2.tlobe" --out "$OUT/lobes/lagerstroemia_2_synthesized.ply"
+step "lobes + synthesize: lobe-based representation of a scanned mahogany, and the full tree drawn from it"
+"$BIN" lobes "$SAMPLE/mahogany_1.las" --species mahogany --out "$OUT/lobes"
+"$BIN" synthesize "$OUT/lobes/mahogany_1.tlobe" --out "$OUT/lobes/mahogany_1_synthesized.ply" \
+    --points "$SAMPLE/mahogany_1.las" --preview "$OUT/lobes/mahogany_1_preview.png"
+echo "picture: $OUT/lobes/mahogany_1_preview.png (the scan | the tree synthesized from its .tlobe)"
 
 step "encode: DBF6 chain code with 3 levels of detail, decoded back"
 "$BIN" encode "$OUT/reconstruct/ailanthus_altissima_5_skeleton.ply" --resolution 5 --lods 3 --out "$OUT/ailanthus_altissima_5.dbf6" --stats

@@ -25,6 +25,10 @@ generate() {
     # The Lagerstroemia at a finer raster (0.4 degrees) with little ground around it: at 0.8 degrees
     # the scan hits too few of its thin stems for a skeleton worth scoring.
     "$BIN" --log-level warn synth tree --species lagerstroemia --seed 2 --height 5 --angular-step 0.4 --ground-margin 0.5 --max-leaves 3000 --no-mesh --out "$out" >/dev/null
+    # A 9 m mahogany scanned finely enough (0.6 degrees) for the demo's lobe-based representation
+    # to show its structure: 11 lobes on 31 main nodes (coarser steps give 3-6 lobes, the
+    # multi-stemmed Lagerstroemia one lobe at its root collar).
+    "$BIN" --log-level warn synth tree --species mahogany --seed 1 --height 9 --angular-step 0.6 --ground-margin 0.5 --max-leaves 3000 --no-mesh --out "$out" >/dev/null
     "$BIN" --log-level warn synth tree --species birch --seed 3 --height 9 --scanner als --pulse-density 80 --max-leaves 4000 --no-mesh --out "$out" >/dev/null
     # A leaf-off terrestrial scan (as QSM campaigns scan broadleaves in winter) of an 8 m tree of
     # heaven: the demo's skeleton is scored on it, every branch thicker than 2 cm in sight.

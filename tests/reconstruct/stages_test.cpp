@@ -130,6 +130,19 @@ TEST(TreeBase, HangingBranchTipIsNotTheRoot) {
     EXPECT_FALSE(base.sources.empty());
 }
 
+// An old oak or fig, 24 m tall, flares to 1.3 m of radius at its foot (the synthetic ones of
+// `synth tree` do). Its foot is still the stem, not the tip of a branch hanging to the ground
+// 4 m away.
+TEST(TreeBase, AFlaredFootWiderThanAMetreIsTheStem) {
+    const std::vector<Segment> parts{{{0, 0, 0}, {0, 0, 3}, 1.3f}, {{0, 0, 3}, {0, 0, 24}, 0.2f}, {{0, 0, 2.5f}, {4.0f, 0, 0.05f}, 0.02f}};
+    const PointCloud cloud = test::cloud_from(parts, 600);
+    const NeighbourGraph graph = build_neighbour_graph(cloud.positions, {});
+    const TreeBase base = find_tree_base(cloud.positions, graph);
+    EXPECT_TRUE(base.stem_visible);
+    EXPECT_LT(base.position.head<2>().norm(), 0.1f);
+    EXPECT_NEAR(base.foot_radius, 1.3f, 0.05f);
+}
+
 TEST(ReconstructTree, StemFitRadiiAndSummary) {
     // A leaning stem of radius 0.2 m with a branch; the scan sees it all round.
     const std::vector<Segment> parts{{{0, 0, 0}, {0.3f, 0, 4}, 0.2f}, {{0.15f, 0, 2}, {1.5f, 0, 3}, 0.05f}};
