@@ -107,6 +107,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"merge_pass_ratio", &o.merge_pass_ratio},
                                                   {"chm_smoothing", &o.chm_smoothing},
                                                   {"max_stem_lean", &o.max_stem_lean},
+                                                  {"min_quarter_arc_share", &o.min_quarter_arc_share},
                                                   {"stem_layer_height", &o.stem_layer_height},
                                                   {"trunk_layer_height", &o.trunk_layer_height},
                                                   {"graph_beta", &o.graph_beta},

@@ -86,6 +86,10 @@ struct SegmentOptions {
     float min_circle_inliers = 0.5f;  // share of the cluster's points on the circle
     float min_arc_coverage = 0.2f;    // share of the circle's 10-degree sectors that hold inliers
     float max_stem_lean = 30.0f;      // degrees from vertical between the lower and upper half of a stem's slice points
+    // A circle fitted to the whole slice is a stem only when each of the slice's upper three
+    // quarters holds its arc over at least this share of the 10-degree sectors the whole slice
+    // covers (a drooping limb's band fills only some heights; 0 = not checked).
+    float min_quarter_arc_share = 0.1f;
     float stem_layer_height = 0.25f;  // a tapering trunk: circles fitted layer by layer, this thick (metres)
     float trunk_layer_height = 0.1f;  // a thin, leaning trunk under twigs: layers this thick (metres)
     float graph_voxel = 0.1f;         // voxel edge of the thinned cloud the plot graph is built on (metres)

@@ -546,3 +546,41 @@ TEST(SegmentTrees, StandPresets) {
     EXPECT_EQ(broadleaf.min_tree_height, 4.0f);
     EXPECT_EQ(test::error_code_of([] { parse_stand_type("palm"); }), ExitCode::Usage);
 }
+
+// A limb that droops to the ground, 0.7 m from nothing (docs/segment.md: a fig's limb on a
+// crowded plot): in the slice 1-2 m above the ground its points fill a half circle up to
+// 1.25 m and above that only the narrow strip where the limb rises. The whole slice fits the
+// half circle, and the strip stands over the middle of the arc, so the circle passes as an
+// upright stem unless every upper quarter of the slice must hold its arc too. A trunk beside
+// it holds its circle all the way up.
+TEST(SegmentTrees, ALimbWhoseArcFillsOnlyTheFootOfTheSliceIsNoStem) {
+    ToyTile tile = test::flat_ground(-3, 5, -3, 3);
+    const auto on_circle = [](float radius, float degrees) {
+        const float t = degrees * std::numbers::pi_v<float> / 180.0f;
+        return Eigen::Vector2f(radius * std::cos(t), radius * std::sin(t));
+    };
+    for (float z = 0.0f; z <= 1.25f; z += 0.02f)  // the limb's half circle, down to the ground
+        for (float a = 0.0f; a <= 180.0f; a += 2.0f) {
+            const Eigen::Vector2f p = on_circle(0.7f, a);
+            tile.add({p.x(), p.y(), z}, 1);
+        }
+    for (float z = 1.25f; z <= 4.0f; z += 0.01f)  // where it rises: 6 degrees of the arc
+        for (float a = 92.0f; a <= 98.0f; a += 2.0f) {
+            const Eigen::Vector2f p = on_circle(0.7f, a);
+            tile.add({p.x(), p.y(), z}, 1);
+        }
+    for (float z = 0.0f; z <= 4.0f; z += 0.02f)  // a trunk 3 m away
+        for (float a = 0.0f; a < 360.0f; a += 10.0f) {
+            const Eigen::Vector2f p = Eigen::Vector2f(3.0f, 0.0f) + on_circle(0.15f, a);
+            tile.add({p.x(), p.y(), z}, 2);
+        }
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].stem_radius, 0.15f, 0.02f);
+    SegmentOptions unchecked;
+    unchecked.min_quarter_arc_share = 0.0f;
+    EXPECT_EQ(segment_trees(tile.cloud, terrain, unchecked).trees.size(), 2u);
+}
