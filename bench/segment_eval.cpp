@@ -114,6 +114,8 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"stem_reach_exponent", &o.stem_reach_exponent},
                                                   {"stem_subcluster_distance", &o.stem_subcluster_distance},
                                                   {"stem_merge_distance", &o.stem_merge_distance},
+                                                  {"shared_top_stem_distance", &o.shared_top_stem_distance},
+                                                  {"shared_top_distance", &o.shared_top_distance},
                                                   {"seed_ratio", &o.seed_ratio},
                                                   {"crown_ratio", &o.crown_ratio},
                                                   {"max_crown_radius", &o.max_crown_radius},

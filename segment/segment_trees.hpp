@@ -79,6 +79,11 @@ struct SegmentOptions {
     // curtain of hanging twigs or under limbs that fill the slice (metres).
     float stem_subcluster_distance = 0.05f;
     float stem_merge_distance = 1.0f;    // stems closer than this are one tree's (multi-stemmed trees; metres)
+    // Stems closer than shared_top_stem_distance whose trees' highest voxels lie within
+    // shared_top_distance of each other split one crown between them: one tree
+    // (a trunk and an arc of its curtain of twigs; 0 = not joined; metres).
+    float shared_top_stem_distance = 2.0f;
+    float shared_top_distance = 1.0f;
     int min_stem_points = 15;            // smaller slice clusters are not stems
     float min_stem_radius = 0.025f;      // accepted circle radii (metres)
     float max_stem_radius = 0.8f;

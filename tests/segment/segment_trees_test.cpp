@@ -366,7 +366,8 @@ TEST(SegmentTrees, ATrunkInsideACurtainOfTwigsIsAStem) {
 }
 
 // Two trunks 0.6 m apart under one crown (a multi-stemmed tree) are one tree, as wide as the two
-// together; with no merging, two that share the crown between them.
+// together; with no merging (by their distance or by the top they share), two that share the
+// crown between them.
 TEST(SegmentTrees, TrunksWithinAMetreAreOneTree) {
     ToyTile tile = test::flat_ground(-3, 4, -3, 3);
     test::add_stem_and_ball(tile, 0, 0, 0.08f, 5, 2.0f, 0.15f, 1);
@@ -380,7 +381,50 @@ TEST(SegmentTrees, TrunksWithinAMetreAreOneTree) {
     EXPECT_EQ(score.f1, 1.0);
     SegmentOptions apart;
     apart.stem_merge_distance = 0.0f;
+    apart.shared_top_stem_distance = 0.0f;
     EXPECT_EQ(segment_trees(tile.cloud, terrain, apart).trees.size(), 2u);
+    apart.shared_top_stem_distance = SegmentOptions{}.shared_top_stem_distance;
+    EXPECT_EQ(segment_trees(tile.cloud, terrain, apart).trees.size(), 1u);  // the shared top joins them
+}
+
+// A willow's curtain of hanging twigs can hold a circle of its trunk's size farther from the
+// trunk than stem_merge_distance: here a bundle 1.4 m beside the trunk, hanging from the crown
+// to the ground. Trunk and bundle split the one crown between them, and both their regions reach
+// its top: one tree. Two trees as close whose tops lie 0.5 m apart across but 3.2 m apart in
+// height (a short tree under a tall one's leaning crown) stay two.
+TEST(SegmentTrees, TwoStemsWhoseTreesShareOneTopAreOneTree) {
+    ToyTile willow = test::flat_ground(-3, 5, -3, 3);
+    test::add_stem_and_ball(willow, 0, 0, 0.15f, 5, 0.0f, 0.15f, 1);
+    test::add_stem_and_ball(willow, 1.4f, 0, 0.15f, 5, 0.0f, 0.15f, 1);
+    for (float z = -2.0f; z <= 2.0f; z += 0.15f)  // the crown over both, top (0.7, 0, 8)
+        for (float y = -2.0f; y <= 2.0f; y += 0.15f)
+            for (float x = -2.0f; x <= 2.0f; x += 0.15f)
+                if (x * x + y * y + z * z <= 4.0f) willow.add({0.7f + x, y, 6.0f + z}, 1);
+    test::classify_flat_ground(willow);
+    const Terrain willow_terrain = analyse_terrain(willow.cloud, {});
+    const TreeSegmentation one = segment_trees(willow.cloud, willow_terrain, {});
+    ASSERT_EQ(one.trees.size(), 1u);
+    EXPECT_EQ(score_segmentation(willow.truth, one.tree_id, willow_terrain.height_above_ground, 2.0f).f1, 1.0);
+    SegmentOptions not_joined;
+    not_joined.shared_top_stem_distance = 0.0f;
+    EXPECT_EQ(segment_trees(willow.cloud, willow_terrain, not_joined).trees.size(), 2u);
+
+    ToyTile pair = test::flat_ground(-3, 5, -3, 3);
+    test::add_stem_and_ball(pair, 0, 0, 0.15f, 7.5f, 0.0f, 0.15f, 1);
+    test::add_stem_and_ball(pair, 1.5f, 0, 0.12f, 5.5f, 0.0f, 0.15f, 2);
+    const auto add_ball = [](ToyTile& tile, float cx, float cz, float radius, std::int32_t id) {
+        for (float z = -radius; z <= radius; z += 0.15f)
+            for (float y = -radius; y <= radius; y += 0.15f)
+                for (float x = -radius; x <= radius; x += 0.15f)
+                    if (x * x + y * y + z * z <= radius * radius) tile.add({cx + x, y, cz + z}, id);
+    };
+    add_ball(pair, 0.5f, 8.5f, 1.0f, 1);  // the tall tree's crown, leaning toward the short one: top (0.5, 0, 9.5)
+    add_ball(pair, 1.0f, 5.5f, 0.8f, 2);  // the short tree's: top (1.0, 0, 6.3)
+    test::classify_flat_ground(pair);
+    const Terrain pair_terrain = analyse_terrain(pair.cloud, {});
+    const TreeSegmentation two = segment_trees(pair.cloud, pair_terrain, {});
+    ASSERT_EQ(two.trees.size(), 2u);
+    EXPECT_EQ(score_segmentation(pair.truth, two.tree_id, pair_terrain.height_above_ground, 2.0f).f1, 1.0);
 }
 
 // A multi-stemmed tree (a crape myrtle's): three trunks of 5 cm rising from one root collar at
@@ -509,6 +553,12 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
         EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
         bad = {};
         bad.detached_min_height = length;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
+        bad = {};
+        bad.shared_top_stem_distance = length;
+        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
+        bad = {};
+        bad.shared_top_distance = length;
         EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
     }
     bad = {};
