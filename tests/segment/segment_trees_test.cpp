@@ -520,50 +520,32 @@ TEST(SegmentTrees, AllGroundAndEmptyTilesGiveNoTrees) {
 TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     const ToyTile tile = two_crowns_airborne();
     const Terrain terrain = analyse_terrain(tile.cloud, {});
-    SegmentOptions bad;
-    bad.chm_cell = 0;
-    EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
-    bad = {};
-    bad.stem_slice_high = bad.stem_slice_low;
-    EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
-    for (const float layer : {0.0f, 1e-9f, 100.0f, std::numeric_limits<float>::quiet_NaN()}) {
-        bad = {};
-        bad.stem_layer_height = layer;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
-        bad = {};
-        bad.trunk_layer_height = layer;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << layer;
+    const auto code_with = [&](const SegmentOptions& options) {
+        return test::error_code_of([&] { segment_trees(tile.cloud, terrain, options); });
+    };
+    // The usage error for one option set to `value`, the others at their defaults.
+    const auto rejects = [&](float SegmentOptions::*field, float value) {
+        SegmentOptions bad;
+        bad.*field = value;
+        return code_with(bad) == ExitCode::Usage;
+    };
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    EXPECT_TRUE(rejects(&SegmentOptions::chm_cell, 0.0f));
+    EXPECT_TRUE(rejects(&SegmentOptions::stem_slice_high, SegmentOptions{}.stem_slice_low));
+    for (const float layer : {0.0f, 1e-9f, 100.0f, nan}) {
+        EXPECT_TRUE(rejects(&SegmentOptions::stem_layer_height, layer)) << layer;
+        EXPECT_TRUE(rejects(&SegmentOptions::trunk_layer_height, layer)) << layer;
     }
-    for (const float distance : {-0.01f, 0.1f, std::numeric_limits<float>::quiet_NaN()}) {
-        bad = {};
-        bad.stem_subcluster_distance = distance;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << distance;
-        bad = {};
-        bad.stem_merge_distance = distance < 0.0f || std::isnan(distance) ? distance : std::numeric_limits<float>::infinity();
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << distance;
-    }
-    for (const float exponent : {-0.5f, 5.0f, std::numeric_limits<float>::quiet_NaN()}) {
-        bad = {};
-        bad.stem_reach_exponent = exponent;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << exponent;
-    }
-    for (const float length : {-1.0f, std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()}) {
-        bad = {};
-        bad.attach_gap = length;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
-        bad = {};
-        bad.detached_min_height = length;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
-        bad = {};
-        bad.shared_top_stem_distance = length;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
-        bad = {};
-        bad.shared_top_distance = length;
-        EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage) << length;
-    }
-    bad = {};
-    bad.min_detached_voxels = 0;
-    EXPECT_EQ(test::error_code_of([&] { segment_trees(tile.cloud, terrain, bad); }), ExitCode::Usage);
+    for (const float distance : {-0.01f, 0.1f, nan}) EXPECT_TRUE(rejects(&SegmentOptions::stem_subcluster_distance, distance)) << distance;
+    for (const float exponent : {-0.5f, 5.0f, nan}) EXPECT_TRUE(rejects(&SegmentOptions::stem_reach_exponent, exponent)) << exponent;
+    for (const float share : {-0.1f, 1.5f, nan}) EXPECT_TRUE(rejects(&SegmentOptions::min_quarter_arc_share, share)) << share;
+    for (const float length : {-1.0f, inf, nan})
+        for (const auto field : {&SegmentOptions::stem_merge_distance, &SegmentOptions::attach_gap, &SegmentOptions::detached_min_height,
+                                 &SegmentOptions::shared_top_stem_distance, &SegmentOptions::shared_top_distance})
+            EXPECT_TRUE(rejects(field, length)) << length;
+    SegmentOptions no_voxels;
+    no_voxels.min_detached_voxels = 0;
+    EXPECT_EQ(code_with(no_voxels), ExitCode::Usage);
     EXPECT_EQ(test::error_code_of([&] { segment_trees(PointCloud{}, terrain, {}); }), ExitCode::Internal);
 }
 
