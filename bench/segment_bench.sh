@@ -7,7 +7,8 @@
 #      40 x 40 m) and crowded ones (30 on 80 x 80 m, 12 on 30 x 30 m: the synth tile relaxes its
 #      spacing and broad crowns interpenetrate), with the input's ground class and with the ground
 #      filtered afresh (--ignore-classification); and the same stands with crown competition
-#      (`synth tile --competition`: crowns cut where a neighbour owns the canopy);
+#      (`synth tile --competition`: crowns cut where a neighbour owns the canopy); and two dense
+#      conifer stands (80 pines on 50 x 50 m, crowns touching) with both stand presets;
 #   2. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
 #   3. treels/pine_plot.las: stems found, with their positions and diameters (--stand conifer,
 #      and the heights the broadleaf default gives);
@@ -49,6 +50,14 @@ for s in 11 12 13 14; do tile "als_open_${s}_competing" "$s" --trees 25 --size 1
 for s in 1 2 3 4; do tile "als_crowded_${s}_competing" "$s" --trees 30 --size 80 --scanner als --competition; done
 for s in 21 22 23 24 25 26 27; do tile "tls_open_${s}_competing" "$s" --trees 10 --size 40 --scanner tls --station-spacing 20 --angular-step 0.25 --competition; done
 for s in 1 2 3 4 5 6; do tile "tls_crowded_${s}_competing" "$s" --trees 12 --size 30 --scanner tls --station-spacing 15 --angular-step 0.25 --competition; done
+# Dense conifer stands for the stand presets (`--stand`): 80 pines on 50 x 50 m whose narrow
+# crowns touch (spacing 0.5 x the summed crown radii), as in lidR's MixedConifer.
+for s in 1 2; do
+  [[ -f "$WORK/als_pine_dense_$s/tile.las" ]] && continue
+  echo "generating als_pine_dense_$s" >&2
+  "$BIN" --log-level error synth tile --out "$WORK/als_pine_dense_$s" --seed "$s" --slope 20 --roughness 1 --spacing 0.5 \
+    --trees 80 --size 50 --scanner als --species pine >/dev/null
+done
 
 # row LABEL ARGS...: one table row from one segment_eval run.
 row() {
@@ -83,6 +92,10 @@ for s in 11 12 13 14; do row "ALS open, seed $s, competing" "$WORK/als_open_${s}
 for s in 1 2 3 4; do row "ALS crowded, seed $s, competing" "$WORK/als_crowded_${s}_competing/tile.las" --reference treeID; done
 for s in 21 22 23 24 25 26 27; do row "TLS open, seed $s, competing" "$WORK/tls_open_${s}_competing/tile.las" --reference treeID; done
 for s in 1 2 3 4 5 6; do row "TLS crowded, seed $s, competing" "$WORK/tls_crowded_${s}_competing/tile.las" --reference treeID; done
+for s in 1 2; do
+  row "ALS dense pines, seed $s" "$WORK/als_pine_dense_$s/tile.las" --reference treeID
+  row "ALS dense pines, seed $s, conifer" "$WORK/als_pine_dense_$s/tile.las" --reference treeID --stand conifer
+done
 # Crown cover (summed true crown areas over the plot area): how far the crowns interpenetrate.
 echo "crown cover (sum of the true crown areas / plot area):"
 for d in "$WORK"/als_*/ "$WORK"/tls_*/; do
