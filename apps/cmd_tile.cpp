@@ -576,12 +576,15 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         std::cout << summary.dump(2) << "\n";
     } else {
         const std::string failure_note = failures.empty() ? "" : " (" + out.failures.string() + ")";
+        // The preset is named: no automatic choice tells dense conifers from broad crowns
+        // (docs/segment.md), and the wrong one loses most trees.
+        const std::string stand_note = o.use_input_segmentation ? "" : " (" + o.stand + " stand)";
         std::printf(
-                "%s: %zu points, %zu ground (%s); %s segmentation: %zu trees found, %zu modelled, %zu measured only (fewer than %zu "
+                "%s: %zu points, %zu ground (%s); %s segmentation%s: %zu trees found, %zu modelled, %zu measured only (fewer than %zu "
                 "points), %zu failed%s\n",
                 o.input.c_str(), cloud.size(), terrain.ground_points, terrain.ground_source.c_str(),
-                options["mode_used"].get<std::string>().c_str(), outcomes.size(), modelled, rows.size() - modelled, o.trees.min_points,
-                failures.size(), failure_note.c_str());
+                options["mode_used"].get<std::string>().c_str(), stand_note.c_str(), outcomes.size(), modelled, rows.size() - modelled,
+                o.trees.min_points, failures.size(), failure_note.c_str());
         std::printf("DBH: %s; %.1f s, peak memory %.0f MB\n", dbh_text.c_str(), seconds["total"].get<double>(), peak_memory_mb());
         std::printf("trees: %s and %s; picture: %s\n", out.csv.string().c_str(), out.geojson.string().c_str(), out.map.string().c_str());
     }

@@ -290,6 +290,24 @@ TEST(TileCli, ATreeTooSmallForAModelIsMeasuredNotModelled) {
     }
 }
 
+// The summary line names the stand preset the segmentation ran with (the choice decides most of
+// the trees on a dense conifer stand, and nothing chooses it automatically); a tile that takes
+// its input's segmentation ran none.
+TEST(TileCli, TheSummaryLineNamesTheStandPreset) {
+    TempDir dir;
+    const std::string measure_only = " --min-tree-points 100000000";
+    const auto broadleaf = run_cli(run_tile(dir / "broadleaf", measure_only));
+    ASSERT_EQ(broadleaf.exit_code, 0) << broadleaf.err;
+    EXPECT_NE(broadleaf.out.find("als segmentation (broadleaf stand): "), std::string::npos) << broadleaf.out;
+    const auto conifer = run_cli(run_tile(dir / "conifer", "--stand conifer" + measure_only));
+    ASSERT_EQ(conifer.exit_code, 0) << conifer.err;
+    EXPECT_NE(conifer.out.find("als segmentation (conifer stand): "), std::string::npos) << conifer.out;
+    const auto input = run_cli(run_tile(dir / "input", "--use-input-segmentation" + measure_only));
+    ASSERT_EQ(input.exit_code, 0) << input.err;
+    EXPECT_NE(input.out.find("input segmentation: "), std::string::npos) << input.out;
+    EXPECT_EQ(input.out.find(" stand)"), std::string::npos) << input.out;
+}
+
 TEST(TileCli, ATreeThatFailsIsListedAndTheOthersGoOn) {
     TempDir dir;
     PointCloud cloud = read_point_cloud(small_tile());
