@@ -58,8 +58,8 @@ void add_leaf(TriangleMesh& mesh, const Eigen::Vector3f& base, const Eigen::Vect
 }
 
 // Sizes every leaf blade (the four vertices of add_leaf) about its base so that the blades'
-// area is `target`: the tree's stored leaf area (a rebuilt model's original) instead of the area
-// that the species' patches and the triangle budget happen to give.
+// area is `target`. After plan_leaf_area the factor is close to 1: it only takes up the rounding
+// of the leaf counts.
 void scale_leaves_to_area(TriangleMesh& leaves, double target, LeafShape shape) {
     const double area = leaves.area();
     if (!(area > 0)) return;
@@ -93,8 +93,99 @@ std::vector<double> lobe_leaf_weights(const LobeTree& tree, const TexturedTree& 
     return weight;
 }
 
+// Leaves of a placed patch drawn at full detail: the budget thinning's share of them (rounded
+// up, as the triangle budget counted them), or with lobe weights that share times the lobe's
+// weight (rounded down, so the tree never draws more than the budget counted).
+std::size_t offered_leaves(const Patch& patch, double leaf_share, const std::vector<double>& leaf_weight, std::size_t lobe) {
+    if (leaf_weight.empty()) return kept_leaves(leaf_share, patch.leaves.size());
+    return std::min(patch.leaves.size(),
+                    static_cast<std::size_t>(std::floor(leaf_share * leaf_weight[lobe] * static_cast<double>(patch.leaves.size()))));
+}
+
+float blade_area(const PatchLeaf& leaf, LeafShape shape) {
+    return shape == LeafShape::Needle ? leaf.length * leaf.width : 0.5f * leaf.length * leaf.width;
+}
+
+// A leaf of a rebuilt tree is drawn only where the scan saw its lobe: its tip in an occupied cell
+// (every leaf of a lobe without occupancy).
+bool leaf_seen(const Lobe& lobe, const PatchInstance& inst, const PatchLeaf& leaf) {
+    return lobe.occupancy.empty() || lobe.occupancy.occupied(inst.apply(leaf.base) + inst.rotation * leaf.direction * leaf.length);
+}
+
+// How a tree that stores its leaf area draws its leaves: the share of the offered leaves that
+// are seen (leaf_seen) which it draws, and the factor on their size. The texturing fitted the
+// patches with their leaves at the species' size, their tips reaching a lobe's outer cells, but
+// the offered leaves hold several times the stored area (the palm's 111 times). Shrinking every
+// blade to that area pulled the crown's rim in (the palm's 0.6 m leaflets were drawn 0.16 m
+// long, docs/rebuild.md), so the leaves keep their size and are thinned instead; only when the
+// seen leaves hold less than the area are they enlarged.
+struct LeafPlan {
+    double drawn_share = 1;
+    float size = 1;
+};
+
+LeafPlan plan_leaf_area(const LobeTree& tree, const TexturedTree& textured, const std::vector<double>& leaf_weight) {
+    double seen_area = 0;
+    for (std::size_t l = 0; l < textured.lobes.size(); ++l)
+        for (const auto& inst : textured.lobes[l].instances) {
+            const Patch& patch = textured.library.patches[inst.patch];
+            const std::size_t offered = offered_leaves(patch, textured.leaf_share, leaf_weight, l);
+            for (std::size_t i = 0; i < offered; ++i)
+                if (leaf_seen(tree.lobes[l], inst, patch.leaves[i]))
+                    seen_area += static_cast<double>(blade_area(patch.leaves[i], textured.library.leaf_shape));
+        }
+    if (!(seen_area > 0)) return {};
+    const double ratio = tree.leaf_area_m2 / seen_area;
+    return {std::min(1.0, ratio), static_cast<float>(std::sqrt(std::max(1.0, ratio)))};
+}
+
 std::size_t prefix(double fraction, std::size_t n) {
     return std::min(n, static_cast<std::size_t>(std::ceil(fraction * static_cast<double>(n))));
+}
+
+void draw_leaf(const TexturedTree& textured, const PatchInstance& inst, const PatchLeaf& leaf, float enlarge, SynthesizedMesh& out) {
+    add_leaf(out.leaves, inst.apply(leaf.base), inst.rotation * leaf.direction, inst.rotation * leaf.normal, leaf.length * enlarge,
+             leaf.width * enlarge, textured.library.leaf_shape);
+    ++out.leaf_count;
+}
+
+// Stochastic pruning: of each patch a prefix of its shuffled leaves, enlarged to keep the leaf
+// area of the level of detail.
+void draw_pruned_leaves(const TexturedTree& textured, const std::vector<double>& leaf_weight, double fraction, SynthesizedMesh& out) {
+    for (std::size_t l = 0; l < textured.lobes.size(); ++l)
+        for (const auto& inst : textured.lobes[l].instances) {
+            const Patch& patch = textured.library.patches[inst.patch];
+            const std::size_t pruned = kept_leaves(fraction * textured.leaf_share, patch.leaves.size());
+            const float enlarge = pruned > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(pruned)) : 1.0f;
+            // Weighted counts are rounded down: the tree's leaves then never exceed the unweighted
+            // (rounded up) count that the triangle budget was spent on.
+            const std::size_t kept =
+                    leaf_weight.empty() ? pruned
+                                        : std::min(patch.leaves.size(),
+                                                   static_cast<std::size_t>(std::floor(fraction * textured.leaf_share * leaf_weight[l] *
+                                                                                       static_cast<double>(patch.leaves.size()))));
+            for (std::size_t i = 0; i < kept; ++i) draw_leaf(textured, inst, patch.leaves[i], enlarge, out);
+        }
+}
+
+// A tree that stores its leaf area: the plan's share of each patch's seen leaves, of them the
+// level of detail's fraction (a prefix of the shuffled leaves, enlarged by 1 / sqrt(fraction) to
+// keep the area). Counts are rounded down with the remainder carried to the next patch, so the
+// tree draws its share whatever the patches' sizes.
+void draw_planned_leaves(const LobeTree& tree, const TexturedTree& textured, const std::vector<double>& leaf_weight, double fraction,
+                         SynthesizedMesh& out) {
+    const LeafPlan plan = plan_leaf_area(tree, textured, leaf_weight);
+    const float enlarge = plan.size / std::sqrt(static_cast<float>(fraction));
+    double carried = 0;
+    for (std::size_t l = 0; l < textured.lobes.size(); ++l)
+        for (const auto& inst : textured.lobes[l].instances) {
+            const Patch& patch = textured.library.patches[inst.patch];
+            carried += fraction * plan.drawn_share * static_cast<double>(offered_leaves(patch, textured.leaf_share, leaf_weight, l));
+            const auto kept = std::min(patch.leaves.size(), static_cast<std::size_t>(std::floor(carried)));
+            carried -= static_cast<double>(kept);
+            for (std::size_t i = 0; i < kept; ++i)
+                if (leaf_seen(tree.lobes[l], inst, patch.leaves[i])) draw_leaf(textured, inst, patch.leaves[i], enlarge, out);
+        }
 }
 
 }  // namespace
@@ -230,34 +321,24 @@ SynthesizedMesh synthesized_mesh(const LobeTree& tree, const TexturedTree& textu
         min_thickness = thickness[kept - 1];
     }
     const std::vector<double> leaf_weight = lobe_leaf_weights(tree, textured);
+    const bool stored_area = tree.leaf_area_m2 > 0;
     for (std::size_t l = 0; l < textured.lobes.size(); ++l)
-        for (const auto& inst : textured.lobes[l].instances) {
-            const Patch& patch = textured.library.patches[inst.patch];
-            for (const auto& s : patch.segments) {
+        for (const auto& inst : textured.lobes[l].instances)
+            for (const auto& s : textured.library.patches[inst.patch].segments) {
                 if (s.thickness_a * inst.scale < min_thickness) continue;
+                // As its leaves (leaf_seen), a rebuilt tree's twigs stay where the scan saw its lobe.
+                const Occupancy& seen = tree.lobes[l].occupancy;
+                if (stored_area && !seen.empty() && !seen.occupied(inst.apply(0.5f * (s.a + s.b)))) continue;
                 add_prism(out.wood, inst.apply(s.a), inst.apply(s.b), std::max(0.5f * s.thickness_a * inst.scale, kMinTwigRadius),
                           std::max(0.5f * s.thickness_b * inst.scale, kMinTwigRadius), o.twig_sides);
                 ++out.twig_segments;
             }
-            // Stochastic pruning: a prefix of the shuffled leaves, enlarged to keep the leaf area
-            // of the level of detail.
-            const std::size_t pruned = kept_leaves(fraction * textured.leaf_share, patch.leaves.size());
-            const float enlarge = pruned > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(pruned)) : 1.0f;
-            // Weighted counts are rounded down: the tree's leaves then never exceed the unweighted
-            // (rounded up) count that the triangle budget was spent on.
-            const std::size_t kept =
-                    leaf_weight.empty() ? pruned
-                                        : std::min(patch.leaves.size(),
-                                                   static_cast<std::size_t>(std::floor(fraction * textured.leaf_share * leaf_weight[l] *
-                                                                                       static_cast<double>(patch.leaves.size()))));
-            for (std::size_t i = 0; i < kept; ++i) {
-                const PatchLeaf& leaf = patch.leaves[i];
-                add_leaf(out.leaves, inst.apply(leaf.base), inst.rotation * leaf.direction, inst.rotation * leaf.normal,
-                         leaf.length * enlarge, leaf.width * enlarge, textured.library.leaf_shape);
-                ++out.leaf_count;
-            }
-        }
-    if (tree.leaf_area_m2 > 0) scale_leaves_to_area(out.leaves, tree.leaf_area_m2, textured.library.leaf_shape);
+    if (stored_area) {
+        draw_planned_leaves(tree, textured, leaf_weight, fraction, out);
+        scale_leaves_to_area(out.leaves, tree.leaf_area_m2, textured.library.leaf_shape);
+    } else {
+        draw_pruned_leaves(textured, leaf_weight, fraction, out);
+    }
     return out;
 }
 

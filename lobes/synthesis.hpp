@@ -20,8 +20,11 @@
 // and a reduced mesh keeps the first fraction f of each list.
 //
 // A tree that stores its leaf area (LobeTree::leaf_area_m2 > 0: a `treelobes rebuild` of a mesh
-// with leaves) gets its leaf blades sized about their bases to give exactly that area, at every
-// level of detail; otherwise the blades keep the sizes of the species' patches.
+// with leaves) draws leaves and twigs only where its lobes' occupancy saw the crown (a leaf's
+// tip, a twig's middle in an occupied cell), and gives exactly that area at every level of
+// detail: its leaves keep the species' size and are thinned when the patches offer more, and
+// are enlarged about their bases only when they offer less. Otherwise the blades keep the
+// sizes of the species' patches.
 #pragma once
 
 #include "config/species_profile.hpp"

@@ -240,27 +240,89 @@ TEST(Synthesis, LodKeepsThickestEdgesAndLeafArea) {
     EXPECT_EQ(error_code_of([&] { synthesized_mesh(tree, textured, 1.5, o); }), ExitCode::Usage);
 }
 
-// A stored leaf area (a rebuilt model's original) sizes the blades to give it exactly, at every
-// level of detail, about the blades' bases; the twigs and the blades' number and places stay.
-TEST(Synthesis, StoredLeafAreaSizesTheBlades) {
+namespace {
+
+// Lengths of a broad-leaved mesh's blades (add_leaf: base, side, tip, side).
+std::vector<float> blade_lengths(const TriangleMesh& leaves) {
+    std::vector<float> lengths;
+    for (std::size_t i = 0; i + 3 < leaves.vertices.size(); i += 4) lengths.push_back((leaves.vertices[i + 2] - leaves.vertices[i]).norm());
+    return lengths;
+}
+
+}  // namespace
+
+// A stored leaf area (a rebuilt model's original) is given exactly, at every level of detail.
+// Below the area of the leaves the patches offer at the species' size, the blades keep that size
+// and fewer are drawn: shrunk instead, a palm's 0.6 m leaflets were drawn 0.16 m long and its
+// crown's rim thinned out (docs/rebuild.md). Above it, every offered blade is drawn, enlarged
+// about its base. The twigs stay as they are.
+TEST(Synthesis, StoredLeafAreaThinsOrEnlargesTheBlades) {
     LobeTree tree = boxed_tree();
     SynthesisOptions o;
     o.texturing.fill_cell = 0.2;
     const TexturedTree textured = texture_tree(tree, species("lagerstroemia"), o);
+    ASSERT_EQ(textured.library.leaf_shape, LeafShape::Broad);
+    TexturedTree whole = textured;  // every leaf of the placed patches at the species' size
+    whole.leaf_share = 1;
+    const SynthesizedMesh offered = synthesized_mesh(tree, whole, 1.0, o);
     const SynthesizedMesh natural = synthesized_mesh(tree, textured, 1.0, o);
-    ASSERT_GT(natural.leaves.area(), 0);
-    for (const double factor : {0.25, 3.0}) {
-        tree.leaf_area_m2 = factor * natural.leaves.area();
+    ASSERT_GT(offered.leaves.area(), 0);
+    const auto [shortest, longest] = std::ranges::minmax(blade_lengths(offered.leaves));
+    for (const double factor : {0.05, 0.2}) {
+        tree.leaf_area_m2 = factor * textured.leaf_share * offered.leaves.area();
         for (const double lod : {1.0, 0.5}) {
             const SynthesizedMesh sized = synthesized_mesh(tree, textured, lod, o);
             EXPECT_NEAR(sized.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2) << factor << " at LOD " << lod;
             EXPECT_EQ(sized.wood.faces.size(), synthesized_mesh(boxed_tree(), textured, lod, o).wood.faces.size());
         }
         const SynthesizedMesh sized = synthesized_mesh(tree, textured, 1.0, o);
-        ASSERT_EQ(sized.leaves.vertices.size(), natural.leaves.vertices.size());
-        for (std::size_t i = 0; i < sized.leaves.vertices.size(); i += 4)  // broad leaves: the base is a blade's first vertex
-            EXPECT_EQ(sized.leaves.vertices[i], natural.leaves.vertices[i]);
+        EXPECT_NEAR(static_cast<double>(sized.leaf_count), factor * static_cast<double>(natural.leaf_count), 0.1 * factor * natural.leaf_count);
+        for (const float length : blade_lengths(sized.leaves)) {  // the species' blades, within the last count's rounding
+            EXPECT_GE(length, 0.98f * shortest) << factor;
+            EXPECT_LE(length, 1.02f * longest) << factor;
+        }
     }
+    tree.leaf_area_m2 = 3.0 * natural.leaves.area();
+    const SynthesizedMesh enlarged = synthesized_mesh(tree, textured, 1.0, o);
+    EXPECT_NEAR(enlarged.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2);
+    ASSERT_EQ(enlarged.leaves.vertices.size(), natural.leaves.vertices.size());
+    for (std::size_t i = 0; i < enlarged.leaves.vertices.size(); i += 4)  // broad leaves: the base is a blade's first vertex
+        EXPECT_EQ(enlarged.leaves.vertices[i], natural.leaves.vertices[i]);
+}
+
+// A rebuilt tree (one that stores its leaf area) draws leaves and twigs only where its lobe's
+// occupancy saw the crown: every leaf tip and every twig's middle in an occupied cell. The same
+// lobe synthesized from a scan (no stored area) draws its patches whole.
+TEST(Synthesis, ARebuiltTreeDrawsLeavesAndTwigsOnlyInItsOccupiedCells) {
+    LobeTree tree = boxed_tree();
+    std::vector<Eigen::Vector3f> pts;
+    for (float x = 0.2f; x < 1.0f; x += 0.05f)
+        for (float y = -1.0f; y < 1.0f; y += 0.05f)
+            for (float z = 2.0f; z < 3.4f; z += 0.05f) pts.emplace_back(x, y, z);
+    tree.lobes[0].occupancy = occupancy_of(pts, 0.2f);
+    const Occupancy& seen = tree.lobes[0].occupancy;
+    SynthesisOptions o;
+    o.texturing.fill_cell = 0.1;
+    const TexturedTree textured = texture_tree(tree, species("lagerstroemia"), o);
+    const auto tips_seen = [&](const SynthesizedMesh& mesh) {
+        std::size_t in = 0;
+        for (std::size_t i = 2; i < mesh.leaves.vertices.size(); i += 4) in += seen.occupied(mesh.leaves.vertices[i]) ? 1 : 0;
+        return std::pair{in, mesh.leaf_count};
+    };
+    std::size_t twigs_seen = 0;
+    for (const auto& inst : textured.lobes[0].instances)
+        for (const auto& s : textured.library.patches[inst.patch].segments) twigs_seen += seen.occupied(inst.apply(0.5f * (s.a + s.b))) ? 1 : 0;
+    const SynthesizedMesh scanned = synthesized_mesh(tree, textured, 1.0, o);
+    const auto [scanned_in, scanned_all] = tips_seen(scanned);
+    EXPECT_LT(scanned_in, scanned_all * 9 / 10);  // the patches reach out of the occupied cells
+    EXPECT_GT(scanned.twig_segments, twigs_seen);
+    tree.leaf_area_m2 = 0.2 * scanned.leaves.area();
+    const SynthesizedMesh rebuilt = synthesized_mesh(tree, textured, 1.0, o);
+    const auto [rebuilt_in, rebuilt_all] = tips_seen(rebuilt);
+    ASSERT_GT(rebuilt_all, 0u);
+    EXPECT_EQ(rebuilt_in, rebuilt_all);
+    EXPECT_EQ(rebuilt.twig_segments, twigs_seen);
+    EXPECT_NEAR(rebuilt.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2);
 }
 
 TEST(Synthesis, LeafyPatchesAreThinnedToTheTriangleBudget) {
