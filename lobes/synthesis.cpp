@@ -93,9 +93,10 @@ std::vector<double> lobe_leaf_weights(const LobeTree& tree, const TexturedTree& 
     return weight;
 }
 
-// Leaves of a placed patch drawn at full detail: the budget thinning's share of them (rounded
-// up, as the triangle budget counted them), or with lobe weights that share times the lobe's
-// weight (rounded down, so the tree never draws more than the budget counted).
+// Leaves of a placed patch at a share of them (the budget thinning's, times the level of
+// detail's fraction): rounded up, as the triangle budget counted them, or with lobe weights that
+// share times the lobe's weight, rounded down, so the tree never draws more than the budget
+// counted.
 std::size_t offered_leaves(const Patch& patch, double leaf_share, const std::vector<double>& leaf_weight, std::size_t lobe) {
     if (leaf_weight.empty()) return kept_leaves(leaf_share, patch.leaves.size());
     return std::min(patch.leaves.size(),
@@ -116,7 +117,7 @@ bool leaf_seen(const Lobe& lobe, const PatchInstance& inst, const PatchLeaf& lea
 // are seen (leaf_seen) which it draws, and the factor on their size. The texturing fitted the
 // patches with their leaves at the species' size, their tips reaching a lobe's outer cells, but
 // the offered leaves hold several times the stored area (the palm's 111 times). Shrinking every
-// blade to that area pulled the crown's rim in (the palm's 0.6 m leaflets were drawn 0.16 m
+// blade to that area pulled the crown's rim in (the palm's 0.6 m leaflets were drawn 0.16-0.18 m
 // long, docs/rebuild.md), so the leaves keep their size and are thinned instead; only when the
 // seen leaves hold less than the area are they enlarged.
 struct LeafPlan {
@@ -157,13 +158,7 @@ void draw_pruned_leaves(const TexturedTree& textured, const std::vector<double>&
             const Patch& patch = textured.library.patches[inst.patch];
             const std::size_t pruned = kept_leaves(fraction * textured.leaf_share, patch.leaves.size());
             const float enlarge = pruned > 0 ? std::sqrt(static_cast<float>(patch.leaves.size()) / static_cast<float>(pruned)) : 1.0f;
-            // Weighted counts are rounded down: the tree's leaves then never exceed the unweighted
-            // (rounded up) count that the triangle budget was spent on.
-            const std::size_t kept =
-                    leaf_weight.empty() ? pruned
-                                        : std::min(patch.leaves.size(),
-                                                   static_cast<std::size_t>(std::floor(fraction * textured.leaf_share * leaf_weight[l] *
-                                                                                       static_cast<double>(patch.leaves.size()))));
+            const std::size_t kept = offered_leaves(patch, fraction * textured.leaf_share, leaf_weight, l);
             for (std::size_t i = 0; i < kept; ++i) draw_leaf(textured, inst, patch.leaves[i], enlarge, out);
         }
 }

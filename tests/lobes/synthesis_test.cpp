@@ -253,7 +253,7 @@ std::vector<float> blade_lengths(const TriangleMesh& leaves) {
 
 // A stored leaf area (a rebuilt model's original) is given exactly, at every level of detail.
 // Below the area of the leaves the patches offer at the species' size, the blades keep that size
-// and fewer are drawn: shrunk instead, a palm's 0.6 m leaflets were drawn 0.16 m long and its
+// and fewer are drawn: shrunk instead, a palm's 0.6 m leaflets were drawn 0.16-0.18 m long and its
 // crown's rim thinned out (docs/rebuild.md). Above it, every offered blade is drawn, enlarged
 // about its base. The twigs stay as they are.
 TEST(Synthesis, StoredLeafAreaThinsOrEnlargesTheBlades) {
