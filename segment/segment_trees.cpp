@@ -535,9 +535,12 @@ bool circle_holds(const CircleFit& circle, std::size_t points, const SegmentOpti
 // A trunk that tapers within the slice (a root flare: the synthetic oaks, figs and mahoganies of
 // 1.0-1.5 m narrow by a third between 1 and 2 m above the ground) holds no single circle over the
 // slice's height, but each thin horizontal layer of it does. The stem is then the median of the
-// layers' circles when at least half of the layers (two at least) hold one and every layer's
-// centre lies within half that radius of the median centre: one trunk, layer above layer, not
-// a limb and a twig curtain that happen to fit circles at different places. Whether it stands
+// layers' circles when at least half of the layers (two at least) hold one, every layer's
+// centre lies within half that radius of the median centre and every layer's radius within a
+// factor 2 of it: one trunk, layer above layer, not a limb and a twig curtain that happen to
+// fit circles at different places, nor a clump of twigs that fits a 7 cm circle in one layer and
+// a 26 cm one above it (a fig's low crown, 8.9 m from its trunk, passed for a stem on an open
+// plot that way: docs/segment.md). Whether it stands
 // upright is judged by the circles' centres: the layers of a thick trunk see different arcs
 // (occlusion changes with height), so their points' centroids wander by up to a radius.
 std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vector<int>& cluster, float low, float high,
@@ -575,6 +578,7 @@ std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vecto
     stem.radius = median([](const CircleFit& c) { return c.radius; });
     for (const CircleFit& c : circles) {
         if ((c.centre - stem.centre).norm() > 0.5f * stem.radius) return std::nullopt;  // one trunk, layer above layer
+        if (c.radius > 2.0f * stem.radius || 2.0f * c.radius < stem.radius) return std::nullopt;  // ... of one girth
         stem.inliers += c.inliers;
     }
     if (!upright(centres, options.max_stem_lean)) return std::nullopt;

@@ -616,3 +616,39 @@ TEST(SegmentTrees, ALimbWhoseArcFillsOnlyTheFootOfTheSliceIsNoStem) {
     unchecked.min_quarter_arc_share = 0.0f;
     EXPECT_EQ(segment_trees(tile.cloud, terrain, unchecked).trees.size(), 2u);
 }
+
+// A clump of twigs under a broad crown, far from its trunk: a column of twigs 7 cm around
+// reaches the ground, a twig arc 26 cm around the same axis lies in the next layer of the slice,
+// and one twig rises through the rest of the slice to the crown. Two of the slice's four layers
+// hold circles centred within half a radius of each other, but of radii 3.7 times apart: no
+// trunk. A trunk 3 m away is the one tree.
+TEST(SegmentTrees, LayersWhoseCirclesDifferInGirthAreNoStem) {
+    ToyTile tile = test::flat_ground(-3, 5, -3, 3);
+    const auto on_circle = [](float radius, float degrees) {
+        const float t = degrees * std::numbers::pi_v<float> / 180.0f;
+        return Eigen::Vector2f(radius * std::cos(t), radius * std::sin(t));
+    };
+    for (float z = 0.35f; z < 1.25f; z += 0.02f)  // the column, from near the ground into the slice's first layer
+        for (float a = 0.0f; a < 360.0f; a += 30.0f) {
+            const Eigen::Vector2f p = on_circle(0.07f, a);
+            tile.add({p.x(), p.y(), z}, 1);
+        }
+    for (float z = 1.26f; z < 1.5f; z += 0.02f)  // the arc, in the second layer
+        for (float a = 0.0f; a <= 120.0f; a += 4.0f) {
+            const Eigen::Vector2f p = on_circle(0.26f, a);
+            tile.add({p.x(), p.y(), z}, 1);
+        }
+    for (float r = 0.07f; r <= 0.26f; r += 0.02f) tile.add({r, 0.0f, 1.25f}, 1);  // a twig joining them
+    for (float z = 1.5f; z <= 6.0f; z += 0.03f) tile.add({0.26f, 0.0f, z}, 1);     // the twig up to the crown
+    for (float z = 0.0f; z <= 6.0f; z += 0.02f)                                     // the trunk 3 m away
+        for (float a = 0.0f; a < 360.0f; a += 10.0f) {
+            const Eigen::Vector2f p = Eigen::Vector2f(3.0f, 0.0f) + on_circle(0.15f, a);
+            tile.add({p.x(), p.y(), z}, 2);
+        }
+    test::classify_flat_ground(tile);
+
+    const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].base.x(), 3.0f, 0.05f);
+    EXPECT_NEAR(result.trees[0].stem_radius, 0.15f, 0.02f);
+}
