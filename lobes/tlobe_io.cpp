@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <span>
 
 namespace treelobes::lobes {
 
@@ -95,6 +96,7 @@ void check_options(const TlobeOptions& o) {
     for (double fraction : o.lobe_face_fractions)
         if (!(fraction > 0 && fraction < 1)) throw Error::usage("tlobe: lobe face fractions must be in (0, 1)");
     if (o.min_lobe_faces < 4) throw Error::usage("tlobe: lobes keep at least 4 faces");
+    if (!(o.coarsest_cell_before_simplifying > 0)) throw Error::usage("tlobe: the coarsest cell before simplifying must be positive");
 }
 
 // The payload with lobe i's occupancy taken from `occupancy[i]`.
@@ -146,13 +148,13 @@ std::string pack(const std::string& raw, int level) {
     return file;
 }
 
-// The file on the finest occupancy grid at which it fits max_bytes; none when no grid fits (a
-// grid that some lobe's extent makes too large is skipped).
-std::optional<std::string> finest_fitting_file(const LobeTree& tree, const TlobeOptions& o) {
+// The file of `tree` (its surfaces as they are) on the finest grid of `cells` at which it fits
+// max_bytes; none when no grid fits (a grid that some lobe's extent makes too large is skipped).
+std::optional<std::string> finest_fitting_file(const LobeTree& tree, const TlobeOptions& o, std::span<const double> cells) {
     const double quantum = static_cast<float>(o.quantum);
     std::vector<Occupancy> grids(tree.lobes.size());
     std::vector<const Occupancy*> use(tree.lobes.size());
-    for (double size : o.occupancy_cells) {
+    for (double size : cells) {
         const auto cell = static_cast<float>(static_cast<double>(std::max<long long>(1, std::llround(size / quantum))) * quantum);
         bool fits = true;
         for (const Lobe& lobe : tree.lobes) fits = fits && occupancy_cell_count(lobe.cluster_points, cell) <= kMaxOccupancyCells;
@@ -193,16 +195,22 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
         from_points = from_points || !tree.lobes[i].cluster_points.empty();
     }
     if (!from_points) return pack(encode_payload(tree, o, stored), o.compression_level);
-    if (auto file = finest_fitting_file(tree, o)) return *file;
-    // No grid fits: the lobe surfaces give up detail, halving their faces until one does.
-    LobeTree coarse;
-    for (double fraction : o.lobe_face_fractions) {
-        coarse = with_coarser_lobes(tree, fraction, o.min_lobe_faces);
-        if (auto file = finest_fitting_file(coarse, o)) return *file;
+    // The occupancy draws the crown's outline and the lobe surfaces only bound it, so the
+    // surfaces give up detail (halving their faces) before the grid grows coarser than
+    // coarsest_cell_before_simplifying; the coarser grids are then tried the same way.
+    std::vector<double> fine_cells, coarse_cells;
+    for (double size : o.occupancy_cells) (size <= o.coarsest_cell_before_simplifying ? fine_cells : coarse_cells).push_back(size);
+    std::vector<LobeTree> simplified;  // the tree at each of lobe_face_fractions, made when first needed
+    for (const std::vector<double>& cells : {fine_cells, coarse_cells}) {
+        if (auto file = finest_fitting_file(tree, o, cells)) return *file;
+        for (std::size_t k = 0; k < o.lobe_face_fractions.size(); ++k) {
+            if (simplified.size() == k) simplified.push_back(with_coarser_lobes(tree, o.lobe_face_fractions[k], o.min_lobe_faces));
+            if (auto file = finest_fitting_file(simplified[k], o, cells)) return *file;
+        }
     }
     const Occupancy none;
     std::vector<const Occupancy*> use(tree.lobes.size(), &none);
-    return pack(encode_payload(o.lobe_face_fractions.empty() ? tree : coarse, o, use), o.compression_level);
+    return pack(encode_payload(simplified.empty() ? tree : simplified.back(), o, use), o.compression_level);
 }
 
 LobeTree decode_tlobe(std::string_view file, const std::string& name) {

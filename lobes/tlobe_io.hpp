@@ -33,12 +33,18 @@ struct TlobeOptions {
     // keeps min_lobe_faces at least) and every grid is tried again, largest fraction first.
     std::vector<double> lobe_face_fractions{0.5, 0.25, 0.125, 0.0625};
     std::size_t min_lobe_faces = 12;
+    // Metres: grids up to this cell are tried with every simplification of the surfaces before a
+    // coarser grid, since the occupancy draws the crown's outline and the surfaces only bound it
+    // (a palm at 2.9 kB: 0.35 m cells and 306 faces draw it closer than 0.8 m and 562 faces;
+    // docs/rebuild.md).
+    double coarsest_cell_before_simplifying = 0.5;
 };
 
 // Bytes of the file. Lobes with cluster_points get their occupancy on the finest grid of
-// occupancy_cells (rounded to the quantum) at which the file fits max_bytes; if none fits, their
-// surfaces are simplified (lobe_face_fractions) until one does, and if none does even then, the
-// most simplified surfaces are stored without occupancy. Lobes without cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
+// occupancy_cells (rounded to the quantum) at which the file fits max_bytes: the grids up to
+// coarsest_cell_before_simplifying first, their surfaces simplified (lobe_face_fractions) until
+// one fits, then the coarser grids the same way; if none fits even then, the most simplified
+// surfaces are stored without occupancy. Lobes without cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
 std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {});
 // Parses a file's bytes; any inconsistency throws Error(InvalidInput) naming `name`.
 // Decoded lobes have origin 0 (the tree's frame), the skeleton the stored origin.

@@ -443,11 +443,8 @@ TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
     EXPECT_EQ(error_code_of([&] { decode_tlobe(flipped, "x"); }), ExitCode::InvalidInput);
 }
 
-// When no occupancy grid fits the budget, the lobe surfaces are simplified (halving their faces)
-// until one does: the file keeps the budget, its lobes stay closed with fewer faces, and they
-// keep an occupancy. Without fractions to try, the file stays over the budget with full surfaces
-// and no occupancy.
-TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
+// The sample tree with finely meshed 0.6 m balls for lobes, each holding a cluster of points.
+LobeTree tree_with_ball_lobes() {
     LobeTree t = sample_tree();
     for (Lobe& lobe : t.lobes) {
         const Eigen::Vector3f centre = t.seed_position(lobe) + Eigen::Vector3f(0, 0, 0.5f);
@@ -455,6 +452,15 @@ TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
         for (auto& v : lobe.mesh.vertices) v += centre;
         lobe.cluster_points = corner_points(centre);
     }
+    return t;
+}
+
+// When no occupancy grid fits the budget, the lobe surfaces are simplified (halving their faces)
+// until one does: the file keeps the budget, its lobes stay closed with fewer faces, and they
+// keep an occupancy. Without fractions to try, the file stays over the budget with full surfaces
+// and no occupancy.
+TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
+    const LobeTree t = tree_with_ball_lobes();
     const std::size_t full_faces = t.lobes[0].mesh.faces.size();
     const double full_volume = t.lobes[0].mesh.signed_volume();
     TlobeOptions unsimplified;
@@ -485,6 +491,31 @@ TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
     TlobeOptions too_few;
     too_few.min_lobe_faces = 3;
     EXPECT_EQ(error_code_of([&] { encode_tlobe(t, too_few); }), ExitCode::Usage);
+}
+
+// A budget that the full surfaces meet only with a 0.6 m grid: the surfaces are simplified
+// instead, to keep a 5 cm grid (the grids up to coarsest_cell_before_simplifying come first);
+// with that bound below every grid, the coarse grid keeps the full surfaces.
+TEST(Tlobe, SurfacesAreSimplifiedBeforeTheGridGrowsCoarse) {
+    const LobeTree t = tree_with_ball_lobes();
+    const std::size_t full_faces = t.lobes[0].mesh.faces.size();
+    TlobeOptions full_and_coarse;
+    full_and_coarse.occupancy_cells = {0.6};
+    const std::string coarse_file = encode_tlobe(t, full_and_coarse);
+    ASSERT_EQ(decode_tlobe(coarse_file, "coarse.tlobe").lobes[0].mesh.faces.size(), full_faces);
+
+    TlobeOptions o;
+    o.occupancy_cells = {0.05, 0.6};
+    o.max_bytes = coarse_file.size();
+    const LobeTree fine = decode_tlobe(encode_tlobe(t, o), "fine.tlobe");
+    for (const Lobe& lobe : fine.lobes) {
+        EXPECT_NEAR(lobe.occupancy.cell, 0.05f, 1e-6f);
+        EXPECT_LT(lobe.mesh.faces.size(), full_faces);
+    }
+    o.coarsest_cell_before_simplifying = 0.01;
+    EXPECT_EQ(encode_tlobe(t, o), coarse_file);
+    o.coarsest_cell_before_simplifying = 0;
+    EXPECT_EQ(error_code_of([&] { encode_tlobe(t, o); }), ExitCode::Usage);
 }
 
 TEST(Tlobe, FileRoundTripAndBadOptions) {
