@@ -80,10 +80,19 @@ TEST(RebuildCli, WritesEveryOutputAndASaneReport) {
     // ... and every lobe's leaf share, from the samples' labels of the mesh's materials.
     const lobes::LobeTree stored = lobes::read_tlobe(out / "palm_3_mesh.tlobe");
     ASSERT_FALSE(stored.lobes.empty());
+    std::size_t stored_faces = 0;
     for (const lobes::Lobe& lobe : stored.lobes) {
         EXPECT_GE(lobe.leaf_share, 0.0f);
         EXPECT_LE(lobe.leaf_share, 1.0f);
+        stored_faces += lobe.mesh.faces.size();
     }
+    // The report says what the budget left of the lobes: their faces and occupancy cell.
+    EXPECT_EQ(sizes["tlobe_lobe_faces"].get<std::size_t>(), stored_faces);
+    EXPECT_LE(stored_faces, report["lobes"]["faces"].get<std::size_t>());
+    if (stored.lobes.front().occupancy.empty())
+        EXPECT_TRUE(sizes["tlobe_occupancy_cell_m"].is_null());
+    else
+        EXPECT_NEAR(sizes["tlobe_occupancy_cell_m"].get<double>(), stored.lobes.front().occupancy.cell, 1e-3);
     EXPECT_GT(report["rebuilt"]["triangles"].get<int>(), 0);
     EXPECT_LE(report["rebuilt"]["triangles"].get<int>(), 20000);
     EXPECT_GT(report["seconds"]["total"].get<double>(), 0);
@@ -207,6 +216,9 @@ TEST(RebuildCli, GlbModelIsLabelledByItsMaterialNames) {
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto report = nlohmann::json::parse(read_file(out / "report.json"));
     EXPECT_EQ(report["input_mesh"]["format"], "glb");
+    EXPECT_NE(r.out.find("lobes stored with " + std::to_string(report["sizes"]["tlobe_lobe_faces"].get<std::size_t>()) + " of their"),
+              std::string::npos)
+            << r.out;
     EXPECT_EQ(report["input_mesh"]["triangles"].get<std::size_t>(), palm.mesh.faces.size());
     const auto& labels = report["input_mesh"]["labels"];
     EXPECT_GT(labels["leaf_by_name"].get<int>(), 1000);
