@@ -30,7 +30,8 @@ struct TlobeOptions {
     std::vector<double> occupancy_cells{0.03, 0.035, 0.04, 0.05, 0.06, 0.07, 0.085, 0.1, 0.12, 0.14,
                                         0.17, 0.2,   0.24, 0.3,  0.35, 0.4,  0.5,   0.6, 0.8};
     // When no grid fits, the lobe surfaces are simplified to these fractions of their faces (each
-    // keeps min_lobe_faces at least) and every grid is tried again, largest fraction first.
+    // keeps min_lobe_faces at least) and the grids are tried again, largest fraction first (the
+    // grids up to coarsest_cell_before_simplifying, then the coarser ones).
     std::vector<double> lobe_face_fractions{0.5, 0.25, 0.125, 0.0625};
     std::size_t min_lobe_faces = 12;
     // Metres: grids up to this cell are tried with every simplification of the surfaces before a
