@@ -381,9 +381,15 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
             ->check(CLI::Range(0.0, 10.0));
     table->add("--face-budget", o->lobes.face_budget, "Lobe faces over the whole tree after simplification")
             ->check(CLI::Range(100, 10000000));
-    table->add("--quantum", o->file.quantum, "Grid of positions in the .tlobe file, metres")->check(CLI::Range(0.0001, 0.1));
+    table->add("--quantum", o->file.quantum, "Grid of skeleton positions and occupancy cells in the .tlobe file, metres")
+            ->check(CLI::Range(0.0001, 0.1));
+    table->add("--lobe-quantum", o->file.lobe_quantum, "Grid of lobe surface vertices in the .tlobe file, metres")
+            ->check(CLI::Range(0.0001, 0.1));
+    table->add("--min-points-per-cell", o->file.min_points_per_cell,
+               "Occupancy grids finer than this many lobe points per occupied cell are skipped (0 = any grid)")
+            ->check(CLI::Range(0.0, 1000.0));
     table->add("--budget-kb", o->budget_kb,
-               "Size each .tlobe may take (kB); its lobe occupancy grid is coarsened, then its lobe surfaces simplified, to fit")
+               "Size each .tlobe may take (kB); its lobe surfaces are simplified, then its occupancy grid coarsened, to fit")
             ->check(CLI::Range(2.0, 10000.0));
     sub->callback([o, table, &global, &job] { job = [o, table, &global] { return run_lobes(*o, *table, global); }; });
 

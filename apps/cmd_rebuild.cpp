@@ -444,7 +444,7 @@ void add_rebuild_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--stations", o->stations, "TLS stations around the model")->check(CLI::Range(1, 16));
     table->add("--seed", o->seed, "Random seed of sampling and synthesis");
     table->add("--budget-kb", o->budget_kb,
-               "Size the .tlobe may take (kB); its lobe occupancy grid is coarsened, then its lobe surfaces simplified, to fit")
+               "Size the .tlobe may take (kB); its lobe surfaces are simplified, then its occupancy grid coarsened, to fit")
             ->check(CLI::Range(kMinBudgetBytes / 1000, 10000.0));
     table->add("--min-ratio", o->min_ratio,
                "Keep the .tlobe within the input mesh file's size / this where that is below --budget-kb (0: off)")

@@ -634,7 +634,7 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
                "Larger lobe clusters are thinned on a grid to this many points before their alpha shape")
             ->check(CLI::Range(100, 10000000));
     table->add("--budget-kb", o->budget_kb,
-               "Size each tree's .tlobe may take (kB); its lobe occupancy grid is coarsened, then its lobe surfaces simplified, to fit")
+               "Size each tree's .tlobe may take (kB); its lobe surfaces are simplified, then its occupancy grid coarsened, to fit")
             ->check(CLI::Range(2.0, 10000.0));
     table->add("--resolution", o->trees.dbf6.encode.resolution, "DBF6 voxels per internode length (r)")->check(CLI::Range(1.0, 64.0));
     table->add("--lods", o->trees.dbf6.lods, "Levels of detail in each .dbf6 and the .forest")->check(CLI::Range(1, 16));

@@ -3,7 +3,7 @@
 // deterministic random tree (about 1,000 internodes) from tests/encode/random_tree.hpp (switch to synth/
 // species trees once they land). Run: bench_encode [--benchmark_filter=...]
 #include "encode/lod.hpp"
-#include "encode/range_coder.hpp"
+#include "core/range_coder.hpp"
 #include "encode/tree_code.hpp"
 #include "tests/encode/random_tree.hpp"
 

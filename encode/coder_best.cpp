@@ -3,7 +3,7 @@
 #include "core/error.hpp"
 #include "encode/bitstream.hpp"
 #include "encode/coder_ic.hpp"
-#include "encode/range_coder.hpp"
+#include "core/range_coder.hpp"
 
 #include <zlib.h>
 

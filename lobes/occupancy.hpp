@@ -12,6 +12,8 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <string>
+#include <string_view>
 #include <vector>
 
 namespace treelobes::lobes {
@@ -40,9 +42,23 @@ std::size_t occupancy_cell_count(std::span<const Eigen::Vector3f> points, float 
 // above kMaxOccupancyCells.
 Occupancy occupancy_of(std::span<const Eigen::Vector3f> points, float cell);
 
-// Coding (docs/tlobe.md): uvar cell / quantum (0 = none), svar first, uvar size, then an octree
-// of 8-bit child masks, breadth first, for the occupied nodes only. `cell` must be a multiple of `quantum`.
-void encode_occupancy(const Occupancy& occupancy, double quantum, ByteWriter& out);
-Occupancy decode_occupancy(ByteReader& in, double quantum);
+// The cells of all lobes of one file: more than this is a damaged file (the writer keeps within it).
+inline constexpr std::size_t kMaxOccupancyCellsPerTree = std::size_t{1} << 26;
+
+// Coding (docs/tlobe.md, version 5): each lobe's grid (uvar cell / quantum, 0 = none; svar
+// first; uvar size) stands with its lobe, and the cells of all lobes follow the lobes as one
+// range-coded stream of octrees whose adaptive models the lobes share. `cell` must be a multiple
+// of `quantum`.
+void encode_occupancy_grid(const Occupancy& occupancy, double quantum, ByteWriter& out);
+// The grid without its cells (`bits` empty), which decode_occupancy_cells then reads.
+Occupancy decode_occupancy_grid(ByteReader& in, double quantum);
+// The stream of the cells of `grids` (empty when none has occupancy).
+std::string encode_occupancy_cells(std::span<const Occupancy* const> grids);
+// Fills the cells of the grids decode_occupancy_grid read, in order; a truncated or overlong
+// stream, or grids of more than kMaxOccupancyCellsPerTree cells, throw Error(InvalidInput)
+// naming `name`.
+void decode_occupancy_cells(std::string_view stream, std::span<Occupancy> grids, const std::string& name);
+// Versions 3 and 4: the grid, then its octree as one byte of child bits per node.
+Occupancy decode_occupancy_v4(ByteReader& in, double quantum);
 
 }  // namespace treelobes::lobes

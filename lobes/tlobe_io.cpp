@@ -90,13 +90,15 @@ std::uint8_t encode_leaf_share(float share) {
 float decode_leaf_share(std::uint8_t code) { return code == kUnknownLeafShare ? -1.0f : static_cast<float>(code) / kLeafShareSteps; }
 
 void check_options(const TlobeOptions& o) {
-    if (!(o.quantum > 0 && o.quantum <= 1) || !(o.diameter_quantum > 0 && o.diameter_quantum <= 1))
+    if (!(o.quantum > 0 && o.quantum <= 1) || !(o.diameter_quantum > 0 && o.diameter_quantum <= 1) ||
+        !(o.lobe_quantum > 0 && o.lobe_quantum <= 1))
         throw Error::usage("tlobe: quanta must be in (0, 1] metres");
     if (o.compression_level < 1 || o.compression_level > 9) throw Error::usage("tlobe: compression level must be 1..9");
     for (double fraction : o.lobe_face_fractions)
         if (!(fraction > 0 && fraction < 1)) throw Error::usage("tlobe: lobe face fractions must be in (0, 1)");
     if (o.min_lobe_faces < 4) throw Error::usage("tlobe: lobes keep at least 4 faces");
-    if (!(o.coarsest_cell_before_simplifying > 0)) throw Error::usage("tlobe: the coarsest cell before simplifying must be positive");
+    if (!(o.min_points_per_cell >= 0 && std::isfinite(o.min_points_per_cell)))
+        throw Error::usage("tlobe: the points per occupancy cell must be a number >= 0");
 }
 
 // The payload with lobe i's occupancy taken from `occupancy[i]`.
@@ -105,10 +107,11 @@ std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const st
     for (int k = 0; k < 3; ++k) w.f64(tree.skeleton.origin[k]);
     w.f32(static_cast<float>(o.quantum));
     w.f32(static_cast<float>(o.diameter_quantum));
+    w.f32(static_cast<float>(o.lobe_quantum));  // since 5.0
     w.string(tree.species);
     for (double v : {tree.beta, tree.gamma, tree.fs, tree.alpha_factor, tree.root_diameter}) w.f32(static_cast<float>(v));
     // Decoding uses the stored (float) quanta, so encode with exactly those.
-    const double quantum = static_cast<float>(o.quantum);
+    const double quantum = static_cast<float>(o.quantum), lobe_quantum = static_cast<float>(o.lobe_quantum);
     TlobeOptions stored = o;
     stored.quantum = quantum;
     stored.diameter_quantum = static_cast<float>(o.diameter_quantum);
@@ -123,9 +126,10 @@ std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const st
         for (int k = 0; k < 3; ++k) w.svarint(std::lround(lobe.seed_direction[k] * 127.0f));
         if (lobe.mesh.origin != Eigen::Vector3d::Zero() && lobe.mesh.origin != tree.skeleton.origin)
             throw Error(ExitCode::Internal, "tlobe: lobe mesh is not in the tree's frame");
-        encode_mesh(lobe.mesh, quantum, w);
-        encode_occupancy(*occupancy[i], quantum, w);
+        encode_mesh(lobe.mesh, lobe_quantum, w);
+        encode_occupancy_grid(*occupancy[i], quantum, w);
     }
+    w.string(encode_occupancy_cells(occupancy));  // since 5.0: the cells of all lobes in one stream
     w.f32(static_cast<float>(tree.leaf_area_m2));                                  // since 3.1
     for (const Lobe& lobe : tree.lobes) w.u8(encode_leaf_share(lobe.leaf_share));  // since 3.2
     return w.bytes();
@@ -148,25 +152,34 @@ std::string pack(const std::string& raw, int level) {
     return file;
 }
 
-// The file of `tree` (its surfaces as they are) on the finest grid of `cells` at which it fits
-// max_bytes; none when no grid fits (a grid that some lobe's extent makes too large is skipped).
-std::optional<std::string> finest_fitting_file(const LobeTree& tree, const TlobeOptions& o, std::span<const double> cells) {
+// The occupancy of every lobe on a grid of `size` metres (rounded to the quantum); none when a
+// lobe's grid, or the tree's, would hold more cells than a file may. Lobes without cluster
+// points (a decoded tree) keep their occupancy.
+std::optional<std::vector<Occupancy>> occupancy_on_grid(const LobeTree& tree, const TlobeOptions& o, double size) {
     const double quantum = static_cast<float>(o.quantum);
-    std::vector<Occupancy> grids(tree.lobes.size());
-    std::vector<const Occupancy*> use(tree.lobes.size());
-    for (double size : cells) {
-        const auto cell = static_cast<float>(static_cast<double>(std::max<long long>(1, std::llround(size / quantum))) * quantum);
-        bool fits = true;
-        for (const Lobe& lobe : tree.lobes) fits = fits && occupancy_cell_count(lobe.cluster_points, cell) <= kMaxOccupancyCells;
-        if (!fits) continue;
-        for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
-            grids[i] = tree.lobes[i].cluster_points.empty() ? tree.lobes[i].occupancy : occupancy_of(tree.lobes[i].cluster_points, cell);
-            use[i] = &grids[i];
-        }
-        std::string file = pack(encode_payload(tree, o, use), o.compression_level);
-        if (file.size() <= o.max_bytes) return file;
+    const auto cell = static_cast<float>(static_cast<double>(std::max<long long>(1, std::llround(size / quantum))) * quantum);
+    std::size_t tree_cells = 0;
+    for (const Lobe& lobe : tree.lobes) {
+        const std::size_t lobe_cells = occupancy_cell_count(lobe.cluster_points, cell);
+        if (lobe_cells > kMaxOccupancyCells) return std::nullopt;
+        tree_cells += lobe_cells;
     }
-    return std::nullopt;
+    if (tree_cells > kMaxOccupancyCellsPerTree) return std::nullopt;
+    std::vector<Occupancy> grids(tree.lobes.size());
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i)
+        grids[i] = tree.lobes[i].cluster_points.empty() ? tree.lobes[i].occupancy : occupancy_of(tree.lobes[i].cluster_points, cell);
+    return grids;
+}
+
+// The lobes' cluster points per occupied cell of `grids` (their occupancy on one grid).
+double points_per_occupied_cell(const LobeTree& tree, const std::vector<Occupancy>& grids) {
+    std::size_t points = 0, cells = 0;
+    for (std::size_t i = 0; i < tree.lobes.size(); ++i) {
+        if (tree.lobes[i].cluster_points.empty()) continue;
+        points += tree.lobes[i].cluster_points.size();
+        cells += grids[i].occupied_count();
+    }
+    return cells == 0 ? 0.0 : static_cast<double>(points) / static_cast<double>(cells);
 }
 
 // The tree with every lobe surface simplified to `fraction` of its faces (at least min_faces) and
@@ -195,22 +208,32 @@ std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
         from_points = from_points || !tree.lobes[i].cluster_points.empty();
     }
     if (!from_points) return pack(encode_payload(tree, o, stored), o.compression_level);
-    // The occupancy draws the crown's outline and the lobe surfaces only bound it, so the
-    // surfaces give up detail (halving their faces) before the grid grows coarser than
-    // coarsest_cell_before_simplifying; the coarser grids are then tried the same way.
-    std::vector<double> fine_cells, coarse_cells;
-    for (double size : o.occupancy_cells) (size <= o.coarsest_cell_before_simplifying ? fine_cells : coarse_cells).push_back(size);
+    // The occupancy draws the crown's outline and the lobe surfaces only bound it, so the finest
+    // grid that fits wins, with the surfaces simplified (halving their faces) as far as it takes,
+    // down to the fraction simplifications_per_grid; the further fractions only when no grid fits
+    // with that (docs/rebuild.md, the palm at 2.9 and 3.8 kB).
     std::vector<LobeTree> simplified;  // the tree at each of lobe_face_fractions, made when first needed
-    for (const std::vector<double>& cells : {fine_cells, coarse_cells}) {
-        if (auto file = finest_fitting_file(tree, o, cells)) return *file;
-        for (std::size_t k = 0; k < o.lobe_face_fractions.size(); ++k) {
-            if (simplified.size() == k) simplified.push_back(with_coarser_lobes(tree, o.lobe_face_fractions[k], o.min_lobe_faces));
-            if (auto file = finest_fitting_file(simplified[k], o, cells)) return *file;
+    const auto surfaces = [&](std::size_t k) -> const LobeTree& {  // k = 0: as they are; k: the k-th fraction
+        while (simplified.size() < k) simplified.push_back(with_coarser_lobes(tree, o.lobe_face_fractions[simplified.size()], o.min_lobe_faces));
+        return k == 0 ? tree : simplified[k - 1];
+    };
+    const std::size_t simplest = o.lobe_face_fractions.size(), per_grid = std::min(o.simplifications_per_grid, simplest);
+    for (std::size_t deepest = per_grid; deepest <= simplest; ++deepest) {
+        const std::size_t fullest = deepest == per_grid ? 0 : deepest;
+        for (std::size_t c = 0; c < o.occupancy_cells.size(); ++c) {
+            const auto grids = occupancy_on_grid(tree, o, o.occupancy_cells[c]);
+            if (!grids || (c + 1 < o.occupancy_cells.size() && points_per_occupied_cell(tree, *grids) < o.min_points_per_cell)) continue;
+            std::vector<const Occupancy*> use(grids->size());
+            for (std::size_t i = 0; i < grids->size(); ++i) use[i] = &(*grids)[i];
+            const auto file_with = [&](std::size_t k) { return pack(encode_payload(surfaces(k), o, use), o.compression_level); };
+            if (file_with(deepest).size() > o.max_bytes) continue;  // one pass rules out a grid that does not fit at all
+            for (std::size_t k = fullest; k <= deepest; ++k)
+                if (std::string file = file_with(k); file.size() <= o.max_bytes) return file;
         }
     }
     const Occupancy none;
     std::vector<const Occupancy*> use(tree.lobes.size(), &none);
-    return pack(encode_payload(simplified.empty() ? tree : simplified.back(), o, use), o.compression_level);
+    return pack(encode_payload(surfaces(simplest), o, use), o.compression_level);
 }
 
 LobeTree decode_tlobe(std::string_view file, const std::string& name) {
@@ -250,7 +273,9 @@ LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int
     Eigen::Vector3d origin;
     for (int k = 0; k < 3; ++k) origin[k] = in.f64();
     const double quantum = in.f32(), diameter_quantum = in.f32();
-    if (!(quantum > 0 && quantum <= 1) || !(diameter_quantum > 0 && diameter_quantum <= 1) || !origin.allFinite())
+    const double lobe_quantum = major >= 5 ? in.f32() : quantum;
+    if (!(quantum > 0 && quantum <= 1) || !(diameter_quantum > 0 && diameter_quantum <= 1) || !(lobe_quantum > 0 && lobe_quantum <= 1) ||
+        !origin.allFinite())
         in.fail("invalid quantization or origin");
     tree.species = in.string();
     tree.beta = in.f32();
@@ -270,8 +295,14 @@ LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int
         Eigen::Vector3f d;
         for (int k = 0; k < 3; ++k) d[k] = static_cast<float>(in.svarint());
         lobe.seed_direction = d.norm() > 0 ? Eigen::Vector3f(d.normalized()) : Eigen::Vector3f::UnitZ();
-        lobe.mesh = major == 3 ? decode_mesh_v3(in, quantum) : decode_mesh(in, quantum);
-        lobe.occupancy = decode_occupancy(in, quantum);
+        lobe.mesh = major == 3 ? decode_mesh_v3(in, lobe_quantum) : decode_mesh(in, lobe_quantum);
+        lobe.occupancy = major >= 5 ? decode_occupancy_grid(in, quantum) : decode_occupancy_v4(in, quantum);
+    }
+    if (major >= 5) {
+        std::vector<Occupancy> grids(tree.lobes.size());
+        for (std::size_t i = 0; i < grids.size(); ++i) grids[i] = std::move(tree.lobes[i].occupancy);
+        decode_occupancy_cells(in.take(in.count(1, "occupancy stream length")), grids, name);
+        for (std::size_t i = 0; i < grids.size(); ++i) tree.lobes[i].occupancy = std::move(grids[i]);
     }
     const int fields = appended_fields(major, minor);
     if (fields >= 1) {

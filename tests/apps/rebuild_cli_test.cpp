@@ -164,8 +164,11 @@ TEST(RebuildCli, TheBudgetIsTheSmallerOfBudgetKbAndTheInputOverMinRatio) {
         EXPECT_EQ(r.exit_code, 0) << r.err;
         return nlohmann::json::parse(read_file(out / "report.json"))["sizes"];
     };
-    const auto ratio = run(by_ratio, " --min-ratio 100");
-    EXPECT_EQ(ratio["budget_bytes"].get<double>(), std::floor(input_bytes / 100));
+    // A ratio that leaves about 2.4 kB: below the file the 12 kB budget gives (about 2.9 kB:
+    // 20,000 samples draw no finer occupancy), above the 2 kB floor.
+    const double min_ratio = std::floor(input_bytes / 2400);
+    const auto ratio = run(by_ratio, " --min-ratio " + std::to_string(static_cast<long long>(min_ratio)));
+    EXPECT_EQ(ratio["budget_bytes"].get<double>(), std::floor(input_bytes / min_ratio));
     const auto kb = run(by_kb, " --min-ratio 0 --budget-kb 12");
     EXPECT_EQ(kb["budget_bytes"].get<double>(), 12000);
     for (const auto& sizes : {ratio, kb}) {

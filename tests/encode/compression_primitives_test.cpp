@@ -4,7 +4,7 @@
 #include "encode/bitstream.hpp"
 #include "encode/bwt.hpp"
 #include "encode/interpolative.hpp"
-#include "encode/range_coder.hpp"
+#include "core/range_coder.hpp"
 #include "encode/transforms.hpp"
 
 #include <gtest/gtest.h>

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -362,10 +363,38 @@ TEST(Tlobe, VersionThreeFilesStillRead) {
     const LobeTree v3_2 = decode_tlobe(rewritten(v3_0, 2, with_shares), "3.2.tlobe");
     EXPECT_NEAR(v3_2.lobes.front().leaf_share, 127.0f / 254, 1e-6f);
     EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(v3_0, 1, with_shares), "x"); }), ExitCode::InvalidInput);
-    // Encoded again, it becomes a version 4 file with the same lobes.
-    const LobeTree again = decode_tlobe(encode_tlobe(old), "4.tlobe");
+    // Encoded again, it becomes a version 5 file with the same lobes (vertices on the 2 cm grid).
+    const LobeTree again = decode_tlobe(encode_tlobe(old), "5.tlobe");
     ASSERT_EQ(again.lobes.size(), old.lobes.size());
-    for (std::size_t k = 0; k < old.lobes.size(); ++k) expect_same_faces(again.lobes[k].mesh, old.lobes[k].mesh, 0.0025f);
+    for (std::size_t k = 0; k < old.lobes.size(); ++k) expect_same_faces(again.lobes[k].mesh, old.lobes[k].mesh, 0.01f);
+}
+
+constexpr std::size_t kAilanthusV4OccupiedCells = 1571;
+
+// Version 4 files (occupancy as a byte of child bits per octree node, lobe vertices on the
+// skeleton's 5 mm grid) still read: a file the 4.0 writer wrote (`treelobes lobes
+// data/synthetic/ailanthus_altissima_5.las --species ailanthus_altissima --budget-kb 3`), whose
+// five lobes hold occupancy on 3 cm cells; encoded again as version 5, the cells are the same.
+TEST(Tlobe, VersionFourFilesStillRead) {
+    const std::string v4 = file_bytes(test::source_dir() / "tests/data/tlobe/ailanthus_altissima_v4_0.tlobe");
+    ASSERT_EQ(v4[4], 4);
+    const LobeTree old = decode_tlobe(v4, "4.0.tlobe");
+    ASSERT_EQ(old.lobes.size(), 5u);
+    std::size_t occupied = 0;
+    for (const Lobe& lobe : old.lobes) {
+        EXPECT_NEAR(lobe.occupancy.cell, 0.03f, 1e-6f);
+        EXPECT_TRUE(check_closed(lobe.mesh).closed());
+        occupied += lobe.occupancy.occupied_count();
+    }
+    EXPECT_EQ(occupied, kAilanthusV4OccupiedCells);
+    const std::string v5 = encode_tlobe(old);
+    EXPECT_EQ(v5[4], 5);
+    EXPECT_LT(v5.size(), v4.size());
+    const LobeTree again = decode_tlobe(v5, "5.tlobe");
+    for (std::size_t k = 0; k < old.lobes.size(); ++k) {
+        EXPECT_EQ(again.lobes[k].occupancy, old.lobes[k].occupancy);
+        expect_same_faces(again.lobes[k].mesh, old.lobes[k].mesh, 0.01f);
+    }
 }
 
 // Points of a lobe: a dense 0.3 m ball in one corner of the lobe and a thin vertical line.
@@ -393,32 +422,52 @@ TEST(Occupancy, GridHoldsEveryPointAndOnlyTheirCells) {
     // The ball's 0.113 m^3 over 0.05 m cells (about 900 cells plus its rim) and the line's 17 cells.
     EXPECT_GT(o.occupied_count(), 900u);
     EXPECT_LT(o.occupied_count(), 1500u);
+    const Occupancy line = occupancy_of(std::vector<Eigen::Vector3f>{{0, 0, 0}, {0.12f, 0, 0}}, 0.05f);  // 3 x 1 x 1 cells
+    const std::vector<const Occupancy*> grids{&o, &line};
     ByteWriter w;
-    encode_occupancy(o, 0.005, w);
-    ByteReader r(w.bytes(), "test");
-    EXPECT_EQ(decode_occupancy(r, 0.005), o);
-    EXPECT_TRUE(r.at_end());
-    // Truncated masks and a mask with a child outside the grid are invalid input.
-    ByteReader short_reader(std::string_view(w.bytes()).substr(0, w.bytes().size() - 1), "test");
-    EXPECT_EQ(error_code_of([&] { decode_occupancy(short_reader, 0.005); }), ExitCode::InvalidInput);
-    // 3 x 1 x 1 cells padded to a cube of depth 2: three masks (root, then the two occupied
-    // level-1 nodes), so the root mask is the 3rd to last byte;
-    // its children with y = 1 (bit 2) lie outside the grid.
-    const Occupancy three = occupancy_of(std::vector<Eigen::Vector3f>{{0, 0, 0}, {0.12f, 0, 0}}, 0.05f);
-    ByteWriter pw;
-    encode_occupancy(three, 0.005, pw);
-    ByteReader good_reader(pw.bytes(), "test");
-    EXPECT_EQ(decode_occupancy(good_reader, 0.005), three);
-    std::string outside = pw.bytes();
-    outside[outside.size() - 3] = static_cast<char>(outside[outside.size() - 3] | 0x04);
-    ByteReader outside_reader(outside, "test");
-    EXPECT_EQ(error_code_of([&] { decode_occupancy(outside_reader, 0.005); }), ExitCode::InvalidInput);
+    for (const Occupancy* grid : grids) encode_occupancy_grid(*grid, 0.005, w);
+    const std::string cells = encode_occupancy_cells(grids);
+    // The ball's ~1,100 cells, and the octree nodes above them, in far fewer bytes than a byte per node.
+    EXPECT_LT(cells.size(), 250u);
+    const auto decoded = [&](std::string_view stream) {
+        ByteReader r(w.bytes(), "test");
+        std::vector<Occupancy> back{decode_occupancy_grid(r, 0.005), decode_occupancy_grid(r, 0.005)};
+        EXPECT_TRUE(r.at_end());
+        decode_occupancy_cells(stream, back, "test");
+        return back;
+    };
+    const std::vector<Occupancy> back = decoded(cells);
+    EXPECT_EQ(back[0], o);
+    EXPECT_EQ(back[1], line);
+    // A truncated stream, one with a byte too many, and cells for grids that have none are invalid input.
+    EXPECT_EQ(error_code_of([&] { decoded(std::string_view(cells).substr(0, cells.size() - 1)); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { decoded(cells + '\0'); }), ExitCode::InvalidInput);
+    std::vector<Occupancy> none(1);
+    EXPECT_EQ(error_code_of([&] { decode_occupancy_cells(cells, none, "test"); }), ExitCode::InvalidInput);
+    EXPECT_TRUE(encode_occupancy_cells(std::vector<const Occupancy*>{&none[0]}).empty());
+    // A grid without an occupied cell (only a damaged version 4 file holds one) is stored as none.
+    Occupancy hollow = line;
+    std::fill(hollow.bits.begin(), hollow.bits.end(), 0);
+    ByteWriter hw;
+    encode_occupancy_grid(hollow, 0.005, hw);
+    ByteReader hr(hw.bytes(), "test");
+    EXPECT_TRUE(decode_occupancy_grid(hr, 0.005).empty());
+    EXPECT_TRUE(encode_occupancy_cells(std::vector<const Occupancy*>{&hollow}).empty());
+    // Grids of more cells than a file may hold are refused before anything is allocated.
+    std::vector<Occupancy> huge(5);
+    for (Occupancy& g : huge) {
+        g.cell = 0.05f;
+        g.size = {256, 256, 256};
+    }
+    EXPECT_EQ(error_code_of([&] { decode_occupancy_cells(cells, huge, "test"); }), ExitCode::InvalidInput);
 }
 
 TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
     LobeTree t = sample_tree();
     for (Lobe& lobe : t.lobes) lobe.cluster_points = corner_points(t.seed_position(lobe) + Eigen::Vector3f(0, 0, 0.5f));
-    const std::string bytes = encode_tlobe(t);
+    TlobeOptions every_grid;  // the grids finer than the points can draw are tested below
+    every_grid.min_points_per_cell = 0;
+    const std::string bytes = encode_tlobe(t, every_grid);
     const LobeTree d = decode_tlobe(bytes, "occupied.tlobe");
     const float finest = static_cast<float>(0.03);
     for (std::size_t k = 0; k < t.lobes.size(); ++k) {
@@ -429,12 +478,12 @@ TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
     }
     EXPECT_TRUE(encode_tlobe(d) == bytes) << "re-encoding a decoded tree changed the bytes";
     // A smaller budget coarsens the grid; a budget below the file without occupancy drops it.
-    TlobeOptions small;
+    TlobeOptions small = every_grid;
     small.max_bytes = bytes.size() - 1;
     const std::string coarse = encode_tlobe(t, small);
     EXPECT_LE(coarse.size(), small.max_bytes);
     EXPECT_GT(decode_tlobe(coarse, "coarse.tlobe").lobes[0].occupancy.cell, finest);
-    TlobeOptions tiny;
+    TlobeOptions tiny = every_grid;
     tiny.max_bytes = 100;
     for (const Lobe& lobe : decode_tlobe(encode_tlobe(t, tiny), "tiny.tlobe").lobes) EXPECT_TRUE(lobe.occupancy.empty());
     // Corruption inside the occupancy bits is still caught by the CRC.
@@ -443,12 +492,42 @@ TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
     EXPECT_EQ(error_code_of([&] { decode_tlobe(flipped, "x"); }), ExitCode::InvalidInput);
 }
 
+// A grid finer than the points can draw is skipped: the finest grid used holds at least
+// min_points_per_cell points per occupied cell (the ball's 3,050 points: about 2.7 per cell at
+// 3 cm), whatever the budget; when no grid does, the coarsest one is used.
+TEST(Tlobe, OccupancyGridNoFinerThanThePointsDraw) {
+    LobeTree t = sample_tree();
+    for (Lobe& lobe : t.lobes) lobe.cluster_points = corner_points(t.seed_position(lobe) + Eigen::Vector3f(0, 0, 0.5f));
+    const TlobeOptions o;
+    ASSERT_EQ(o.min_points_per_cell, 6.0);
+    const auto points_per_cell = [&](double cell) {
+        std::size_t points = 0, cells = 0;
+        for (const Lobe& lobe : t.lobes) {
+            points += lobe.cluster_points.size();
+            cells += occupancy_of(lobe.cluster_points, static_cast<float>(cell)).occupied_count();
+        }
+        return static_cast<double>(points) / static_cast<double>(cells);
+    };
+    ASSERT_LT(points_per_cell(o.occupancy_cells.front()), o.min_points_per_cell);
+    const auto drawable = std::find_if(o.occupancy_cells.begin(), o.occupancy_cells.end(),
+                                       [&](double cell) { return points_per_cell(cell) >= o.min_points_per_cell; });
+    ASSERT_NE(drawable, o.occupancy_cells.end());
+    EXPECT_NEAR(decode_tlobe(encode_tlobe(t, o), "drawn.tlobe").lobes[0].occupancy.cell, static_cast<float>(*drawable), 1e-6f);
+    TlobeOptions never = o;
+    never.min_points_per_cell = 1e6;
+    EXPECT_NEAR(decode_tlobe(encode_tlobe(t, never), "coarsest.tlobe").lobes[0].occupancy.cell,
+                static_cast<float>(o.occupancy_cells.back()), 1e-6f);
+}
+
 // The sample tree with finely meshed 0.6 m balls for lobes, each holding a cluster of points.
+// Their radii vary by up to 10 % from vertex to vertex, as an alpha shape's do: a regular sphere
+// is predicted so well by the mesh coder that simplifying it would not make its coding smaller.
 LobeTree tree_with_ball_lobes() {
     LobeTree t = sample_tree();
     for (Lobe& lobe : t.lobes) {
         const Eigen::Vector3f centre = t.seed_position(lobe) + Eigen::Vector3f(0, 0, 0.5f);
         lobe.mesh = sphere(16, 30, 0.6f);
+        for (std::size_t i = 0; i < lobe.mesh.vertices.size(); ++i) lobe.mesh.vertices[i] *= 1.0f + 0.1f * std::sin(7.3f * static_cast<float>(i));
         for (auto& v : lobe.mesh.vertices) v += centre;
         lobe.cluster_points = corner_points(centre);
     }
@@ -493,29 +572,70 @@ TEST(Tlobe, LobeSurfacesAreSimplifiedWhenNoGridFits) {
     EXPECT_EQ(error_code_of([&] { encode_tlobe(t, too_few); }), ExitCode::Usage);
 }
 
-// A budget that the full surfaces meet only with a 0.6 m grid: the surfaces are simplified
-// instead, to keep a 5 cm grid (the grids up to coarsest_cell_before_simplifying come first);
-// with that bound below every grid, the coarse grid keeps the full surfaces.
+// A budget that the full surfaces meet only with a 0.6 m grid, not a 5 cm one: the surfaces are
+// simplified instead, to keep the 5 cm grid (a finer grid is worth more than fuller surfaces);
+// without simplifications at each grid, the coarse grid keeps the full surfaces.
 TEST(Tlobe, SurfacesAreSimplifiedBeforeTheGridGrowsCoarse) {
     const LobeTree t = tree_with_ball_lobes();
     const std::size_t full_faces = t.lobes[0].mesh.faces.size();
     TlobeOptions full_and_coarse;
+    full_and_coarse.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 5 cm cells
     full_and_coarse.occupancy_cells = {0.6};
     const std::string coarse_file = encode_tlobe(t, full_and_coarse);
     ASSERT_EQ(decode_tlobe(coarse_file, "coarse.tlobe").lobes[0].mesh.faces.size(), full_faces);
+    TlobeOptions full_and_fine = full_and_coarse;
+    full_and_fine.occupancy_cells = {0.05};
+    const std::size_t fine_full = encode_tlobe(t, full_and_fine).size();
+    ASSERT_LT(coarse_file.size(), fine_full);
 
-    TlobeOptions o;
+    TlobeOptions o = full_and_coarse;
     o.occupancy_cells = {0.05, 0.6};
-    o.max_bytes = coarse_file.size();
+    o.max_bytes = fine_full - 1;
     const LobeTree fine = decode_tlobe(encode_tlobe(t, o), "fine.tlobe");
     for (const Lobe& lobe : fine.lobes) {
         EXPECT_NEAR(lobe.occupancy.cell, 0.05f, 1e-6f);
         EXPECT_LT(lobe.mesh.faces.size(), full_faces);
     }
-    o.coarsest_cell_before_simplifying = 0.01;
+    o.simplifications_per_grid = 0;
     EXPECT_EQ(encode_tlobe(t, o), coarse_file);
-    o.coarsest_cell_before_simplifying = 0;
-    EXPECT_EQ(error_code_of([&] { encode_tlobe(t, o); }), ExitCode::Usage);
+}
+
+// The simplifications beyond simplifications_per_grid come only when no grid fits with fewer:
+// a budget that a 2 cm grid meets only with the surfaces at 1/16 keeps the 0.6 m grid when the
+// surfaces may be simplified to 1/8 at each grid (the default), the 2 cm one when to 1/16.
+TEST(Tlobe, DeepSimplificationsWaitForEveryGrid) {
+    const LobeTree t = tree_with_ball_lobes();
+    // Bytes of the file on the grid `cell` with the surfaces at `fraction` of their faces: the
+    // budget one byte below the full surfaces' file on that grid makes the encoder simplify them.
+    const auto size_with = [&](double cell, double fraction) {
+        TlobeOptions o;
+        o.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 2 cm cells
+        o.occupancy_cells = {cell};
+        o.lobe_face_fractions.clear();
+        o.max_bytes = encode_tlobe(t, o).size() - 1;
+        o.lobe_face_fractions = {fraction};
+        const std::string file = encode_tlobe(t, o);
+        EXPECT_NEAR(decode_tlobe(file, "sized.tlobe").lobes[0].occupancy.cell, static_cast<float>(cell), 1e-6f);
+        return file.size();
+    };
+    const std::size_t fine_sixteenth = size_with(0.02, 0.0625);
+    ASSERT_GT(size_with(0.02, 0.125), fine_sixteenth);
+    ASSERT_LE(size_with(0.6, 0.125), fine_sixteenth);
+
+    TlobeOptions budget;
+    budget.min_points_per_cell = 0;
+    budget.occupancy_cells = {0.02, 0.6};
+    budget.max_bytes = fine_sixteenth;
+    ASSERT_EQ(budget.simplifications_per_grid, 3u);
+    EXPECT_NEAR(decode_tlobe(encode_tlobe(t, budget), "three.tlobe").lobes[0].occupancy.cell, 0.6f, 1e-6f);
+    budget.simplifications_per_grid = 4;
+    const LobeTree fine = decode_tlobe(encode_tlobe(t, budget), "four.tlobe");
+    EXPECT_NEAR(fine.lobes[0].occupancy.cell, 0.02f, 1e-6f);
+    EXPECT_EQ(fine.lobes[0].mesh.faces.size(), size_t{60});  // 1/16 of the ball's 960
+    // More simplifications per grid than fractions: each grid tries them all, full surfaces first.
+    budget.simplifications_per_grid = 10;
+    budget.max_bytes = 1000000;
+    EXPECT_EQ(decode_tlobe(encode_tlobe(t, budget), "ten.tlobe").lobes[0].mesh.faces.size(), t.lobes[0].mesh.faces.size());
 }
 
 TEST(Tlobe, FileRoundTripAndBadOptions) {
@@ -527,6 +647,25 @@ TEST(Tlobe, FileRoundTripAndBadOptions) {
     TlobeOptions bad;
     bad.quantum = 0;
     EXPECT_EQ(error_code_of([&] { encode_tlobe(t, bad); }), ExitCode::Usage);
+    TlobeOptions bad_lobe_grid;
+    bad_lobe_grid.lobe_quantum = -0.02;
+    EXPECT_EQ(error_code_of([&] { encode_tlobe(t, bad_lobe_grid); }), ExitCode::Usage);
+}
+
+// Lobe vertices lie on their own grid (lobe_quantum, stored in the file), the skeleton keeps the
+// finer one.
+TEST(Tlobe, LobeVerticesOnTheirOwnGrid) {
+    const LobeTree t = sample_tree();
+    TlobeOptions o;
+    o.lobe_quantum = 0.05;
+    const LobeTree d = decode_tlobe(encode_tlobe(t, o), "coarse_lobes.tlobe");
+    for (std::size_t k = 0; k < t.lobes.size(); ++k) {
+        expect_same_faces(d.lobes[k].mesh, t.lobes[k].mesh, 0.025f);
+        for (const auto& v : d.lobes[k].mesh.vertices)
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(v[c] / 0.05f, std::round(v[c] / 0.05f), 1e-3f);
+    }
+    for (std::size_t i = 0; i < t.skeleton.size(); ++i)
+        EXPECT_LE((d.skeleton.nodes[i].position - t.skeleton.nodes[i].position).cwiseAbs().maxCoeff(), 0.0025f + 1e-5f);
 }
 
 // Found by the tlobe_payload fuzzer (UBSan: signed overflow adding a huge coordinate delta to its

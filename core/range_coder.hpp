@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace treelobes::encode {
+namespace treelobes {
 
 // Probability that the next bit is 0, in 1/65536, plus how many bits it has seen (capped).
 struct BitModel {
@@ -160,4 +160,4 @@ private:
     const std::string* context_;
 };
 
-}  // namespace treelobes::encode
+}  // namespace treelobes
