@@ -383,8 +383,12 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
             ->check(CLI::Range(100, 10000000));
     table->add("--quantum", o->file.quantum, "Grid of skeleton positions and occupancy cells in the .tlobe file, metres")
             ->check(CLI::Range(0.0001, 0.1));
-    table->add("--lobe-quantum", o->file.lobe_quantum, "Grid of lobe surface vertices in the .tlobe file, metres")
+    table->add("--lobe-quantum", o->file.lobe_quantum,
+               "Grid of lobe surface vertices in the .tlobe file, metres (an eighth of the occupancy cell when that is coarser)")
             ->check(CLI::Range(0.0001, 0.1));
+    table->add("--skeleton-tolerance", o->file.skeleton_tolerance,
+               "The .tlobe stores the main skeleton without the nodes within this many metres of their chain (0 = every node)")
+            ->check(CLI::Range(0.0, 1.0));
     table->add("--min-points-per-cell", o->file.min_points_per_cell,
                "Occupancy grids finer than this many lobe points per occupied cell are skipped (0 = any grid)")
             ->check(CLI::Range(0.0, 1000.0));

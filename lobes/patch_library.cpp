@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/random.hpp"
+#include "geometry/polyline.hpp"
 
 #include <Eigen/Geometry>
 
@@ -58,29 +59,9 @@ std::vector<PatchSegment> simplify_axis(const std::vector<PatchSegment>& segment
         points.push_back(s.b);
         thickness.push_back(s.thickness_b);
     }
-    std::vector<char> keep(points.size(), 0);
-    keep.front() = keep.back() = 1;
-    std::vector<std::pair<std::size_t, std::size_t>> spans{{0, points.size() - 1}};
-    while (!spans.empty()) {
-        const auto [i, j] = spans.back();
-        spans.pop_back();
-        const Eigen::Vector3f chord = points[j] - points[i];
-        float worst = 0;
-        std::size_t at = i;
-        for (std::size_t k = i + 1; k < j; ++k) {
-            const Eigen::Vector3f d = points[k] - points[i];
-            const float along = std::clamp(d.dot(chord) / std::max(chord.squaredNorm(), 1e-12f), 0.0f, 1.0f);
-            const float off = (d - along * chord).norm();
-            if (off > worst) {
-                worst = off;
-                at = k;
-            }
-        }
-        if (worst <= tolerance) continue;
-        keep[at] = 1;
-        spans.push_back({at, j});
-        spans.push_back({i, at});
-    }
+    const std::vector<char> keep = douglas_peucker(points.size(), tolerance, [&](std::size_t a, std::size_t b, std::size_t k) {
+        return distance_to_segment(points[k], points[a], points[b]);
+    });
     std::vector<PatchSegment> out;
     std::size_t last = 0;
     for (std::size_t k = 1; k < points.size(); ++k)

@@ -3,11 +3,13 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "geometry/alpha_shape.hpp"
+#include "geometry/polyline.hpp"
 #include "lobes/mesh_coder.hpp"
 #include "lobes/occupancy.hpp"
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -79,6 +81,63 @@ TreeGraph decode_skeleton(ByteReader& in, double quantum, double diameter_quantu
     return skeleton;
 }
 
+// Which nodes of the main skeleton a file keeps: Douglas-Peucker along each chain (root, forks,
+// tips and lobe seeds kept), a dropped node within skeleton_tolerance of the segment between the
+// kept nodes around it and its diameter within skeleton_diameter_tolerance of theirs
+// interpolated. Deviations are measured on the grids the file stores, so thinning a decoded
+// tree again drops nothing more.
+std::vector<bool> skeleton_nodes_to_keep(const LobeTree& tree, const TlobeOptions& o) {
+    const TreeGraph& skeleton = tree.skeleton;
+    std::vector<Eigen::Vector3f> position(skeleton.size());
+    std::vector<float> diameter(skeleton.size());
+    const double quantum = static_cast<float>(o.quantum), diameter_quantum = static_cast<float>(o.diameter_quantum);
+    for (std::size_t i = 0; i < skeleton.size(); ++i) {
+        for (int k = 0; k < 3; ++k)
+            position[i][k] = static_cast<float>(static_cast<double>(quantize(skeleton.nodes[i].position[k], quantum)) * quantum);
+        const std::int64_t d = quantize(2.0 * skeleton.nodes[i].radius, diameter_quantum);
+        diameter[i] = static_cast<float>(static_cast<double>(d) * diameter_quantum);
+    }
+    std::vector<bool> keep(skeleton.size(), true), seed(skeleton.size(), false);
+    for (const Lobe& lobe : tree.lobes)
+        if (lobe.seed_node >= 0 && static_cast<std::size_t>(lobe.seed_node) < seed.size()) seed[lobe.seed_node] = true;
+    const auto tolerance = static_cast<float>(o.skeleton_tolerance);
+    const auto diameter_tolerance = std::max(static_cast<float>(o.skeleton_diameter_tolerance), 1e-9f);
+    const auto thin = [&](std::span<const int> run) {
+        const auto deviation = [&](std::size_t a, std::size_t b, std::size_t k) {  // > 1: keep
+            const Eigen::Vector3f &pa = position[run[a]], &pb = position[run[b]], &pk = position[run[k]];
+            const Eigen::Vector3f chord = pb - pa;
+            const float t = chord.squaredNorm() > 0 ? std::clamp((pk - pa).dot(chord) / chord.squaredNorm(), 0.0f, 1.0f) : 0.0f;
+            const float diameter_off = std::abs(diameter[run[k]] - ((1 - t) * diameter[run[a]] + t * diameter[run[b]]));
+            return std::max(distance_to_segment(pk, pa, pb) / tolerance, diameter_off / diameter_tolerance);
+        };
+        const std::vector<char> kept = douglas_peucker(run.size(), 1.0f, deviation);
+        for (std::size_t k = 0; k < run.size(); ++k) keep[run[k]] = keep[run[k]] && kept[k];
+    };
+    for (const std::vector<int>& chain : tree_chains(skeleton)) {
+        std::size_t from = 0;  // runs between lobe seeds
+        for (std::size_t k = 1; k < chain.size(); ++k)
+            if (seed[chain[k]] || k + 1 == chain.size()) {
+                thin(std::span<const int>(chain).subspan(from, k - from + 1));
+                from = k;
+            }
+    }
+    return keep;
+}
+
+// The tree as a file stores it: the main skeleton thinned (skeleton_nodes_to_keep). The
+// reconstruction spaces nodes evenly along straight branches, so most are redundant: the second
+// palm's 277 nodes become 73 at 1 cm and its skeleton 566 bytes 347 (docs/tlobe.md).
+LobeTree with_thinned_skeleton(const LobeTree& tree, const TlobeOptions& o) {
+    if (!(o.skeleton_tolerance > 0) || tree.skeleton.size() < 3) return tree;
+    LobeTree thinned = tree;
+    std::vector<int> new_index;
+    thinned.skeleton = keep_nodes(tree.skeleton, skeleton_nodes_to_keep(tree, o), new_index);
+    for (Lobe& lobe : thinned.lobes)
+        if (lobe.seed_node >= 0 && static_cast<std::size_t>(lobe.seed_node) < new_index.size())
+            lobe.seed_node = new_index[lobe.seed_node];
+    return thinned;
+}
+
 // A lobe's leaf share in one byte: 0..kLeafShareSteps for 0..1, kUnknownLeafShare when unknown.
 constexpr std::uint8_t kLeafShareSteps = 254, kUnknownLeafShare = 255;
 
@@ -91,14 +150,26 @@ float decode_leaf_share(std::uint8_t code) { return code == kUnknownLeafShare ? 
 
 void check_options(const TlobeOptions& o) {
     if (!(o.quantum > 0 && o.quantum <= 1) || !(o.diameter_quantum > 0 && o.diameter_quantum <= 1) ||
-        !(o.lobe_quantum > 0 && o.lobe_quantum <= 1))
+        !(o.lobe_quantum > 0 && o.lobe_quantum <= 1) || !(o.lobe_quantum_per_cell >= 0 && o.lobe_quantum_per_cell <= 1))
         throw Error::usage("tlobe: quanta must be in (0, 1] metres");
     if (o.compression_level < 1 || o.compression_level > 9) throw Error::usage("tlobe: compression level must be 1..9");
     for (double fraction : o.lobe_face_fractions)
         if (!(fraction > 0 && fraction < 1)) throw Error::usage("tlobe: lobe face fractions must be in (0, 1)");
     if (o.min_lobe_faces < 4) throw Error::usage("tlobe: lobes keep at least 4 faces");
+    if (!(o.skeleton_tolerance >= 0 && o.skeleton_tolerance <= 1) ||
+        !(o.skeleton_diameter_tolerance >= 0 && o.skeleton_diameter_tolerance <= 1))
+        throw Error::usage("tlobe: skeleton tolerances must be in [0, 1] metres");
     if (!(o.min_points_per_cell >= 0 && std::isfinite(o.min_points_per_cell)))
         throw Error::usage("tlobe: the points per occupancy cell must be a number >= 0");
+}
+
+// The grid of the lobe vertices: lobe_quantum, or lobe_quantum_per_cell of the coarsest
+// occupancy cell when that is coarser (the stored cells decide, so a decoded tree is encoded on
+// the grid it came on).
+double lobe_vertex_quantum(const TlobeOptions& o, const std::vector<const Occupancy*>& occupancy) {
+    double cell = 0;
+    for (const Occupancy* grid : occupancy) cell = std::max(cell, static_cast<double>(grid->cell));
+    return static_cast<float>(std::max(o.lobe_quantum, o.lobe_quantum_per_cell * cell));
 }
 
 // The payload with lobe i's occupancy taken from `occupancy[i]`.
@@ -107,11 +178,12 @@ std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const st
     for (int k = 0; k < 3; ++k) w.f64(tree.skeleton.origin[k]);
     w.f32(static_cast<float>(o.quantum));
     w.f32(static_cast<float>(o.diameter_quantum));
-    w.f32(static_cast<float>(o.lobe_quantum));  // since 5.0
+    const double lobe_quantum = lobe_vertex_quantum(o, occupancy);
+    w.f32(static_cast<float>(lobe_quantum));  // since 5.0
     w.string(tree.species);
     for (double v : {tree.beta, tree.gamma, tree.fs, tree.alpha_factor, tree.root_diameter}) w.f32(static_cast<float>(v));
     // Decoding uses the stored (float) quanta, so encode with exactly those.
-    const double quantum = static_cast<float>(o.quantum), lobe_quantum = static_cast<float>(o.lobe_quantum);
+    const double quantum = static_cast<float>(o.quantum);
     TlobeOptions stored = o;
     stored.quantum = quantum;
     stored.diameter_quantum = static_cast<float>(o.diameter_quantum);
@@ -199,8 +271,9 @@ LobeTree with_coarser_lobes(const LobeTree& tree, double fraction, std::size_t m
 
 }  // namespace
 
-std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& o) {
+std::string encode_tlobe(const LobeTree& unthinned, const TlobeOptions& o) {
     check_options(o);
+    const LobeTree tree = with_thinned_skeleton(unthinned, o);
     std::vector<const Occupancy*> stored(tree.lobes.size());
     bool from_points = false;
     for (std::size_t i = 0; i < tree.lobes.size(); ++i) {

@@ -27,7 +27,16 @@ struct TlobeOptions {
     // cell is 3 cm, so they need no finer grid; 2 cm instead of 5 mm takes 11 % off their bytes
     // (docs/tlobe.md).
     double lobe_quantum = 0.02;
+    // On an occupancy grid coarser than 8 x lobe_quantum, the lobe vertices take this fraction of
+    // its cell as their grid: the surfaces only bound cells that size, and the bytes saved buy a
+    // finer grid (the second palm: 0.3 m cells instead of 0.35-0.5 m in 2.9 kB; docs/tlobe.md).
+    double lobe_quantum_per_cell = 0.125;
     double diameter_quantum = 0.0005;  // metres: grid of branch diameters
+    // Metres: the main skeleton is stored thinned by Douglas-Peucker along its chains, each
+    // dropped node within skeleton_tolerance of the segment between the kept ones around it and
+    // its diameter within skeleton_diameter_tolerance of theirs interpolated (0: every node kept).
+    double skeleton_tolerance = 0.01;
+    double skeleton_diameter_tolerance = 0.002;
     int compression_level = 9;         // deflate level 1..9
     std::size_t max_bytes = 39000;     // the occupancy grid is coarsened until the file fits (target < 40 kB)
     // A grid is used only when the lobes' points average at least this many per occupied cell
@@ -38,7 +47,7 @@ struct TlobeOptions {
     double min_points_per_cell = 6;
     // Metres, finest first, steps of about 1.2 (each one costs an encoding pass).
     std::vector<double> occupancy_cells{0.03, 0.035, 0.04, 0.05, 0.06, 0.07, 0.085, 0.1, 0.12, 0.14,
-                                        0.17, 0.2,   0.24, 0.3,  0.35, 0.4,  0.5,   0.6, 0.8};
+                                        0.17, 0.2, 0.22, 0.24, 0.27, 0.3, 0.35, 0.4,  0.5,   0.6, 0.8};
     // At each grid, finest first, the lobe surfaces are simplified to these fractions of their
     // faces (each keeps min_lobe_faces at least), largest fraction first, until the file fits,
     // down to the fraction number simplifications_per_grid: the occupancy draws the crown's

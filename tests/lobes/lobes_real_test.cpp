@@ -34,6 +34,11 @@ TEST(LobesReal, AdtreeTree13GivesClosedLobesInAFewKilobytes) {
     EXPECT_LT(bytes.size(), 40000u);
     const LobeTree decoded = decode_tlobe(bytes, "tree13.tlobe");
     ASSERT_EQ(decoded.lobes.size(), tree.lobes.size());
+    // The main skeleton is stored thinned (docs/tlobe.md), or whole with skeleton_tolerance 0.
+    EXPECT_LT(decoded.skeleton.size(), tree.skeleton.size());
+    TlobeOptions every_node;
+    every_node.skeleton_tolerance = 0;
+    EXPECT_EQ(decode_tlobe(encode_tlobe(tree, every_node), "whole.tlobe").skeleton.size(), tree.skeleton.size());
     // The file has room for the occupancy (a few kB of lobes): every cluster point is in an
     // occupied cell, on the grid the points can draw. AdTree's scan is sparse (6,283 lobe points,
     // 10-20 cm apart): 0.5 m cells hold 6 or more of them each on average, 0.4 m ones fewer.
@@ -66,11 +71,14 @@ TEST(LobesReal, CliWritesTlobeMeshesAndSummary) {
     EXPECT_TRUE(std::filesystem::exists(dir / "tree1_points_lobes.ply"));
     EXPECT_TRUE(std::filesystem::exists(dir / "tree1_points_main.ply"));
     EXPECT_EQ(read_tlobe(dir / "tree1_points.tlobe").lobes.size(), summary["lobe_count"].get<std::size_t>());
-    // A smaller --budget-kb is kept: coarser occupancy, then simpler lobe surfaces (the same lobes).
-    const auto tight = test::run_cli("lobes " + input.string() + " --out " + (dir / "tight").string() + " --fs 0.8 --budget-kb 4");
+    // A smaller --budget-kb is kept: coarser occupancy, then simpler lobe surfaces (the same lobes);
+    // the file options reach the writer (tree13 below: what --skeleton-tolerance does).
+    const auto tight = test::run_cli("lobes " + input.string() + " --out " + (dir / "tight").string() +
+                                     " --fs 0.8 --budget-kb 4 --skeleton-tolerance 0");
     ASSERT_EQ(tight.exit_code, 0) << tight.err;
     EXPECT_LE(std::filesystem::file_size(dir / "tight" / "tree1_points.tlobe"), 4000u);
     EXPECT_EQ(read_tlobe(dir / "tight" / "tree1_points.tlobe").lobes.size(), summary["lobe_count"].get<std::size_t>());
+    EXPECT_EQ(nlohmann::json::parse(read_file(dir / "tight" / "tree1_points_lobes.json"))["options"]["skeleton_tolerance"], 0.0);
 
     // Synthesis from the file: full tree with fidelity metrics and preview, then a 25 % LOD.
     const std::string tlobe = (dir / "tree1_points.tlobe").string();
@@ -102,6 +110,7 @@ TEST(LobesReal, CliExitCodes) {
     EXPECT_EQ(test::run_cli("lobes " + (dir / "missing.xyz").string() + " --out " + dir.path().string()).exit_code, 2);
     const auto input = test::real_data("adtree/tree13.xyz");
     EXPECT_EQ(test::run_cli("lobes " + input.string() + " --out " + dir.path().string() + " --alpha-factor 0.5").exit_code, 1);
+    EXPECT_EQ(test::run_cli("lobes " + input.string() + " --out " + dir.path().string() + " --skeleton-tolerance -0.01").exit_code, 1);
     test::write_text(dir / "bad.tlobe", "TLOB not really");
     const auto bad = test::run_cli("synthesize " + (dir / "bad.tlobe").string() + " --out " + (dir / "x.ply").string());
     EXPECT_EQ(bad.exit_code, 2);

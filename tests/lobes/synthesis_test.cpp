@@ -325,6 +325,54 @@ TEST(Synthesis, ARebuiltTreeDrawsLeavesAndTwigsOnlyInItsOccupiedCells) {
     EXPECT_NEAR(rebuilt.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2);
 }
 
+// The leaves drawn, and how many of them have their tip, a point a cell apart from it back
+// towards the base or the base itself in an empty cell.
+struct BladeCheck {
+    std::size_t drawn = 0, crossing_empty_cells = 0;
+};
+BladeCheck check_blades(const SynthesizedMesh& mesh, const Occupancy& seen) {
+    BladeCheck c;
+    for (std::size_t i = 0; i + 3 < mesh.leaves.vertices.size(); i += 4) {  // add_leaf: base, ..., tip, ...
+        const Eigen::Vector3f base = mesh.leaves.vertices[i], tip = mesh.leaves.vertices[i + 2];
+        const Eigen::Vector3f toward_base = (base - tip).normalized();
+        bool crossing = !seen.occupied(base);
+        for (float back = 0; back < (tip - base).norm(); back += seen.cell) crossing = crossing || !seen.occupied(tip + toward_base * back);
+        ++c.drawn;
+        c.crossing_empty_cells += crossing ? 1 : 0;
+    }
+    return c;
+}
+
+// Blades two or more cells long (the palm's 0.6 m leaflets on 20 cm cells) are drawn only where
+// the occupancy holds them from the tip back to the base; shorter ones (lagerstroemia's 7 cm) by
+// their tip alone. The occupancy: 40 cm slabs of occupied cells 20 cm apart, the gaps between
+// fronds.
+TEST(Synthesis, LongBladesAreDrawnOnlyAcrossOccupiedCells) {
+    LobeTree tree = boxed_tree();
+    std::vector<Eigen::Vector3f> pts;
+    for (float x = -0.99f; x < 1.0f; x += 0.05f)
+        for (float y = -0.99f; y < 1.0f; y += 0.05f)
+            for (float z = 1.91f; z < 3.4f; z += 0.05f)
+                if (static_cast<int>(std::floor((x + 1.0f) / 0.2f)) % 3 != 2) pts.emplace_back(x, y, z);
+    tree.lobes[0].occupancy = occupancy_of(pts, 0.2f);
+    const Occupancy& seen = tree.lobes[0].occupancy;
+    SynthesisOptions o;
+    o.texturing.fill_cell = 0.1;
+    for (const char* name : {"palm", "lagerstroemia"}) {
+        LobeTree t = tree;
+        const TexturedTree textured = texture_tree(t, species(name), o);
+        const SynthesizedMesh scanned = synthesized_mesh(t, textured, 1.0, o);  // no stored area: every leaf
+        EXPECT_GT(check_blades(scanned, seen).crossing_empty_cells, 0u) << name;
+        t.leaf_area_m2 = 0.01 * scanned.leaves.area();  // small enough that no drawn leaf is enlarged
+        const BladeCheck rebuilt = check_blades(synthesized_mesh(t, textured, 1.0, o), seen);
+        ASSERT_GT(rebuilt.drawn, 0u) << name;
+        if (std::string(name) == "palm")
+            EXPECT_EQ(rebuilt.crossing_empty_cells, 0u);
+        else
+            EXPECT_GT(rebuilt.crossing_empty_cells, 0u) << "short blades are judged by their tip";
+    }
+}
+
 TEST(Synthesis, LeafyPatchesAreThinnedToTheTriangleBudget) {
     const LobeTree tree = boxed_tree();
     SynthesisOptions o;

@@ -668,6 +668,72 @@ TEST(Tlobe, LobeVerticesOnTheirOwnGrid) {
         EXPECT_LE((d.skeleton.nodes[i].position - t.skeleton.nodes[i].position).cwiseAbs().maxCoeff(), 0.0025f + 1e-5f);
 }
 
+// A trunk of 31 evenly spaced nodes, straight and evenly tapering but for a diameter bump at
+// 1.5 m and a bend at 2 m, with a fork at 1 m to a thin straight lateral of 5 nodes and a lobe
+// seeded at 0.5 m: the file keeps the root, the lobe's seed, the fork, the bump, the bend, both
+// tips and the lateral's first node (its diameter is not the fork's), and drops the rest.
+LobeTree tree_with_straight_chains() {
+    LobeTree t = sample_tree();
+    t.skeleton = TreeGraph{};
+    t.skeleton.add_node({0, 0, 0}, 0.2f, -1);
+    for (int i = 1; i <= 30; ++i) {
+        const Eigen::Vector3f at = i <= 20 ? Eigen::Vector3f(0, 0, 0.1f * i) : Eigen::Vector3f(0.05f * (i - 20), 0, 2 + 0.1f * (i - 20));
+        t.skeleton.add_node(at, 0.2f - 0.005f * i + (i == 15 ? 0.003f : 0.0f), i - 1);
+    }
+    for (int k = 1; k <= 5; ++k) t.skeleton.add_node({0.1f * k, 0, 1.0f}, 0.03f, k == 1 ? 10 : 30 + k - 1);
+    t.lobes.resize(1);
+    t.lobes[0].seed_node = 5;
+    return t;
+}
+
+TEST(Tlobe, StraightSkeletonStretchesAreStoredByTheirEnds) {
+    const LobeTree t = tree_with_straight_chains();
+    const std::string bytes = encode_tlobe(t);
+    const LobeTree d = decode_tlobe(bytes, "thinned.tlobe");
+    // In pre-order, the trunk before the lateral; the bump keeps its neighbours too, as the taper
+    // from the fork or the bend to it would miss their diameters by 4.8 mm.
+    const std::vector<int> kept{0, 5, 10, 14, 15, 16, 20, 30, 31, 35};
+    ASSERT_EQ(d.skeleton.size(), kept.size());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        EXPECT_LE((d.skeleton.nodes[i].position - t.skeleton.nodes[kept[i]].position).cwiseAbs().maxCoeff(), 0.0026f) << "node " << i;
+        EXPECT_NEAR(d.skeleton.nodes[i].radius, t.skeleton.nodes[kept[i]].radius, 0.00026f) << "node " << i;
+    }
+    EXPECT_EQ(d.lobes[0].seed_node, 1);
+    EXPECT_TRUE(encode_tlobe(d) == bytes) << "thinning the decoded tree again changed the bytes";
+    TlobeOptions every_node;
+    every_node.skeleton_tolerance = 0;
+    EXPECT_EQ(decode_tlobe(encode_tlobe(t, every_node), "all.tlobe").skeleton.size(), t.skeleton.size());
+    TlobeOptions bad;
+    bad.skeleton_tolerance = -0.01;
+    EXPECT_EQ(error_code_of([&] { encode_tlobe(t, bad); }), ExitCode::Usage);
+}
+
+// On an occupancy grid coarser than 8 x lobe_quantum, lobe vertices lie on an eighth of its cell.
+TEST(Tlobe, LobeVerticesOnAnEighthOfACoarseCell) {
+    LobeTree t = sample_tree();
+    for (Lobe& lobe : t.lobes)
+        for (Eigen::Vector3f& v : lobe.mesh.vertices) {
+            v += Eigen::Vector3f(0.013f, 0.007f, 0.011f);  // off the 5 cm grid
+            lobe.cluster_points.push_back(v);
+        }
+    TlobeOptions o;
+    o.occupancy_cells = {0.4};
+    const LobeTree d = decode_tlobe(encode_tlobe(t, o), "coarse_cells.tlobe");
+    ASSERT_FLOAT_EQ(d.lobes[0].occupancy.cell, 0.4f);
+    for (std::size_t k = 0; k < t.lobes.size(); ++k) {
+        expect_same_faces(d.lobes[k].mesh, t.lobes[k].mesh, 0.025f + 1e-4f);
+        for (const auto& v : d.lobes[k].mesh.vertices)
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(v[c] / 0.05f, std::round(v[c] / 0.05f), 1e-3f);
+    }
+    EXPECT_TRUE(encode_tlobe(d, o) == encode_tlobe(t, o)) << "a decoded tree is not encoded on the grid it came on";
+    o.lobe_quantum_per_cell = 0;
+    const LobeTree fine = decode_tlobe(encode_tlobe(t, o), "fine.tlobe");
+    bool off_the_coarse_grid = false;
+    for (const auto& v : fine.lobes[0].mesh.vertices)
+        for (int c = 0; c < 3; ++c) off_the_coarse_grid = off_the_coarse_grid || std::abs(v[c] / 0.05f - std::round(v[c] / 0.05f)) > 1e-3f;
+    EXPECT_TRUE(off_the_coarse_grid);
+}
+
 // Found by the tlobe_payload fuzzer (UBSan: signed overflow adding a huge coordinate delta to its
 // parent's coordinate): a delta-coded coordinate outside the writer's int32 grid is bad input.
 TEST(Tlobe, CoordinateDeltaBeyondTheGridIsBadInputNotAnOverflow) {
