@@ -107,6 +107,9 @@ float blade_area(const PatchLeaf& leaf, LeafShape shape) {
     return shape == LeafShape::Needle ? leaf.length * leaf.width : 0.5f * leaf.length * leaf.width;
 }
 
+// Points a blade is checked at, at most: a damaged file's tiny cells cost no more than this.
+constexpr float kMaxBladeChecks = 64;
+
 // A leaf of a rebuilt tree is drawn only where the scan saw its lobe (every leaf of a lobe
 // without occupancy): its tip in an occupied cell and, for a blade at least two cells long,
 // also every point a cell apart from the tip back to its base, and the base. Such a blade (the
@@ -120,8 +123,11 @@ bool leaf_seen(const Lobe& lobe, const PatchInstance& inst, const PatchLeaf& lea
     const Eigen::Vector3f toward_tip = inst.rotation * leaf.direction, tip = inst.apply(leaf.base) + toward_tip * leaf.length;
     if (!seen.occupied(tip)) return false;
     if (leaf.length < 2 * seen.cell) return true;
-    for (float back = seen.cell; back < leaf.length; back += seen.cell)
-        if (!seen.occupied(tip - toward_tip * back)) return false;
+    // Counted steps: a float sum of a tiny cell would stop growing before it reached the base.
+    const float step = std::max(seen.cell, leaf.length / kMaxBladeChecks);
+    const auto steps = static_cast<int>(std::ceil(leaf.length / step));
+    for (int j = 1; j < steps; ++j)
+        if (!seen.occupied(tip - toward_tip * (static_cast<float>(j) * step))) return false;
     return seen.occupied(tip - toward_tip * leaf.length);
 }
 
