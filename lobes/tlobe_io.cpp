@@ -126,7 +126,7 @@ std::vector<bool> skeleton_nodes_to_keep(const LobeTree& tree, const TlobeOption
 
 // The tree as a file stores it: the main skeleton thinned (skeleton_nodes_to_keep). The
 // reconstruction spaces nodes evenly along straight branches, so most are redundant: the second
-// palm's 277 nodes become 73 at 1 cm and its skeleton 566 bytes 347 (docs/tlobe.md).
+// palm's 277 nodes become 69 at 3 cm and its skeleton 566 bytes 321 (docs/tlobe.md).
 LobeTree with_thinned_skeleton(const LobeTree& tree, const TlobeOptions& o) {
     if (!(o.skeleton_tolerance > 0) || tree.skeleton.size() < 3) return tree;
     LobeTree thinned = tree;

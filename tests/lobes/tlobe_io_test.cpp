@@ -1,4 +1,5 @@
 #include "geometry/closed_mesh.hpp"
+#include "geometry/polyline.hpp"
 #include "lobes/mesh_coder.hpp"
 #include "lobes/occupancy.hpp"
 #include "lobes/tlobe_io.hpp"
@@ -10,6 +11,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -706,6 +708,34 @@ TEST(Tlobe, StraightSkeletonStretchesAreStoredByTheirEnds) {
     TlobeOptions bad;
     bad.skeleton_tolerance = -0.01;
     EXPECT_EQ(error_code_of([&] { encode_tlobe(t, bad); }), ExitCode::Usage);
+}
+
+// A branch that wanders by up to 2 cm about its line: the default tolerance (3 cm) stores it by
+// fewer nodes than 1 cm does, and every node left out lies within the tolerance (plus the
+// 5 mm grid's rounding) of the branch the file stores.
+TEST(Tlobe, SkeletonNodesWithinThreeCentimetresOfTheStoredBranchAreLeftOut) {
+    LobeTree t = sample_tree();
+    t.skeleton = TreeGraph{};
+    constexpr int kNodes = 61;
+    for (int i = 0; i < kNodes; ++i) {
+        const float z = 0.05f * static_cast<float>(i);
+        t.skeleton.add_node({0.02f * std::sin(z * 2.5f), 0.01f * std::cos(z * 4.0f), z}, 0.1f, i - 1);
+    }
+    t.lobes.resize(1);
+    t.lobes[0].seed_node = kNodes - 1;
+    const LobeTree stored = decode_tlobe(encode_tlobe(t), "wandering.tlobe");
+    TlobeOptions one_centimetre;
+    one_centimetre.skeleton_tolerance = 0.01;
+    const std::size_t kept_at_1cm = decode_tlobe(encode_tlobe(t, one_centimetre), "1cm.tlobe").skeleton.size();
+    EXPECT_LT(stored.skeleton.size(), kept_at_1cm);
+    EXPECT_LT(kept_at_1cm, t.skeleton.size());
+    for (const auto& node : t.skeleton.nodes) {
+        float nearest = std::numeric_limits<float>::max();
+        for (std::size_t k = 1; k < stored.skeleton.size(); ++k)
+            nearest = std::min(
+                    nearest, distance_to_segment(node.position, stored.skeleton.nodes[k - 1].position, stored.skeleton.nodes[k].position));
+        EXPECT_LE(nearest, 0.03f + 0.0045f) << "node at z = " << node.position.z();
+    }
 }
 
 // On an occupancy grid coarser than 8 x lobe_quantum, lobe vertices lie on an eighth of its cell.
