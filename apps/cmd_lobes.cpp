@@ -389,6 +389,10 @@ void add_lobes_commands(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--skeleton-tolerance", o->file.skeleton_tolerance,
                "The .tlobe stores the main skeleton without the nodes within this many metres of their chain (0 = every node)")
             ->check(CLI::Range(0.0, 1.0));
+    table->add("--bare-twig-length", o->file.bare_twig_length,
+               "Where the budget binds, the main skeleton's twigs that seed no lobe, up to this many metres, are left out before "
+               "the occupancy grid is coarsened (0 = never)")
+            ->check(CLI::Range(0.0, 100.0));
     table->add("--min-points-per-cell", o->file.min_points_per_cell,
                "Occupancy grids finer than this many lobe points per occupied cell are skipped (0 = any grid)")
             ->check(CLI::Range(0.0, 1000.0));

@@ -138,6 +138,36 @@ LobeTree with_thinned_skeleton(const LobeTree& tree, const TlobeOptions& o) {
     return thinned;
 }
 
+// The tree without the main skeleton's bare twigs: chains from a fork to a tip, up to
+// bare_twig_length long, that seed no lobe (TlobeOptions::bare_twig_length). Chains from the
+// root are kept: they are the trunk. Nothing when the tree has no bare twig.
+std::optional<LobeTree> without_bare_twigs(const LobeTree& tree, const TlobeOptions& o) {
+    const TreeGraph& skeleton = tree.skeleton;
+    std::vector<bool> keep(skeleton.size(), true), seed(skeleton.size(), false);
+    for (const Lobe& lobe : tree.lobes)
+        if (lobe.seed_node >= 0 && static_cast<std::size_t>(lobe.seed_node) < seed.size()) seed[lobe.seed_node] = true;
+    bool any = false;
+    for (const std::vector<int>& chain : tree_chains(skeleton)) {
+        if (chain.size() < 2 || chain.front() == 0 || !skeleton.nodes[chain.back()].children.empty()) continue;
+        double length = 0;
+        bool seeds_a_lobe = false;
+        for (std::size_t k = 1; k < chain.size(); ++k) {
+            length += (skeleton.nodes[chain[k]].position - skeleton.nodes[chain[k - 1]].position).norm();
+            seeds_a_lobe = seeds_a_lobe || seed[chain[k]];
+        }
+        if (seeds_a_lobe || length > o.bare_twig_length) continue;
+        for (std::size_t k = 1; k < chain.size(); ++k) keep[chain[k]] = false;
+        any = true;
+    }
+    if (!any) return std::nullopt;
+    LobeTree pruned = tree;
+    std::vector<int> new_index;
+    pruned.skeleton = keep_nodes(skeleton, keep, new_index);
+    for (Lobe& lobe : pruned.lobes)
+        if (lobe.seed_node >= 0 && static_cast<std::size_t>(lobe.seed_node) < new_index.size()) lobe.seed_node = new_index[lobe.seed_node];
+    return pruned;
+}
+
 // A lobe's leaf share in one byte: 0..kLeafShareSteps for 0..1, kUnknownLeafShare when unknown.
 constexpr std::uint8_t kLeafShareSteps = 254, kUnknownLeafShare = 255;
 
@@ -159,6 +189,8 @@ void check_options(const TlobeOptions& o) {
     if (!(o.skeleton_tolerance >= 0 && o.skeleton_tolerance <= 1) ||
         !(o.skeleton_diameter_tolerance >= 0 && o.skeleton_diameter_tolerance <= 1))
         throw Error::usage("tlobe: skeleton tolerances must be in [0, 1] metres");
+    if (!(o.bare_twig_length >= 0 && std::isfinite(o.bare_twig_length)))
+        throw Error::usage("tlobe: the bare twig length must be >= 0 metres");
     if (!(o.min_points_per_cell >= 0 && std::isfinite(o.min_points_per_cell)))
         throw Error::usage("tlobe: the points per occupancy cell must be a number >= 0");
 }
@@ -290,6 +322,15 @@ std::string encode_tlobe(const LobeTree& unthinned, const TlobeOptions& o) {
         while (simplified.size() < k) simplified.push_back(with_coarser_lobes(tree, o.lobe_face_fractions[simplified.size()], o.min_lobe_faces));
         return k == 0 ? tree : simplified[k - 1];
     };
+    std::optional<LobeTree> bare;  // the skeleton and lobe seeds without the bare twigs
+    if (o.bare_twig_length > 0)
+        if (auto pruned = without_bare_twigs(unthinned, o)) bare = with_thinned_skeleton(*pruned, o);
+    const auto without_twigs = [&](std::size_t k) {  // surfaces(k) on the skeleton of `bare`
+        LobeTree t = surfaces(k);
+        t.skeleton = bare->skeleton;
+        for (std::size_t i = 0; i < t.lobes.size(); ++i) t.lobes[i].seed_node = bare->lobes[i].seed_node;
+        return t;
+    };
     const std::size_t simplest = o.lobe_face_fractions.size(), per_grid = std::min(o.simplifications_per_grid, simplest);
     for (std::size_t deepest = per_grid; deepest <= simplest; ++deepest) {
         const std::size_t fullest = deepest == per_grid ? 0 : deepest;
@@ -298,10 +339,14 @@ std::string encode_tlobe(const LobeTree& unthinned, const TlobeOptions& o) {
             if (!grids || (c + 1 < o.occupancy_cells.size() && points_per_occupied_cell(tree, *grids) < o.min_points_per_cell)) continue;
             std::vector<const Occupancy*> use(grids->size());
             for (std::size_t i = 0; i < grids->size(); ++i) use[i] = &(*grids)[i];
-            const auto file_with = [&](std::size_t k) { return pack(encode_payload(surfaces(k), o, use), o.compression_level); };
-            if (file_with(deepest).size() > o.max_bytes) continue;  // one pass rules out a grid that does not fit at all
+            const auto file_of = [&](const LobeTree& t) { return pack(encode_payload(t, o, use), o.compression_level); };
+            // One pass rules out a grid that does not fit at all; the smallest file at this grid
+            // is the last resort at it.
+            std::string smallest = file_of(bare ? without_twigs(deepest) : surfaces(deepest));
+            if (smallest.size() > o.max_bytes) continue;
             for (std::size_t k = fullest; k <= deepest; ++k)
-                if (std::string file = file_with(k); file.size() <= o.max_bytes) return file;
+                if (std::string file = file_of(surfaces(k)); file.size() <= o.max_bytes) return file;
+            return smallest;
         }
     }
     const Occupancy none;

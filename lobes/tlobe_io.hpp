@@ -61,13 +61,21 @@ struct TlobeOptions {
     std::vector<double> lobe_face_fractions{0.5, 0.25, 0.125, 0.0625};
     std::size_t simplifications_per_grid = 3;
     std::size_t min_lobe_faces = 12;
+    // Metres: at a grid where the surfaces simplified that far still do not fit, the main
+    // skeleton's bare twigs up to this long are left out before a coarser grid is tried. A bare
+    // twig is a chain from a fork to a tip that seeds no lobe: a cluster with too few points for
+    // a lobe, whose edges went back to the main structure (docs/lobes.md), drawn as a thin
+    // cylinder with no leaves. One sample of the second palm has 40 of them (0.1-1 m, 15 m in
+    // all): without them its file keeps 30 instead of 40 cm cells and meets the crown-outline
+    // target (docs/rebuild.md). 0: twigs are never left out.
+    double bare_twig_length = 1.0;
 };
 
 // Bytes of the file. Lobes with cluster_points get their occupancy on the finest grid of
 // occupancy_cells (rounded to the quantum) at which the file fits max_bytes, with the surfaces
 // as they are or simplified (lobe_face_fractions, up to simplifications_per_grid) as far as that
-// grid needs, then the further fractions the same way; if no grid fits even then, the most
-// simplified surfaces are stored without occupancy. Lobes without
+// grid needs, and then without the bare twigs (bare_twig_length), then the further fractions the
+// same way; if no grid fits even then, the most simplified surfaces are stored without occupancy. Lobes without
 // cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options
 // out of range or coordinates the grid cannot hold.
 std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {});

@@ -111,6 +111,7 @@ TEST(LobesReal, CliExitCodes) {
     const auto input = test::real_data("adtree/tree13.xyz");
     EXPECT_EQ(test::run_cli("lobes " + input.string() + " --out " + dir.path().string() + " --alpha-factor 0.5").exit_code, 1);
     EXPECT_EQ(test::run_cli("lobes " + input.string() + " --out " + dir.path().string() + " --skeleton-tolerance -0.01").exit_code, 1);
+    EXPECT_EQ(test::run_cli("lobes " + input.string() + " --out " + dir.path().string() + " --bare-twig-length -1").exit_code, 1);
     test::write_text(dir / "bad.tlobe", "TLOB not really");
     const auto bad = test::run_cli("synthesize " + (dir / "bad.tlobe").string() + " --out " + (dir / "x.ply").string());
     EXPECT_EQ(bad.exit_code, 2);

@@ -602,6 +602,51 @@ TEST(Tlobe, SurfacesAreSimplifiedBeforeTheGridGrowsCoarse) {
     EXPECT_EQ(encode_tlobe(t, o), coarse_file);
 }
 
+// The main skeleton's bare twigs (a fork to a tip that seeds no lobe: a cluster too small for a
+// lobe) go before the grid grows coarse: with a budget one byte below the whole tree's file on
+// the fine grid, the file keeps that grid without the three short twigs and keeps the long one;
+// with bare_twig_length 0 it falls to the coarse grid with every twig, and within the default
+// budget every twig is kept on the fine grid.
+TEST(Tlobe, BareTwigsAreLeftOutBeforeTheGridGrowsCoarse) {
+    LobeTree t = tree_with_ball_lobes();
+    const auto add_twig = [&](const Eigen::Vector3f& direction, float length) {
+        int node = 1;  // the fork below both lobes
+        for (int k = 1; k <= 3; ++k)
+            node = t.skeleton.add_node(t.skeleton.nodes[1].position + direction.normalized() * (length * static_cast<float>(k) / 3), 0.01f,
+                                       node);
+        return node;
+    };
+    for (const Eigen::Vector3f& direction : {Eigen::Vector3f(1, 0, 0.2f), Eigen::Vector3f(0, 1, 0.3f), Eigen::Vector3f(-1, -1, 0.1f)})
+        add_twig(direction, 0.4f);
+    const int long_tip = add_twig(Eigen::Vector3f(0, -1, 0.5f), 1.5f);
+    const Eigen::Vector3f long_tip_position = t.skeleton.nodes[long_tip].position;
+    ASSERT_EQ(t.skeleton.tip_count(), 6u);
+
+    TlobeOptions o;
+    o.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 5 cm cells
+    o.lobe_face_fractions.clear();
+    o.occupancy_cells = {0.05};
+    const std::size_t whole_on_fine = encode_tlobe(t, o).size();
+    o.occupancy_cells = {0.05, 0.6};
+    EXPECT_EQ(decode_tlobe(encode_tlobe(t, o), "roomy.tlobe").skeleton.tip_count(), 6u);
+
+    o.max_bytes = whole_on_fine - 1;
+    const LobeTree without = decode_tlobe(encode_tlobe(t, o), "without.tlobe");
+    EXPECT_NEAR(without.lobes[0].occupancy.cell, 0.05f, 1e-6f);
+    EXPECT_EQ(without.skeleton.tip_count(), 3u);  // the two lobe seeds and the long twig
+    bool long_twig_kept = false;
+    for (const auto& node : without.skeleton.nodes) long_twig_kept = long_twig_kept || (node.position - long_tip_position).norm() < 0.005f;
+    EXPECT_TRUE(long_twig_kept);
+    for (const Lobe& lobe : without.lobes) EXPECT_TRUE(without.skeleton.nodes[lobe.seed_node].children.empty());
+
+    o.bare_twig_length = 0;
+    const LobeTree coarse = decode_tlobe(encode_tlobe(t, o), "coarse.tlobe");
+    EXPECT_NEAR(coarse.lobes[0].occupancy.cell, 0.6f, 1e-6f);
+    EXPECT_EQ(coarse.skeleton.tip_count(), 6u);
+    o.bare_twig_length = -1;
+    EXPECT_EQ(error_code_of([&] { encode_tlobe(t, o); }), ExitCode::Usage);
+}
+
 // The simplifications beyond simplifications_per_grid come only when no grid fits with fewer:
 // a budget that a 2 cm grid meets only with the surfaces at 1/16 keeps the 0.6 m grid when the
 // surfaces may be simplified to 1/8 at each grid (the default), the 2 cm one when to 1/16.
