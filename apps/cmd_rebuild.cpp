@@ -196,8 +196,10 @@ void print_summary(const json& r) {
                 s["within_budget"].get<bool>() ? "" : ", exceeded: the skeleton and simplest lobes need more",
                 s["dbf6_bytes"].get<double>() / 1e3, r["lobes"]["count"].get<std::size_t>());
     const json& cell = s["tlobe_occupancy_cell_m"];
-    std::printf("           lobes stored with %zu of their %zu faces, %s\n", s["tlobe_lobe_faces"].get<std::size_t>(),
+    const std::size_t derived = s["tlobe_surfaces_from_occupancy"].get<std::size_t>();
+    std::printf("           lobes stored with %zu of their %zu faces%s, %s\n", s["tlobe_lobe_faces"].get<std::size_t>(),
                 r["lobes"]["faces"].get<std::size_t>(),
+                derived == 0 ? "" : (" (" + std::to_string(derived) + " surfaces derived from the occupancy)").c_str(),
                 cell.is_null() ? "no occupancy (no room in the budget)"
                                : ("occupancy on " + std::to_string(std::lround(100 * cell.get<double>())) + " cm cells").c_str());
     std::printf("  rebuilt  %zu triangles; distance mean %.3f m (%.2f %% of the diagonal), p95 %.3f m, Hausdorff %.3f m\n",
@@ -313,7 +315,13 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
     const double dbf6_bytes = static_cast<double>(file_bytes(dbf6_path));
     std::size_t lobe_faces = 0, stored_lobe_faces = 0;
     for (const auto& lobe : tree.lobes) lobe_faces += lobe.mesh.faces.size();
-    for (const auto& lobe : stored.lobes) stored_lobe_faces += lobe.mesh.faces.size();
+    std::size_t derived_surfaces = 0;
+    for (const auto& lobe : stored.lobes) {
+        if (lobe.surface_from_occupancy)
+            ++derived_surfaces;
+        else
+            stored_lobe_faces += lobe.mesh.faces.size();
+    }
     // What the budget left of the lobes (docs/tlobe.md): their surfaces' faces and the cell of
     // their occupancy, which all lobes of a file share (none when the budget had no room).
     const json occupancy_cell = stored.lobes.empty() || stored.lobes.front().occupancy.empty()
@@ -383,6 +391,7 @@ int run_rebuild(RebuildCliOptions& o, const OptionTable& table, const GlobalOpti
                      {"budget_bytes", file_options.max_bytes},
                      {"within_budget", tlobe_bytes.size() <= file_options.max_bytes},
                      {"tlobe_lobe_faces", stored_lobe_faces},
+                     {"tlobe_surfaces_from_occupancy", derived_surfaces},
                      {"tlobe_occupancy_cell_m", occupancy_cell},
                      {"compression_factor", rounded(original_bytes / static_cast<double>(tlobe_bytes.size()), 1)},
                      {"compression_factor_dbf6", dbf6_bytes > 0 ? json(rounded(original_bytes / dbf6_bytes, 1)) : json()}}},

@@ -122,7 +122,7 @@ nlohmann::json describe_tlobe(const fs::path& path) {
     j["root_diameter"] = tree.root_diameter;
     j["leaf_area_m2"] = tree.leaf_area_m2 > 0 ? nlohmann::json(tree.leaf_area_m2) : nlohmann::json();
     j["main_skeleton"] = skeleton_json(tree.skeleton);
-    std::size_t faces = 0, vertices = 0, with_occupancy = 0;
+    std::size_t faces = 0, vertices = 0, with_occupancy = 0, occupied_cells = 0, derived = 0;
     float finest = 0, coarsest = 0;
     Bounds bounds;
     for (const auto& node : tree.skeleton.nodes) bounds.add_local(tree.skeleton.origin, node.position);
@@ -130,12 +130,19 @@ nlohmann::json describe_tlobe(const fs::path& path) {
         faces += lobe.mesh.faces.size();
         vertices += lobe.mesh.vertices.size();
         for (const auto& v : lobe.mesh.vertices) bounds.add_local(tree.skeleton.origin, v);
+        if (lobe.surface_from_occupancy) ++derived;
         if (lobe.occupancy.empty()) continue;
         ++with_occupancy;
+        occupied_cells += lobe.occupancy.occupied_count();
         finest = finest == 0 ? lobe.occupancy.cell : std::min(finest, lobe.occupancy.cell);
         coarsest = std::max(coarsest, lobe.occupancy.cell);
     }
-    j["lobes"] = {{"count", tree.lobes.size()}, {"faces", faces}, {"vertices", vertices}, {"with_occupancy", with_occupancy}};
+    j["lobes"] = {{"count", tree.lobes.size()},
+                  {"faces", faces},
+                  {"vertices", vertices},
+                  {"with_occupancy", with_occupancy},
+                  {"occupied_cells", occupied_cells},
+                  {"surfaces_from_occupancy", derived}};
     if (with_occupancy > 0) j["lobes"]["occupancy_cell_m"] = {finest, coarsest};
     j["bounds"] = bounds.json();
     return j;
@@ -195,8 +202,11 @@ void print_tlobe(const nlohmann::json& j) {
     std::printf("  %s: %zu faces, %zu vertices", counted(lobes["count"], "lobe").c_str(), lobes["faces"].get<std::size_t>(),
                 lobes["vertices"].get<std::size_t>());
     if (lobes.contains("occupancy_cell_m"))
-        std::printf("; occupancy in %zu, cells %.3f .. %.3f m", lobes["with_occupancy"].get<std::size_t>(),
-                    lobes["occupancy_cell_m"][0].get<double>(), lobes["occupancy_cell_m"][1].get<double>());
+        std::printf("; occupancy in %zu, %zu cells of %.3f .. %.3f m", lobes["with_occupancy"].get<std::size_t>(),
+                    lobes["occupied_cells"].get<std::size_t>(), lobes["occupancy_cell_m"][0].get<double>(),
+                    lobes["occupancy_cell_m"][1].get<double>());
+    if (const auto derived = lobes["surfaces_from_occupancy"].get<std::size_t>(); derived > 0)
+        std::printf("; %zu surfaces derived from the occupancy", derived);
     std::printf("\n");
     std::printf("  root diameter %.3f m", j["root_diameter"].get<double>());
     if (!j["leaf_area_m2"].is_null()) std::printf(", leaf area %.1f m^2", j["leaf_area_m2"].get<double>());

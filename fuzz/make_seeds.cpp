@@ -199,14 +199,24 @@ void tlobe_seeds(const fs::path& source, const fs::path& out) {
     }
     const std::string file = lobes::encode_tlobe(tree);
     write_bytes(out / "tlobe/lagerstroemia.tlobe", file);
-    // The payload seed: the inflated bytes behind the 20-byte header (docs/tlobe.md).
-    std::uint32_t raw_size = 0;
-    for (int i = 0; i < 4; ++i) raw_size |= static_cast<std::uint32_t>(static_cast<unsigned char>(file[8 + i])) << (8 * i);
-    std::string raw(raw_size, '\0');
-    uLongf unpacked = raw_size;
-    uncompress(reinterpret_cast<Bytef*>(raw.data()), &unpacked, reinterpret_cast<const Bytef*>(file.data() + 20),
-               static_cast<uLong>(file.size() - 20));
-    write_bytes(out / "tlobe_payload/lagerstroemia.payload", raw);
+    // A budget one byte short of it: the lobes are stored without surfaces, which the reader
+    // derives from their occupancy (version 6.0).
+    lobes::TlobeOptions tight;
+    tight.max_bytes = file.size() - 1;
+    const std::string derived = lobes::encode_tlobe(tree, tight);
+    write_bytes(out / "tlobe/lagerstroemia_derived.tlobe", derived);
+    // The payload seeds: the inflated bytes behind the 20-byte header (docs/tlobe.md).
+    const auto payload = [](const std::string& bytes) {
+        std::uint32_t raw_size = 0;
+        for (int i = 0; i < 4; ++i) raw_size |= static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[8 + i])) << (8 * i);
+        std::string raw(raw_size, '\0');
+        uLongf unpacked = raw_size;
+        uncompress(reinterpret_cast<Bytef*>(raw.data()), &unpacked, reinterpret_cast<const Bytef*>(bytes.data() + 20),
+                   static_cast<uLong>(bytes.size() - 20));
+        return raw;
+    };
+    write_bytes(out / "tlobe_payload/lagerstroemia.payload", payload(file));
+    write_bytes(out / "tlobe_payload/lagerstroemia_derived.payload", payload(derived));
 }
 
 void jointboost_seeds(const fs::path& out) {

@@ -34,6 +34,10 @@ struct Lobe {
     // (LobeOptions::leaf_label_attribute); -1 = unknown. Synthesis draws a
     // lobe's leaves in proportion to it, so that bare twigs stay bare.
     float leaf_share = -1.0f;
+    // The file stores no surface for this lobe: it is derived from the occupancy
+    // (surface_of_occupancy in lobes/occupancy.hpp), what the .tlobe writer does where the
+    // budget binds (docs/tlobe.md, version 6.0). `mesh` then holds the derived surface.
+    bool surface_from_occupancy = false;
     double volume() const { return mesh.signed_volume(); }
     double area() const { return mesh.area(); }
 };

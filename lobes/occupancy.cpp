@@ -2,6 +2,7 @@
 
 #include "core/error.hpp"
 #include "core/range_coder.hpp"
+#include "geometry/alpha_shape.hpp"
 #include "lobes/mesh_coder.hpp"
 
 #include <algorithm>
@@ -271,6 +272,38 @@ Occupancy decode_occupancy_v4(ByteReader& in, double quantum) {
     }
     for (const Node& n : nodes) o.bits[static_cast<std::size_t>((n[0] * o.size[1] + n[1]) * o.size[2] + n[2])] = 1;
     return o;
+}
+
+TriangleMesh surface_of_occupancy(const Occupancy& occupancy, double alpha_factor, const std::string& name) {
+    if (occupancy.empty()) throw Error::input(name, "a lobe stores neither a surface nor an occupancy");
+    if (!(alpha_factor >= 1 && alpha_factor <= 100)) throw Error::input(name, "alpha factor outside [1, 100]");
+    const std::size_t cells = occupancy.occupied_count();
+    if (cells == 0 || cells > kMaxDerivedSurfaceCells)
+        throw Error::input(name, "a lobe surface to derive from " + std::to_string(cells) + " occupied cells (1 to " +
+                                         std::to_string(kMaxDerivedSurfaceCells) + " may be)");
+    // Corners as grid indices, so that the cells sharing one give it once.
+    std::vector<std::array<std::int64_t, 3>> indices;
+    indices.reserve(8 * cells);
+    const std::array<std::int64_t, 3>& size = occupancy.size;
+    for (std::size_t n = 0; n < occupancy.bits.size(); ++n) {
+        if (!occupancy.bits[n]) continue;
+        const auto cell = static_cast<std::int64_t>(n);
+        const std::array<std::int64_t, 3> at{occupancy.first[0] + cell / (size[2] * size[1]),
+                                             occupancy.first[1] + (cell / size[2]) % size[1], occupancy.first[2] + cell % size[2]};
+        for (int k = 0; k < 8; ++k) indices.push_back({at[0] + (k & 1), at[1] + ((k >> 1) & 1), at[2] + ((k >> 2) & 1)});
+    }
+    std::sort(indices.begin(), indices.end());
+    indices.erase(std::unique(indices.begin(), indices.end()), indices.end());
+    std::vector<Eigen::Vector3f> corners;
+    corners.reserve(indices.size());
+    for (const auto& index : indices)
+        corners.push_back(occupancy.cell *
+                          Eigen::Vector3f(static_cast<float>(index[0]), static_cast<float>(index[1]), static_cast<float>(index[2])));
+    AlphaShapeOptions options;
+    options.alpha_factor = alpha_factor;
+    AlphaShapeResult shape = alpha_shape(corners, options);
+    if (shape.mesh.faces.empty()) throw Error::input(name, "no lobe surface around its occupied cells: " + shape.failure);
+    return std::move(shape.mesh);
 }
 
 }  // namespace treelobes::lobes

@@ -7,6 +7,8 @@
 // cell, its size in cells and one bit per cell (x slowest, z fastest).
 #pragma once
 
+#include "core/triangle_mesh.hpp"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -44,6 +46,18 @@ Occupancy occupancy_of(std::span<const Eigen::Vector3f> points, float cell);
 
 // The cells of all lobes of one file: more than this is a damaged file (the writer keeps within it).
 inline constexpr std::size_t kMaxOccupancyCellsPerTree = std::size_t{1} << 26;
+
+// A lobe's surface when its file stores none (.tlobe 6.0): the alpha shape of the occupied
+// cells' corners with alpha = alpha_factor x alpha_min, as the lobes themselves are made of their
+// points (Livny et al. 2011, §4.2). The corners are sorted first, so the surface is the same on
+// every reader. Throws Error(InvalidInput) naming `name` when no alpha shape closes, for an
+// empty occupancy, more than kMaxDerivedSurfaceCells occupied cells (the writer derives only
+// smaller ones; a reader's time stays bounded: an alpha shape of 8 corners per cell) or an alpha
+// factor outside [1, 100].
+inline constexpr std::size_t kMaxDerivedSurfaceCells = std::size_t{1} << 13;
+// All derived surfaces of one file together.
+inline constexpr std::size_t kMaxDerivedSurfaceCellsPerTree = std::size_t{1} << 14;
+TriangleMesh surface_of_occupancy(const Occupancy& occupancy, double alpha_factor, const std::string& name);
 
 // Coding (docs/tlobe.md, version 5): each lobe's grid (uvar cell / quantum, 0 = none; svar
 // first; uvar size) stands with its lobe, and the cells of all lobes follow the lobes as one

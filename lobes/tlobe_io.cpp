@@ -230,7 +230,9 @@ std::string encode_payload(const LobeTree& tree, const TlobeOptions& o, const st
         for (int k = 0; k < 3; ++k) w.svarint(std::lround(lobe.seed_direction[k] * 127.0f));
         if (lobe.mesh.origin != Eigen::Vector3d::Zero() && lobe.mesh.origin != tree.skeleton.origin)
             throw Error(ExitCode::Internal, "tlobe: lobe mesh is not in the tree's frame");
-        encode_mesh(lobe.mesh, lobe_quantum, w);
+        if (lobe.surface_from_occupancy && occupancy[i]->empty())
+            throw Error(ExitCode::Internal, "tlobe: a lobe surface to derive from no occupancy");
+        encode_mesh(lobe.surface_from_occupancy ? TriangleMesh{} : lobe.mesh, lobe_quantum, w);  // 6.0: no faces = derived
         encode_occupancy_grid(*occupancy[i], quantum, w);
     }
     w.string(encode_occupancy_cells(occupancy));  // since 5.0: the cells of all lobes in one stream
@@ -340,12 +342,21 @@ std::string encode_tlobe(const LobeTree& unthinned, const TlobeOptions& o) {
             std::vector<const Occupancy*> use(grids->size());
             for (std::size_t i = 0; i < grids->size(); ++i) use[i] = &(*grids)[i];
             const auto file_of = [&](const LobeTree& t) { return pack(encode_payload(t, o, use), o.compression_level); };
-            // One pass rules out a grid that does not fit at all; the smallest file at this grid
-            // is the last resort at it.
-            std::string smallest = file_of(bare ? without_twigs(deepest) : surfaces(deepest));
+            // One pass rules out a grid that does not fit at all: the smallest file on it, the
+            // last resort there, has no surfaces stored where the occupancy can give them.
+            LobeTree least = bare ? without_twigs(deepest) : surfaces(deepest);
+            for (std::size_t i = 0, derived_cells = 0; i < least.lobes.size(); ++i) {
+                const std::size_t cells = (*grids)[i].empty() ? 0 : (*grids)[i].occupied_count();
+                least.lobes[i].surface_from_occupancy = o.surfaces_from_occupancy && cells > 0 && cells <= kMaxDerivedSurfaceCells &&
+                                                        derived_cells + cells <= kMaxDerivedSurfaceCellsPerTree;
+                if (least.lobes[i].surface_from_occupancy) derived_cells += cells;
+            }
+            std::string smallest = file_of(least);
             if (smallest.size() > o.max_bytes) continue;
             for (std::size_t k = fullest; k <= deepest; ++k)
                 if (std::string file = file_of(surfaces(k)); file.size() <= o.max_bytes) return file;
+            if (bare)
+                if (std::string file = file_of(without_twigs(deepest)); file.size() <= o.max_bytes) return file;
             return smallest;
         }
     }
@@ -421,6 +432,17 @@ LobeTree decode_tlobe_payload(std::string_view raw, const std::string& name, int
         for (std::size_t i = 0; i < grids.size(); ++i) grids[i] = std::move(tree.lobes[i].occupancy);
         decode_occupancy_cells(in.take(in.count(1, "occupancy stream length")), grids, name);
         for (std::size_t i = 0; i < grids.size(); ++i) tree.lobes[i].occupancy = std::move(grids[i]);
+    }
+    if (major >= 6) {  // a lobe without faces has its surface from its occupancy
+        std::size_t derived_cells = 0;
+        for (Lobe& lobe : tree.lobes) {
+            if (!lobe.mesh.faces.empty()) continue;
+            derived_cells += lobe.occupancy.empty() ? 0 : lobe.occupancy.occupied_count();
+            if (derived_cells > kMaxDerivedSurfaceCellsPerTree)
+                in.fail("lobe surfaces to derive from more occupied cells than a file may hold");
+            lobe.mesh = surface_of_occupancy(lobe.occupancy, tree.alpha_factor, name);
+            lobe.surface_from_occupancy = true;
+        }
     }
     const int fields = appended_fields(major, minor);
     if (fields >= 1) {

@@ -365,7 +365,7 @@ TEST(Tlobe, VersionThreeFilesStillRead) {
     const LobeTree v3_2 = decode_tlobe(rewritten(v3_0, 2, with_shares), "3.2.tlobe");
     EXPECT_NEAR(v3_2.lobes.front().leaf_share, 127.0f / 254, 1e-6f);
     EXPECT_EQ(error_code_of([&] { decode_tlobe(rewritten(v3_0, 1, with_shares), "x"); }), ExitCode::InvalidInput);
-    // Encoded again, it becomes a version 5 file with the same lobes (vertices on the 2 cm grid).
+    // Encoded again, it becomes a file of the current version with the same lobes (vertices on the 2 cm grid).
     const LobeTree again = decode_tlobe(encode_tlobe(old), "5.tlobe");
     ASSERT_EQ(again.lobes.size(), old.lobes.size());
     for (std::size_t k = 0; k < old.lobes.size(); ++k) expect_same_faces(again.lobes[k].mesh, old.lobes[k].mesh, 0.01f);
@@ -376,7 +376,7 @@ constexpr std::size_t kAilanthusV4OccupiedCells = 1571;
 // Version 4 files (occupancy as a byte of child bits per octree node, lobe vertices on the
 // skeleton's 5 mm grid) still read: a file the 4.0 writer wrote (`treelobes lobes
 // data/synthetic/ailanthus_altissima_5.las --species ailanthus_altissima --budget-kb 3`), whose
-// five lobes hold occupancy on 3 cm cells; encoded again as version 5, the cells are the same.
+// five lobes hold occupancy on 3 cm cells; encoded again in the current version, the cells are the same.
 TEST(Tlobe, VersionFourFilesStillRead) {
     const std::string v4 = file_bytes(test::source_dir() / "tests/data/tlobe/ailanthus_altissima_v4_0.tlobe");
     ASSERT_EQ(v4[4], 4);
@@ -389,10 +389,10 @@ TEST(Tlobe, VersionFourFilesStillRead) {
         occupied += lobe.occupancy.occupied_count();
     }
     EXPECT_EQ(occupied, kAilanthusV4OccupiedCells);
-    const std::string v5 = encode_tlobe(old);
-    EXPECT_EQ(v5[4], 5);
-    EXPECT_LT(v5.size(), v4.size());
-    const LobeTree again = decode_tlobe(v5, "5.tlobe");
+    const std::string now = encode_tlobe(old);
+    EXPECT_EQ(now[4], kTlobeMajorVersion);
+    EXPECT_LT(now.size(), v4.size());
+    const LobeTree again = decode_tlobe(now, "now.tlobe");
     for (std::size_t k = 0; k < old.lobes.size(); ++k) {
         EXPECT_EQ(again.lobes[k].occupancy, old.lobes[k].occupancy);
         expect_same_faces(again.lobes[k].mesh, old.lobes[k].mesh, 0.01f);
@@ -468,6 +468,7 @@ TEST(Tlobe, OccupancyRoundTripOnTheFinestGridThatFits) {
     LobeTree t = sample_tree();
     for (Lobe& lobe : t.lobes) lobe.cluster_points = corner_points(t.seed_position(lobe) + Eigen::Vector3f(0, 0, 0.5f));
     TlobeOptions every_grid;  // the grids finer than the points can draw are tested below
+    every_grid.surfaces_from_occupancy = false;  // the stored surfaces' ladder (derived ones: further below)
     every_grid.min_points_per_cell = 0;
     const std::string bytes = encode_tlobe(t, every_grid);
     const LobeTree d = decode_tlobe(bytes, "occupied.tlobe");
@@ -581,6 +582,7 @@ TEST(Tlobe, SurfacesAreSimplifiedBeforeTheGridGrowsCoarse) {
     const LobeTree t = tree_with_ball_lobes();
     const std::size_t full_faces = t.lobes[0].mesh.faces.size();
     TlobeOptions full_and_coarse;
+    full_and_coarse.surfaces_from_occupancy = false;  // the stored surfaces' ladder
     full_and_coarse.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 5 cm cells
     full_and_coarse.occupancy_cells = {0.6};
     const std::string coarse_file = encode_tlobe(t, full_and_coarse);
@@ -623,6 +625,7 @@ TEST(Tlobe, BareTwigsAreLeftOutBeforeTheGridGrowsCoarse) {
     ASSERT_EQ(t.skeleton.tip_count(), 6u);
 
     TlobeOptions o;
+    o.surfaces_from_occupancy = false;  // the stored surfaces' ladder
     o.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 5 cm cells
     o.lobe_face_fractions.clear();
     o.occupancy_cells = {0.05};
@@ -647,6 +650,83 @@ TEST(Tlobe, BareTwigsAreLeftOutBeforeTheGridGrowsCoarse) {
     EXPECT_EQ(error_code_of([&] { encode_tlobe(t, o); }), ExitCode::Usage);
 }
 
+// A lobe's surface derived from its occupancy (.tlobe 6.0): closed, around every occupied cell,
+// the same on every call; an occupancy too large or empty, or a bad alpha factor, is bad input.
+TEST(Occupancy, SurfaceDerivedAroundEveryOccupiedCell) {
+    std::vector<Eigen::Vector3f> points;
+    for (int i = 0; i < 6; ++i) points.emplace_back(0.05f + 0.1f * static_cast<float>(i), 0.05f, 0.05f);  // an L of cells
+    for (int k = 1; k < 4; ++k) points.emplace_back(0.05f, 0.05f, 0.05f + 0.1f * static_cast<float>(k));
+    const Occupancy occupancy = occupancy_of(points, 0.1f);
+    ASSERT_EQ(occupancy.occupied_count(), 9u);
+    const TriangleMesh surface = surface_of_occupancy(occupancy, 5.0, "l.tlobe");
+    EXPECT_TRUE(check_closed(surface).closed());
+    EXPECT_GT(surface.signed_volume(), 0.0);
+    Eigen::Vector3f low = surface.vertices.front(), high = low;
+    for (const Eigen::Vector3f& v : surface.vertices) {
+        low = low.cwiseMin(v);
+        high = high.cwiseMax(v);
+    }
+    for (std::size_t i = 0; i < occupancy.bits.size(); ++i)
+        if (occupancy.bits[i]) {
+            const Eigen::Vector3f c = occupancy.cell_centre(i);
+            EXPECT_TRUE((c.array() > low.array()).all() && (c.array() < high.array()).all()) << c.transpose();
+        }
+    EXPECT_NEAR(high.x() - low.x(), 0.6f, 1e-5f);
+    EXPECT_NEAR(high.z() - low.z(), 0.4f, 1e-5f);
+    const TriangleMesh again = surface_of_occupancy(occupancy, 5.0, "l.tlobe");
+    EXPECT_EQ(again.vertices, surface.vertices);
+    EXPECT_EQ(again.faces, surface.faces);
+
+    EXPECT_EQ(error_code_of([&] { surface_of_occupancy(Occupancy{}, 5.0, "x"); }), ExitCode::InvalidInput);
+    EXPECT_EQ(error_code_of([&] { surface_of_occupancy(occupancy, std::nan(""), "x"); }), ExitCode::InvalidInput);
+    Occupancy full;
+    full.cell = 0.1f;
+    full.size = {32, 32, 9};
+    full.bits.assign(32 * 32 * 9, 1);  // 9,216 cells: more than a lobe may derive from
+    EXPECT_EQ(error_code_of([&] { surface_of_occupancy(full, 5.0, "x"); }), ExitCode::InvalidInput);
+}
+
+// Where the stored surfaces leave no room even for the finest grid, the file stores none and the
+// reader derives them from the occupancy (version 6.0): the file keeps the fine grid, its lobes
+// are closed around their cells, re-encoding gives the same bytes; within a roomy budget the
+// surfaces are stored. A lobe with neither surface nor occupancy is bad input, and in a 5.0
+// file a lobe without faces stays without (5.0 writers never made one).
+TEST(Tlobe, SurfacesComeFromTheOccupancyWhereNothingElseFits) {
+    const LobeTree t = tree_with_ball_lobes();
+    TlobeOptions o;
+    o.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 5 cm cells
+    o.lobe_face_fractions.clear();
+    o.occupancy_cells = {0.05};
+    const std::string stored_on_fine = encode_tlobe(t, o);
+    const LobeTree roomy = decode_tlobe(stored_on_fine, "roomy.tlobe");
+    EXPECT_EQ(stored_on_fine[4], 6);
+    for (std::size_t k = 0; k < t.lobes.size(); ++k) {
+        EXPECT_FALSE(roomy.lobes[k].surface_from_occupancy);
+        EXPECT_EQ(roomy.lobes[k].mesh.faces.size(), t.lobes[k].mesh.faces.size());
+    }
+
+    o.occupancy_cells = {0.05, 0.6};
+    o.max_bytes = stored_on_fine.size() - 1;
+    const std::string bytes = encode_tlobe(t, o);
+    EXPECT_LE(bytes.size(), o.max_bytes);
+    const LobeTree derived = decode_tlobe(bytes, "derived.tlobe");
+    for (const Lobe& lobe : derived.lobes) {
+        EXPECT_TRUE(lobe.surface_from_occupancy);
+        EXPECT_NEAR(lobe.occupancy.cell, 0.05f, 1e-6f);
+        EXPECT_TRUE(check_closed(lobe.mesh).closed());
+        EXPECT_GT(lobe.mesh.signed_volume(), 0.9 * 0.05 * 0.05 * 0.05 * static_cast<double>(lobe.occupancy.occupied_count()));
+    }
+    EXPECT_TRUE(encode_tlobe(derived) == bytes) << "re-encoding a tree with derived surfaces changed the bytes";
+
+    LobeTree hollow = sample_tree();  // no occupancy: nothing to derive a surface from
+    hollow.lobes[0].mesh = TriangleMesh{};
+    const std::string no_surface = encode_tlobe(hollow);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(no_surface, "hollow.tlobe"); }), ExitCode::InvalidInput);
+    std::string five = no_surface;
+    five[4] = 5;
+    EXPECT_TRUE(decode_tlobe(rewritten(five, 0, [](std::string&) {}), "five.tlobe").lobes[0].mesh.faces.empty());
+}
+
 // The simplifications beyond simplifications_per_grid come only when no grid fits with fewer:
 // a budget that a 2 cm grid meets only with the surfaces at 1/16 keeps the 0.6 m grid when the
 // surfaces may be simplified to 1/8 at each grid (the default), the 2 cm one when to 1/16.
@@ -656,6 +736,7 @@ TEST(Tlobe, DeepSimplificationsWaitForEveryGrid) {
     // budget one byte below the full surfaces' file on that grid makes the encoder simplify them.
     const auto size_with = [&](double cell, double fraction) {
         TlobeOptions o;
+        o.surfaces_from_occupancy = false;  // the stored surfaces' ladder
         o.min_points_per_cell = 0;  // the ball's 3,050 points are too few for 2 cm cells
         o.occupancy_cells = {cell};
         o.lobe_face_fractions.clear();
@@ -670,6 +751,7 @@ TEST(Tlobe, DeepSimplificationsWaitForEveryGrid) {
     ASSERT_LE(size_with(0.6, 0.125), fine_sixteenth);
 
     TlobeOptions budget;
+    budget.surfaces_from_occupancy = false;
     budget.min_points_per_cell = 0;
     budget.occupancy_cells = {0.02, 0.6};
     budget.max_bytes = fine_sixteenth;
