@@ -168,6 +168,28 @@ std::optional<LobeTree> without_bare_twigs(const LobeTree& tree, const TlobeOpti
     return pruned;
 }
 
+// The last major version whose readers take a lobe mesh without faces as it is (6.0 derives it).
+constexpr int kLastMajorWithStoredSurfacesOnly = 5;
+
+// Lobes of `t` to have their surfaces derived (Lobe::surface_from_occupancy) whose occupancy, as
+// a reader decodes it from `payload`, gives no closed alpha shape (a few configurations of cells
+// do not: one lobe of 26 in 20 samples of terminalia forced to derive every surface) keep their
+// stored surfaces. Returns whether any did.
+bool keep_underivable_surfaces(LobeTree& t, const std::string& payload) {
+    const LobeTree seen = decode_tlobe_payload(payload, "tlobe writer", kLastMajorWithStoredSurfacesOnly, kTlobeMinorVersion);
+    bool kept = false;
+    for (std::size_t i = 0; i < t.lobes.size(); ++i) {
+        if (!t.lobes[i].surface_from_occupancy) continue;
+        try {
+            surface_of_occupancy(seen.lobes[i].occupancy, seen.alpha_factor, "tlobe writer");
+        } catch (const Error&) {
+            t.lobes[i].surface_from_occupancy = false;
+            kept = true;
+        }
+    }
+    return kept;
+}
+
 // A lobe's leaf share in one byte: 0..kLeafShareSteps for 0..1, kUnknownLeafShare when unknown.
 constexpr std::uint8_t kLeafShareSteps = 254, kUnknownLeafShare = 255;
 
@@ -357,6 +379,10 @@ std::string encode_tlobe(const LobeTree& unthinned, const TlobeOptions& o) {
                 if (std::string file = file_of(surfaces(k)); file.size() <= o.max_bytes) return file;
             if (bare)
                 if (std::string file = file_of(without_twigs(deepest)); file.size() <= o.max_bytes) return file;
+            if (keep_underivable_surfaces(least, encode_payload(least, o, use))) {
+                smallest = file_of(least);
+                if (smallest.size() > o.max_bytes) continue;
+            }
             return smallest;
         }
     }

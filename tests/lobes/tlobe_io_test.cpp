@@ -727,6 +727,48 @@ TEST(Tlobe, SurfacesComeFromTheOccupancyWhereNothingElseFits) {
     EXPECT_TRUE(decode_tlobe(rewritten(five, 0, [](std::string&) {}), "five.tlobe").lobes[0].mesh.faces.empty());
 }
 
+// Terminalia's file of the rebuild bench (sample 13) written with every surface it could derive
+// derived: its first lobe's 7,928 cells of 14 cm give no closed alpha shape, so the writer kept
+// that lobe's surface. Writing the same lobes from points at the same grid under a tight budget
+// keeps it again, and the file reads; a file that claimed that lobe's surface from its cells
+// would be bad input.
+TEST(Tlobe, SurfacesTheCellsCannotGiveAreKept) {
+    const LobeTree file = decode_tlobe(file_bytes(test::source_dir() / "tests/data/tlobe/terminalia_v6_0.tlobe"), "terminalia.tlobe");
+    ASSERT_FALSE(file.lobes[0].surface_from_occupancy);
+    EXPECT_EQ(error_code_of([&] { surface_of_occupancy(file.lobes[0].occupancy, file.alpha_factor, "x"); }), ExitCode::InvalidInput);
+
+    LobeTree from_points = file;  // the underivable lobe and the first two that derive
+    from_points.lobes = {file.lobes[0]};
+    for (const Lobe& lobe : file.lobes)
+        if (lobe.surface_from_occupancy && from_points.lobes.size() < 3) from_points.lobes.push_back(lobe);
+    ASSERT_EQ(from_points.lobes.size(), 3u);
+    for (Lobe& lobe : from_points.lobes) {
+        lobe.surface_from_occupancy = false;
+        for (std::size_t i = 0; i < lobe.occupancy.bits.size(); ++i)
+            if (lobe.occupancy.bits[i]) lobe.cluster_points.push_back(lobe.occupancy.cell_centre(i));
+        lobe.occupancy = Occupancy{};
+    }
+    TlobeOptions o;
+    o.min_points_per_cell = 0;
+    o.lobe_face_fractions.clear();
+    o.occupancy_cells = {file.lobes[0].occupancy.cell};
+    o.skeleton_tolerance = 0;
+    o.bare_twig_length = 0;  // the seeds of the lobes left out would be bare twigs
+    o.max_bytes = 1000000;
+    const std::size_t stored = encode_tlobe(from_points, o).size();
+    o.max_bytes = stored - 1;
+    const std::string bytes = encode_tlobe(from_points, o);
+    const LobeTree written = decode_tlobe(bytes, "written.tlobe");
+    EXPECT_FALSE(written.lobes[0].surface_from_occupancy);
+    EXPECT_EQ(written.lobes[0].occupancy, file.lobes[0].occupancy);
+    EXPECT_TRUE(written.lobes[1].surface_from_occupancy);
+    EXPECT_TRUE(written.lobes[2].surface_from_occupancy);
+
+    LobeTree claimed = file;
+    claimed.lobes[0].surface_from_occupancy = true;
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(encode_tlobe(claimed), "claimed.tlobe"); }), ExitCode::InvalidInput);
+}
+
 // The simplifications beyond simplifications_per_grid come only when no grid fits with fewer:
 // a budget that a 2 cm grid meets only with the surfaces at 1/16 keeps the 0.6 m grid when the
 // surfaces may be simplified to 1/8 at each grid (the default), the 2 cm one when to 1/16.
