@@ -7,9 +7,11 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <numeric>
+#include <optional>
 
 namespace treelobes::lobes {
 
@@ -131,8 +133,31 @@ bool leaf_seen(const Lobe& lobe, const PatchInstance& inst, const PatchLeaf& lea
     return seen.occupied(tip - toward_tip * leaf.length);
 }
 
+// The turns tried, smallest first, for a leaf whose tip the scan did not see: about its base, in
+// its blade's plane, as a leaf turns on its stalk.
+constexpr std::array<float, 7> kLeafTurns{std::numbers::pi_v<float> / 4,     -std::numbers::pi_v<float> / 4,
+                                          std::numbers::pi_v<float> / 2,     -std::numbers::pi_v<float> / 2,
+                                          3 * std::numbers::pi_v<float> / 4, -3 * std::numbers::pi_v<float> / 4,
+                                          std::numbers::pi_v<float>};
+
+// A leaf of a rebuilt tree as it is drawn: as placed where the scan saw it (leaf_seen), else
+// turned by the smallest of kLeafTurns that brings it into seen cells, else not at all. The
+// texturing fits the patches to the lobe's hull, so many leaves point out of the cells where the
+// scan saw foliage. Dropped, they left the seen leaves to carry the stored area: on terminalia's
+// first tree those held 417 of its 1,002 m² and were drawn 1.55 times larger, into the gaps
+// between the crown's tiers; turned, 946 m² are seen at the species' size (docs/rebuild.md).
+std::optional<PatchLeaf> drawn_leaf(const Lobe& lobe, const PatchInstance& inst, const PatchLeaf& leaf) {
+    if (leaf_seen(lobe, inst, leaf)) return leaf;
+    for (const float angle : kLeafTurns) {
+        PatchLeaf turned = leaf;
+        turned.direction = Eigen::AngleAxisf(angle, leaf.normal) * leaf.direction;
+        if (leaf_seen(lobe, inst, turned)) return turned;
+    }
+    return std::nullopt;
+}
+
 // How a tree that stores its leaf area draws its leaves: the share of the offered leaves that
-// are seen (leaf_seen) which it draws, and the factor on their size. The texturing fitted the
+// are seen, as placed or turned (drawn_leaf), which it draws, and the factor on their size. The texturing fitted the
 // patches with their leaves at the species' size, their tips reaching a lobe's outer cells, but
 // the offered leaves hold several times the stored area (the palm's 111 times). Shrinking every
 // blade to that area pulled the crown's rim in (the palm's 0.6 m leaflets were drawn 0.16-0.18 m
@@ -150,7 +175,7 @@ LeafPlan plan_leaf_area(const LobeTree& tree, const TexturedTree& textured, cons
             const Patch& patch = textured.library.patches[inst.patch];
             const std::size_t offered = offered_leaves(patch, textured.leaf_share, leaf_weight, l);
             for (std::size_t i = 0; i < offered; ++i)
-                if (leaf_seen(tree.lobes[l], inst, patch.leaves[i]))
+                if (drawn_leaf(tree.lobes[l], inst, patch.leaves[i]))
                     seen_area += static_cast<double>(blade_area(patch.leaves[i], textured.library.leaf_shape));
         }
     if (!(seen_area > 0)) return {};
@@ -197,7 +222,7 @@ void draw_planned_leaves(const LobeTree& tree, const TexturedTree& textured, con
             const auto kept = std::min(patch.leaves.size(), static_cast<std::size_t>(std::floor(carried)));
             carried -= static_cast<double>(kept);
             for (std::size_t i = 0; i < kept; ++i)
-                if (leaf_seen(tree.lobes[l], inst, patch.leaves[i])) draw_leaf(textured, inst, patch.leaves[i], enlarge, out);
+                if (const auto leaf = drawn_leaf(tree.lobes[l], inst, patch.leaves[i])) draw_leaf(textured, inst, *leaf, enlarge, out);
         }
 }
 

@@ -243,6 +243,26 @@ TEST(Synthesis, LodKeepsThickestEdgesAndLeafArea) {
 namespace {
 
 // Lengths of a broad-leaved mesh's blades (add_leaf: base, side, tip, side).
+// The occupancy of points filling boxed_tree()'s lobe in slabs across x, `slab` metres wide,
+// the last of every `period` slabs empty (the gaps between fronds, or between a crown's tiers).
+Occupancy slabs_across_the_box(float slab, int period, float cell) {
+    std::vector<Eigen::Vector3f> pts;
+    for (float x = -0.9875f; x < 1.0f; x += 0.05f)  // off the slabs' faces
+        for (float y = -0.9875f; y < 1.0f; y += 0.05f)
+            for (float z = 1.9125f; z < 3.4f; z += 0.05f)
+                if (static_cast<int>(std::floor((x + 1.0f) / slab)) % period != period - 1) pts.emplace_back(x, y, z);
+    return occupancy_of(pts, cell);
+}
+
+// Whether the blade whose vertices begin at `first` (add_leaf: base, ..., tip, ...) ends in an
+// occupied cell, up to the final sizing of the leaves to the stored area: a factor within 1 % of
+// 1 that takes up the rounding of the leaf counts, and can move a tip that ended just across a
+// cell's face (as a turn often leaves it) back across it by a fraction of a millimetre.
+bool tip_seen(const TriangleMesh& leaves, std::size_t first, const Occupancy& seen) {
+    const Eigen::Vector3f &base = leaves.vertices[first], &tip = leaves.vertices[first + 2];
+    return seen.occupied(tip) || seen.occupied(base + 1.01f * (tip - base)) || seen.occupied(base + 0.99f * (tip - base));
+}
+
 std::vector<float> blade_lengths(const TriangleMesh& leaves) {
     std::vector<float> lengths;
     for (std::size_t i = 0; i + 3 < leaves.vertices.size(); i += 4) lengths.push_back((leaves.vertices[i + 2] - leaves.vertices[i]).norm());
@@ -306,7 +326,7 @@ TEST(Synthesis, ARebuiltTreeDrawsLeavesAndTwigsOnlyInItsOccupiedCells) {
     const TexturedTree textured = texture_tree(tree, species("lagerstroemia"), o);
     const auto tips_seen = [&](const SynthesizedMesh& mesh) {
         std::size_t in = 0;
-        for (std::size_t i = 2; i < mesh.leaves.vertices.size(); i += 4) in += seen.occupied(mesh.leaves.vertices[i]) ? 1 : 0;
+        for (std::size_t i = 0; i + 3 < mesh.leaves.vertices.size(); i += 4) in += tip_seen(mesh.leaves, i, seen) ? 1 : 0;
         return std::pair{in, mesh.leaf_count};
     };
     std::size_t twigs_seen = 0;
@@ -323,6 +343,46 @@ TEST(Synthesis, ARebuiltTreeDrawsLeavesAndTwigsOnlyInItsOccupiedCells) {
     EXPECT_EQ(rebuilt_in, rebuilt_all);
     EXPECT_EQ(rebuilt.twig_segments, twigs_seen);
     EXPECT_NEAR(rebuilt.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2);
+}
+
+// A rebuilt tree's leaf pointing out of the seen cells is turned about its base into them, not
+// dropped: the stored area is then drawn at the species' size where the leaves seen as placed
+// would have had to be enlarged (by the square root of 1.5 here), and every tip stays in a seen
+// cell. The occupancy: 10 cm cells in slabs one cell thick, one cell apart, across the lobe.
+TEST(Synthesis, LeavesPointingOutOfTheSeenCellsAreTurnedIntoThem) {
+    LobeTree tree = boxed_tree();
+    tree.lobes[0].occupancy = slabs_across_the_box(0.1f, 2, 0.1f);
+    const Occupancy& seen = tree.lobes[0].occupancy;
+    SynthesisOptions o;
+    o.texturing.fill_cell = 0.1;
+    o.library.simplify_tolerance = 0;  // every leaf of the patches offered (no thinning to the twig triangles)
+    const TexturedTree textured = texture_tree(tree, species("lagerstroemia"), o);
+    ASSERT_DOUBLE_EQ(textured.leaf_share, 1.0);
+    const SynthesizedMesh scanned = synthesized_mesh(tree, textured, 1.0, o);  // every leaf as placed, at the species' size
+    const auto [shortest, longest] = std::ranges::minmax(blade_lengths(scanned.leaves));
+    double seen_as_placed = 0;
+    std::size_t seen_count = 0;
+    for (std::size_t i = 0; i + 3 < scanned.leaves.vertices.size(); i += 4)
+        if (seen.occupied(scanned.leaves.vertices[i + 2])) {
+            for (const std::size_t f : {i / 2, i / 2 + 1}) {  // a blade's two triangles
+                const auto& [a, b, c] = scanned.leaves.faces[f];
+                const auto& v = scanned.leaves.vertices;
+                seen_as_placed += 0.5 * static_cast<double>((v[b] - v[a]).cross(v[c] - v[a]).norm());
+            }
+            ++seen_count;
+        }
+    tree.leaf_area_m2 = 1e6;  // more than any leaves hold: every leaf that can be drawn is
+    EXPECT_GT(synthesized_mesh(tree, textured, 1.0, o).leaf_count, seen_count * 3 / 2);
+    tree.leaf_area_m2 = 1.5 * seen_as_placed;
+    const SynthesizedMesh rebuilt = synthesized_mesh(tree, textured, 1.0, o);
+    EXPECT_NEAR(rebuilt.leaves.area(), tree.leaf_area_m2, 1e-3 * tree.leaf_area_m2);
+    for (const float length : blade_lengths(rebuilt.leaves)) {
+        EXPECT_GE(length, 0.98f * shortest);
+        EXPECT_LE(length, 1.02f * longest);
+    }
+    std::size_t tips_seen = 0;
+    for (std::size_t i = 0; i + 3 < rebuilt.leaves.vertices.size(); i += 4) tips_seen += tip_seen(rebuilt.leaves, i, seen) ? 1 : 0;
+    EXPECT_EQ(tips_seen, rebuilt.leaf_count);
 }
 
 // The leaves drawn, and how many of them have their tip, a point a cell apart from it back
@@ -349,12 +409,7 @@ BladeCheck check_blades(const SynthesizedMesh& mesh, const Occupancy& seen) {
 // fronds.
 TEST(Synthesis, LongBladesAreDrawnOnlyAcrossOccupiedCells) {
     LobeTree tree = boxed_tree();
-    std::vector<Eigen::Vector3f> pts;
-    for (float x = -0.99f; x < 1.0f; x += 0.05f)
-        for (float y = -0.99f; y < 1.0f; y += 0.05f)
-            for (float z = 1.91f; z < 3.4f; z += 0.05f)
-                if (static_cast<int>(std::floor((x + 1.0f) / 0.2f)) % 3 != 2) pts.emplace_back(x, y, z);
-    tree.lobes[0].occupancy = occupancy_of(pts, 0.2f);
+    tree.lobes[0].occupancy = slabs_across_the_box(0.2f, 3, 0.2f);
     const Occupancy& seen = tree.lobes[0].occupancy;
     SynthesisOptions o;
     o.texturing.fill_cell = 0.1;
