@@ -769,6 +769,29 @@ TEST(Tlobe, SurfacesTheCellsCannotGiveAreKept) {
     EXPECT_EQ(error_code_of([&] { decode_tlobe(encode_tlobe(claimed), "claimed.tlobe"); }), ExitCode::InvalidInput);
 }
 
+// A reader derives surfaces from at most kMaxDerivedSurfaceCellsPerTree cells per file, so a
+// damaged or hostile file cannot make it build alpha shapes without end: three lobes of 6,000
+// cells each, every one within the per-lobe bound, are bad input together; two of them read.
+TEST(Tlobe, AFileDerivesSurfacesFromABoundedNumberOfCells) {
+    Lobe block = sample_tree().lobes[0];
+    block.mesh = TriangleMesh{};
+    block.surface_from_occupancy = true;
+    const double quantum = static_cast<float>(TlobeOptions{}.quantum);                                      // as the file stores it
+    block.occupancy.cell = static_cast<float>(static_cast<double>(std::llround(0.1 / quantum)) * quantum);  // 10 cm, on the quantum
+    block.occupancy.size = {20, 20, 15};
+    block.occupancy.bits.assign(20 * 20 * 15, 1);
+    ASSERT_LE(block.occupancy.occupied_count(), kMaxDerivedSurfaceCells);
+    LobeTree two = sample_tree();
+    two.lobes = {block, block};
+    const LobeTree read = decode_tlobe(encode_tlobe(two), "two.tlobe");
+    ASSERT_EQ(read.lobes.size(), 2u);
+    for (const Lobe& lobe : read.lobes) EXPECT_TRUE(check_closed(lobe.mesh).closed());
+    LobeTree three = two;
+    three.lobes.push_back(block);
+    ASSERT_GT(3 * block.occupancy.occupied_count(), kMaxDerivedSurfaceCellsPerTree);
+    EXPECT_EQ(error_code_of([&] { decode_tlobe(encode_tlobe(three), "three.tlobe"); }), ExitCode::InvalidInput);
+}
+
 // The simplifications beyond simplifications_per_grid come only when no grid fits with fewer:
 // a budget that a 2 cm grid meets only with the surfaces at 1/16 keeps the 0.6 m grid when the
 // surfaces may be simplified to 1/8 at each grid (the default), the 2 cm one when to 1/16.
