@@ -157,12 +157,12 @@ std::optional<PatchLeaf> drawn_leaf(const Lobe& lobe, const PatchInstance& inst,
 }
 
 // How a tree that stores its leaf area draws its leaves: the share of the offered leaves that
-// are seen, as placed or turned (drawn_leaf), which it draws, and the factor on their size. The texturing fitted the
-// patches with their leaves at the species' size, their tips reaching a lobe's outer cells, but
-// the offered leaves hold several times the stored area (the palm's 111 times). Shrinking every
-// blade to that area pulled the crown's rim in (the palm's 0.6 m leaflets were drawn 0.16-0.18 m
-// long, docs/rebuild.md), so the leaves keep their size and are thinned instead; only when the
-// seen leaves hold less than the area are they enlarged.
+// are seen, as placed or turned (drawn_leaf), which it draws, and the factor on their size. The
+// texturing fitted the patches with their leaves at the species' size, their tips reaching a
+// lobe's outer cells, but the offered leaves hold several times the stored area (the palm's 111
+// times). Shrinking every blade to that area pulled the crown's rim in (the palm's 0.6 m
+// leaflets were drawn 0.16-0.18 m long, docs/rebuild.md), so the leaves keep their size and are
+// thinned instead; only when the seen leaves hold less than the area are they enlarged.
 struct LeafPlan {
     double drawn_share = 1;
     float size = 1;

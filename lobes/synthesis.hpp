@@ -21,11 +21,11 @@
 //
 // A tree that stores its leaf area (LobeTree::leaf_area_m2 > 0: a `treelobes rebuild` of a mesh
 // with leaves) draws leaves and twigs only where its lobes' occupancy saw the crown (a leaf's
-// tip, a twig's middle in an occupied cell; a leaf pointing out of the seen cells is turned about
-// its base, in its blade's plane, into them when it can), and gives exactly that area at every level of
-// detail: its leaves keep the species' size and are thinned when the patches offer more, and
-// are enlarged about their bases only when they offer less. Otherwise the blades keep the
-// sizes of the species' patches.
+// tip, a twig's middle in an occupied cell; a leaf pointing out of the seen cells is turned
+// about its base, in its blade's plane, into them when it can), and gives exactly that area at
+// every level of detail: its leaves keep the species' size and are thinned when the patches
+// offer more, and are enlarged about their bases only when they offer less. Otherwise the
+// blades keep the sizes of the species' patches.
 #pragma once
 
 #include "config/species_profile.hpp"
