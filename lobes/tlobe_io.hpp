@@ -86,9 +86,8 @@ struct TlobeOptions {
 // grid needs, then without the bare twigs (bare_twig_length), then with no surfaces stored, the
 // reader deriving them from the occupancy (Lobe::surface_from_occupancy), then the further
 // fractions the same way; if no grid fits even then, the most simplified surfaces are stored
-// without occupancy. Lobes without
-// cluster_points (a decoded tree) keep their occupancy as it is. Throws Error(Usage) for options
-// out of range or coordinates the grid cannot hold.
+// without occupancy. Lobes without cluster_points (a decoded tree) keep their occupancy as it
+// is. Throws Error(Usage) for options out of range or coordinates the grid cannot hold.
 std::string encode_tlobe(const LobeTree& tree, const TlobeOptions& options = {});
 // Parses a file's bytes; any inconsistency throws Error(InvalidInput) naming `name`.
 // Decoded lobes have origin 0 (the tree's frame), the skeleton the stored origin.
