@@ -10,10 +10,14 @@
 #include "apps/option_table.hpp"
 #include "apps/summary_values.hpp"
 #include "core/atomic_file.hpp"
+#include "core/cloud_header.hpp"
+#include "core/cloud_io.hpp"
 #include "core/error.hpp"
 #include "core/log.hpp"
 #include "core/memory_limit.hpp"
 #include "core/version.hpp"
+#include "segment/segment_trees.hpp"
+#include "segment/terrain.hpp"
 #include "survey/completion.hpp"
 #include "survey/tile_list.hpp"
 
@@ -25,6 +29,7 @@
 #include <iostream>
 #include <memory>
 #include <new>
+#include <optional>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -56,6 +61,60 @@ std::vector<std::string> tile_arguments_of(const BatchCliOptions& o) {
         arguments.push_back(o.source);
     }
     return arguments;
+}
+
+// Does `--mode tls` (or --mode=tls) stand among the tile options?
+bool terrestrial_mode(const std::vector<std::string>& arguments) {
+    for (std::size_t i = 0; i < arguments.size(); ++i)
+        if (arguments[i] == "--mode=tls" || (arguments[i] == "--mode" && i + 1 < arguments.size() && arguments[i + 1] == "tls"))
+            return true;
+    return false;
+}
+
+struct SurveySpacing {
+    float metres = 0.0f;
+    fs::path tile;  // the tile it was measured on
+};
+
+// The tile whose header states the median point density: the survey's typical tile. Every shard
+// picks the same one from the same sorted list. Tiles without header bounds (not LAS) count as
+// of unknown density; when none has bounds, the first tile.
+fs::path typical_tile(const std::vector<fs::path>& tiles) {
+    std::vector<std::pair<double, fs::path>> densities;
+    for (const fs::path& tile : tiles) {
+        try {
+            const std::optional<Box3d> bounds = header_bounds(tile);
+            if (!bounds) continue;
+            const double area = (bounds->max.x() - bounds->min.x()) * (bounds->max.y() - bounds->min.y());
+            if (area > 0.0) densities.emplace_back(static_cast<double>(header_point_count(tile)) / area, tile);
+        } catch (const Error&) {
+            // a tile without a readable header fails in its own run
+        }
+    }
+    if (densities.empty()) return tiles.front();
+    std::sort(densities.begin(), densities.end());
+    return densities[densities.size() / 2].second;
+}
+
+// One return spacing for every tile's canopy height model (docs/survey.md), unless the tile
+// options give one or take no airborne segmentation. Tiles that estimate their own draw slightly
+// different CHMs, and the crowns at their edges differ from the uncut survey's: lidR's
+// MixedConifer cut into 45 m tiles with a 7 m buffer kept 180 of its 215 trees as in the uncut
+// run, and all 215 with one spacing. nullopt when the typical tile cannot be read or holds no
+// vegetation: each tile then estimates its own.
+std::optional<SurveySpacing> survey_return_spacing(const std::vector<fs::path>& tiles, const std::vector<std::string>& arguments) {
+    if (has_option(arguments, "--return-spacing") || has_option(arguments, "--use-input-segmentation") || terrestrial_mode(arguments))
+        return std::nullopt;
+    const fs::path tile = typical_tile(tiles);
+    try {
+        const PointCloud cloud = read_point_cloud(tile);
+        const float spacing = vegetation_return_spacing(cloud, analyse_terrain(cloud, {}), {});
+        if (spacing > 0.0f) return SurveySpacing{spacing, tile};
+    } catch (const Error& e) {
+        log_warn("the survey's return spacing could not be measured on " + tile.string() + " (" + e.what() +
+                 "): each tile estimates its own");
+    }
+    return std::nullopt;
 }
 
 // The memory budget is the tile's own check (before it reads anything); not part of the key.
@@ -151,9 +210,16 @@ TileResult process_tile(const fs::path& input, const fs::path& dir, const std::v
 int run_batch(BatchCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const survey::Shard shard = o.shard.empty() ? survey::Shard{} : survey::parse_shard(o.shard);
     if (!o.max_memory.empty()) parse_memory_size(o.max_memory);  // a bad size is a usage error before any tile runs
-    const std::vector<std::string> key_arguments = tile_arguments_of(o);
-    const std::vector<std::string> run_arguments = with_memory_budget(key_arguments, o);
+    std::vector<std::string> key_arguments = tile_arguments_of(o);
     const std::vector<fs::path> all = survey::list_tiles(o.source);
+    const std::optional<SurveySpacing> spacing = survey_return_spacing(all, key_arguments);
+    if (spacing) {
+        char metres[32];
+        std::snprintf(metres, sizeof metres, "%.3f", static_cast<double>(spacing->metres));
+        key_arguments.insert(key_arguments.end(), {"--return-spacing", metres});
+        log_info(std::string("every tile's CHM from a return spacing of ") + metres + " m, measured on " + spacing->tile.string());
+    }
+    const std::vector<std::string> run_arguments = with_memory_budget(key_arguments, o);
     const std::vector<fs::path> tiles = survey::shard_tiles(all, shard);
     {
         CLI::App check;  // tile options are checked once, before any tile runs
@@ -192,20 +258,23 @@ int run_batch(BatchCliOptions& o, const OptionTable& table, const GlobalOptions&
     progress.finish();
     write_failures(failures_path, failures);
 
-    const json summary = {{"treelobes", kVersion},
-                          {"command", "batch"},
-                          {"source", o.source},
-                          {"out", o.out},
-                          {"options", table.json()},
-                          {"shard", o.shard.empty() ? json(nullptr) : json(o.shard)},
-                          {"tiles_total", all.size()},
-                          {"tiles", tiles.size()},
-                          {"tiles_done", done},
-                          {"tiles_skipped", skipped},
-                          {"tiles_failed", failures.size()},
-                          {"tiles_with_tree_failures", with_tree_failures},
-                          {"failures", failures.empty() ? json(nullptr) : json(failures_path.string())},
-                          {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
+    const json summary = {
+            {"treelobes", kVersion},
+            {"command", "batch"},
+            {"source", o.source},
+            {"out", o.out},
+            {"options", table.json()},
+            {"shard", o.shard.empty() ? json(nullptr) : json(o.shard)},
+            {"tiles_total", all.size()},
+            {"tiles", tiles.size()},
+            {"tiles_done", done},
+            {"tiles_skipped", skipped},
+            {"tiles_failed", failures.size()},
+            {"tiles_with_tree_failures", with_tree_failures},
+            {"return_spacing",
+             spacing ? json{{"metres", rounded(spacing->metres, 3)}, {"measured_on", spacing->tile.string()}} : json(nullptr)},
+            {"failures", failures.empty() ? json(nullptr) : json(failures_path.string())},
+            {"peak_memory_mb", rounded(peak_memory_mb(), 1)}};
     if (global.json) {
         std::cout << summary.dump(2) << "\n";
     } else {

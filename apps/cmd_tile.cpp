@@ -128,6 +128,10 @@ json options_json(const OptionTable& table, const TileCliOptions& o, const TreeS
     json options = table.json();
     options["mode_used"] = o.use_input_segmentation ? "input" : scan_mode_name(segmentation.mode_used);
     options["mode_reason"] = o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason;
+    if (!o.use_input_segmentation && segmentation.mode_used == ScanMode::Airborne)
+        options["chm"] = {{"return_spacing_m", segmentation.return_spacing},
+                          {"cell_m", segmentation.chm_cell},
+                          {"point_radius_m", segmentation.chm_point_radius}};
     options["trees"] = tree_options_json(o);
     return options;
 }
@@ -617,6 +621,10 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--max-crown-radius", o->max_crown_radius,
                "Airborne: no crown reaches farther from its treetop, metres (default: the stand's, 15 broadleaf, 3.5 conifer)")
             ->check(PositiveNumber);
+    table->add("--return-spacing", o->segment.return_spacing,
+               "Airborne: mean spacing of the survey's vegetation returns, metres, from which the CHM's cell and discs grow (0 = "
+               "estimated per tile; give the tiles of one survey one value so that they draw the same CHM)")
+            ->check(NonNegativeNumber);
     table->add_flag("--use-input-segmentation", o->use_input_segmentation,
                     "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
     table->add("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");

@@ -2,8 +2,8 @@
 # How wide a tile buffer must be for the airborne segmentation to give the crowns of the uncut
 # survey (docs/survey.md, "How far the airborne segmentation reaches"): lidR's MixedConifer.las
 # (a real dense conifer plot, 90 x 90 m) processed whole with `tile --stand conifer`, then cut by
-# `retile --size 45` and run as a batch with each buffer; every merged tree is compared with the
-# uncut run by its survey-wide id and its point count.
+# `retile --size 45` and run as a batch with each buffer and the uncut run's return spacing; every
+# merged tree is compared with the uncut run by its survey-wide id and its point count.
 # Usage: bench/buffer_reach_bench.sh [WORK_DIR] [BUFFERS...]   (default /tmp/treelobes_buffer_reach,
 # buffers 0 3.5 7 10 15). Environment: TREELOBES (default build/bin/treelobes), TREELOBES_REAL_DATA.
 set -euo pipefail
@@ -22,6 +22,11 @@ rm -rf "$work" && mkdir -p "$work" && cd "$work"
 # Exit 3 (some small crowns fail the per-tree pipeline) is a finished run.
 finished() { "$@" >/dev/null 2>&1 || [[ $? -eq 3 ]]; }
 finished "$cli" --log-level error tile "$plot" --out uncut "${options[@]}"
+# The tiles draw their CHM from the uncut run's return spacing (a batch otherwise measures it on
+# its typical tile, docs/survey.md): the same CHM grid, so that only the buffer differs.
+spacing=$(python3 -c "import json, sys; print(json.load(open(sys.argv[1]))['options']['chm']['return_spacing_m'])" uncut/summary.json)
+options+=(--return-spacing "$spacing")
+echo "return spacing of the uncut run: $spacing m"
 "$cli" --log-level error retile "$plot" --size 45 --out tiles >/dev/null
 echo "| buffer (m) | trees (uncut) | trees merged | same id | same id and points |"
 echo "|---|---|---|---|---|"

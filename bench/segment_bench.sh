@@ -9,10 +9,12 @@
 #      filtered afresh (--ignore-classification); and the same stands with crown competition
 #      (`synth tile --competition`: crowns cut where a neighbour owns the canopy); and two dense
 #      conifer stands (80 pines on 50 x 50 m, crowns touching) with both stand presets;
-#   2. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
-#   3. treels/pine_plot.las: stems found, with their positions and diameters (--stand conifer,
+#   2. sparse airborne surveys (the ALS stands at 0.5-4 pulses per m^2) with the CHM grid from the
+#      returns' spacing and fixed, and lidR/Megaplot.las (1.5 returns per m^2) trees found;
+#   3. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
+#   4. treels/pine_plot.las: stems found, with their positions and diameters (--stand conifer,
 #      and the heights the broadleaf default gives);
-#   4. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
+#   5. timings and peak memory for about 0.25M, 1M and 4M ALS points (a synthetic tile and its
 #      2 x 2 and 4 x 4 copies side by side) and the TLS tiles.
 # Matching rule: a true tree and a found tree match when each holds at least half of the other's
 # points (segment/segmentation_score.hpp).
@@ -107,6 +109,51 @@ area = sum(math.pi / 4 * float(r["crown_diameter_m"]) ** 2 for r in csv.DictRead
 print(f"  {folder.split('/')[-1]}: {area / side ** 2:.2f}")
 PY
 done
+echo
+echo "== sparse airborne surveys: the open and crowded stands above at 0.5-4 pulses per m^2, the CHM's"
+echo "   cell and discs from the returns' spacing (default) and fixed at 0.5 m cells and 0.15 m discs"
+for pd in 0.5 1 2 4; do
+  for s in 11 12 13 14; do tile "als_open_${s}_pd$pd" "$s" --trees 25 --size 100 --scanner als --pulse-density "$pd"; done
+  for s in 1 2 3 4; do tile "als_crowded_${s}_pd$pd" "$s" --trees 30 --size 80 --scanner als --pulse-density "$pd"; done
+done
+# group_row LABEL ARGS -- TILES...: mean F1, points right and found / true trees over the tiles.
+group_row() {
+  local label=$1 args=() results=()
+  shift
+  while [[ $1 != -- ]]; do args+=("$1"); shift; done
+  shift
+  for t in "$@"; do results+=("$("$EVAL" "$t/tile.las" --reference treeID "${args[@]}")"); done
+  python3 - "$label" "${results[@]}" <<'PY'
+import json, sys
+runs = [json.loads(r) for r in sys.argv[2:]]
+f1 = [r["score"]["f1"] for r in runs]
+right = [r["score"]["points_right"] for r in runs]
+found = sum(r["score"]["found_trees"] for r in runs)
+true = sum(r["score"]["reference_trees"] for r in runs)
+chm = runs[0]["chm"]
+print(f"{sys.argv[1]:<40} {' '.join(f'{v:.3f}' for v in f1)}  mean F1 {sum(f1) / len(f1):.3f}  right {100 * sum(right) / len(right):5.1f} %"
+      f"  found {found} of {true}  (first tile: spacing {chm['return_spacing']:.2f} m, cell {chm['cell']:.2f} m, disc {chm['point_radius']:.2f} m)")
+PY
+}
+for pd in 0.5 1 2 4; do
+  for stand in open crowded; do
+    tiles=("$WORK"/als_${stand}_*_pd$pd)
+    group_row "$pd pulses/m^2, $stand" -- "${tiles[@]}"
+    group_row "$pd pulses/m^2, $stand, fixed grid" --set cell_per_spacing=0 --set disc_per_spacing=0 -- "${tiles[@]}"
+  done
+done
+echo "lidR Megaplot.las (no reference), trees found:"
+for stand in broadleaf conifer; do
+  python3 - "$stand" "$("$EVAL" "$DATA/lidr/Megaplot.las" --stand "$stand")" \
+    "$("$EVAL" "$DATA/lidr/Megaplot.las" --stand "$stand" --set cell_per_spacing=0 --set disc_per_spacing=0)" <<'PY'
+import json, sys
+grown, fixed = json.loads(sys.argv[2]), json.loads(sys.argv[3])
+c = grown["chm"]
+print(f"  --stand {sys.argv[1]}: {grown['trees']} (spacing {c['return_spacing']:.2f} m, cell {c['cell']:.2f} m, disc {c['point_radius']:.2f} m);"
+      f" fixed grid: {fixed['trees']}")
+PY
+done
+
 echo
 echo "== lidR MixedConifer.las against lidR's treeID (trees > 5 m)"
 header "setting"

@@ -98,6 +98,8 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
     const float v = std::stof(assignment.substr(equals + 1));
     const std::map<std::string, float*> fields = {{"chm_cell", &o.chm_cell},
                                                   {"point_radius", &o.point_radius},
+                                                  {"cell_per_spacing", &o.cell_per_spacing},
+                                                  {"disc_per_spacing", &o.disc_per_spacing},
                                                   {"pit_depth", &o.pit_depth},
                                                   {"window_base", &o.window_base},
                                                   {"window_per_metre", &o.window_per_metre},
@@ -199,6 +201,7 @@ int run(int argc, char** argv) {
                 {"ground_points", terrain.ground_points},
                 {"mode", scan_mode_name(trees.mode_used)},
                 {"mode_reason", trees.mode_reason},
+                {"chm", {{"return_spacing", trees.return_spacing}, {"cell", trees.chm_cell}, {"point_radius", trees.chm_point_radius}}},
                 {"trees", trees.trees.size()},
                 {"seconds", {{"terrain", terrain_seconds}, {"segment", total_seconds - terrain_seconds}, {"total", total_seconds}}},
                 {"peak_memory_mb", peak_memory_mb()},

@@ -48,6 +48,38 @@ void draw_disc(Image& image, int cx, int cy, int radius, Rgba colour) {
 
 }  // namespace
 
+std::vector<std::optional<LabelBox>> place_labels(int width, int height, std::span<const Eigen::Vector2i> marks, int mark_radius,
+                                                  std::span<const Eigen::Vector2i> sizes) {
+    if (sizes.size() != marks.size()) throw Error(ExitCode::Internal, "place_labels: one label size per mark expected");
+    std::vector<std::uint8_t> taken(static_cast<std::size_t>(std::max(width, 0)) * static_cast<std::size_t>(std::max(height, 0)), 0);
+    const auto mark_taken = [&](int x0, int y0, int x1, int y1) {  // inclusive corners, clipped to the image
+        for (int y = std::max(y0, 0); y <= std::min(y1, height - 1); ++y)
+            for (int x = std::max(x0, 0); x <= std::min(x1, width - 1); ++x) taken[static_cast<std::size_t>(y) * width + x] = 1;
+    };
+    const auto free = [&](const LabelBox& box) {
+        if (box.x < 0 || box.y < 0 || box.x + box.width > width || box.y + box.height > height) return false;
+        for (int y = box.y; y < box.y + box.height; ++y)
+            for (int x = box.x; x < box.x + box.width; ++x)
+                if (taken[static_cast<std::size_t>(y) * width + x]) return false;
+        return true;
+    };
+    for (const auto& m : marks)
+        mark_taken(m.x() - mark_radius - 1, m.y() - mark_radius - 1, m.x() + mark_radius + 1, m.y() + mark_radius + 1);
+    std::vector<std::optional<LabelBox>> placed(marks.size());
+    for (std::size_t i = 0; i < marks.size(); ++i) {
+        const int w = sizes[i].x(), h = sizes[i].y(), x = marks[i].x(), y = marks[i].y(), gap = mark_radius + 3;
+        for (const LabelBox& box : {LabelBox{x + gap, y - h / 2, w, h}, LabelBox{x - gap - w, y - h / 2, w, h},
+                                    LabelBox{x - w / 2, y - gap - h, w, h}, LabelBox{x - w / 2, y + gap, w, h}}) {
+            if (!free(box)) continue;
+            placed[i] = box;
+            // A few pixels around the box stay free, so that two ids never read as one number.
+            mark_taken(box.x - 3, box.y - 3, box.x + box.width + 2, box.y + box.height + 2);
+            break;
+        }
+    }
+    return placed;
+}
+
 Rgba tree_colour(int id) {
     // Golden-ratio steps around the hue circle; three brightness levels break up equal hues.
     const double hue = std::fmod(0.61803398875 * static_cast<double>(id), 1.0);
@@ -107,15 +139,21 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
         image.set(static_cast<int>(cell % width), static_cast<int>(cell / width), colour);
     }
     const int mark = std::clamp(width / 160, 3, 8), scale = std::clamp(width / 250, 2, 5);
+    std::vector<Eigen::Vector2i> marks, sizes;
     for (const auto& stem : stems) {
-        const int x = column(stem.position.x()), y = row(stem.position.y());
-        draw_disc(image, x, y, mark + 1, {255, 255, 255, 255});
-        draw_disc(image, x, y, mark, {0, 0, 0, 255});
-        if (!options.labels) continue;
-        const std::string label = std::to_string(stem.id);
-        const int tx = x + mark + 3, ty = y - text_height(scale) / 2;
-        image.fill_rect(tx - 1, ty - 1, tx + text_width(label, scale), ty + text_height(scale) + 1, {255, 255, 255, 255});
-        draw_text(image, tx, ty, label, scale, {0, 0, 0, 255});
+        marks.emplace_back(column(stem.position.x()), row(stem.position.y()));
+        // The box holds the text and a one-pixel white border.
+        sizes.emplace_back(text_width(std::to_string(stem.id), scale) + 2, text_height(scale) + 2);
+        draw_disc(image, marks.back().x(), marks.back().y(), mark + 1, {255, 255, 255, 255});
+        draw_disc(image, marks.back().x(), marks.back().y(), mark, {0, 0, 0, 255});
+    }
+    if (!options.labels) return image;
+    const auto boxes = place_labels(width, height, marks, mark + 1, sizes);
+    for (std::size_t i = 0; i < stems.size(); ++i) {
+        if (!boxes[i]) continue;
+        const LabelBox& box = *boxes[i];
+        image.fill_rect(box.x, box.y, box.x + box.width, box.y + box.height, {255, 255, 255, 255});
+        draw_text(image, box.x + 1, box.y + 1, std::to_string(stems[i].id), scale, {0, 0, 0, 255});
     }
     return image;
 }

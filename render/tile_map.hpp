@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -27,6 +28,19 @@ struct TileMapOptions {
 
 // Colour of tree `id` (> 0): a fixed hue sequence, so neighbouring ids differ.
 Rgba tree_colour(int id);
+
+// A label's box on the image: top-left corner and size in pixels.
+struct LabelBox {
+    int x = 0, y = 0, width = 0, height = 0;
+};
+
+// Where each mark's label goes, in the marks' order (the first are placed first): to the right of
+// its mark, else left, above or below it, wherever the box stays on the image and overlaps no
+// mark (discs of `mark_radius`) and no box placed before it; nullopt where none of the four is
+// free. Thousands of trees on one tile then show the ids that fit instead of a carpet of
+// overwritten digits. `sizes` holds one label size (width, height) per mark.
+std::vector<std::optional<LabelBox>> place_labels(int width, int height, std::span<const Eigen::Vector2i> marks, int mark_radius,
+                                                  std::span<const Eigen::Vector2i> sizes);
 
 // `tree_id` has one entry per point (0 = no tree); `height_above_ground` one per point (empty:
 // shaded by z). Throws Error(Internal) for mismatched sizes or an empty cloud.

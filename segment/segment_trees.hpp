@@ -52,8 +52,16 @@ struct SegmentOptions {
     float terrestrial_density = 200.0f;
 
     // Airborne (canopy height model and crowns).
-    float chm_cell = 0.5f;          // CHM cell edge (metres)
-    float point_radius = 0.15f;     // each point drawn as a disc of this radius (pit-free CHM)
+    float chm_cell = 0.5f;       // CHM cell edge (metres) ...
+    float point_radius = 0.15f;  // ... each point drawn as a disc of this radius (pit-free CHM)
+    // Sparse surveys: the cell is at least cell_per_spacing and the disc radius at least
+    // disc_per_spacing times the mean spacing of the vegetation returns (0 = fixed), so that the
+    // discs still cover the crowns at 1-2 returns per m^2.
+    float cell_per_spacing = 0.75f;
+    float disc_per_spacing = 0.7071f;  // 1/sqrt(2): discs of this radius around a square grid of returns cover it
+    // The vegetation returns' mean spacing (metres); 0 = estimated from the cloud. A survey cut
+    // into tiles gives every tile one value, so that they all draw the same CHM.
+    float return_spacing = 0.0f;
     float pit_depth = 1.0f;         // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
     float chm_smoothing = 0.5f;     // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
     float window_base = 2.0f;       // treetop window diameter at 0 m height (metres) ...
@@ -118,8 +126,8 @@ struct SegmentOptions {
 // Broadleaf: the defaults above (broad crowns with many maxima: shallow tops merged into higher
 // ones, CHM smoothed, crowns up to 15 m from their top; a thick trunk's paths reach farther).
 // Conifer: every window maximum is a tree on the unsmoothed CHM and a crown reaches at most
-// 3.5 m from its top (narrow, pointed crowns side by side; on lidR's MixedConifer F1 0.87
-// against lidR's treeID, 0.35 with the broadleaf preset), and all stems reach alike (narrow
+// 3.5 m from its top (narrow, pointed crowns side by side; on lidR's MixedConifer F1 0.90
+// against lidR's treeID, 0.34 with the broadleaf preset), and all stems reach alike (narrow
 // crowns of one height whatever the diameter: on TreeLS's pine plot a thick pine's paths would
 // take the top of a thin neighbour).
 enum class StandType { Broadleaf, Conifer };
@@ -149,7 +157,18 @@ struct TreeSegmentation {
     std::vector<SegmentedTree> trees;   // trees[i].id == i + 1
     ScanMode mode_used = ScanMode::Airborne;
     std::string mode_reason;  // why this mode ("requested", or the density that decided it)
+    // Airborne: the CHM's cell and disc radius used, from the options and the vegetation
+    // returns' mean spacing (metres; 0 for terrestrial).
+    float return_spacing = 0.0f;
+    float chm_cell = 0.0f;
+    float chm_point_radius = 0.0f;
 };
+
+// Mean spacing of the vegetation returns seen from above, which the airborne CHM's cell and discs
+// grow with: 1 / sqrt(returns per m^2 over the 2 m cells that hold any). A 2 m cell is missed
+// with probability e^-4 at 1 return per m^2, so a sparse survey is not counted denser than it is,
+// as it would be over the 1 m cells that happen to be hit. 0 without vegetation.
+float vegetation_return_spacing(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options);
 
 // Segments the tile into trees. `terrain` must come from analyse_terrain on the same cloud
 // (Error(Internal) when its sizes differ). An empty cloud, or one without points above

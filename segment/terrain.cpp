@@ -348,8 +348,17 @@ float DtmGrid::height_at(float x, float y) const {
     return weights > 0 ? static_cast<float>(sum / weights) : kNaN;
 }
 
-Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options) {
-    check_options(options);
+float grid_cell_for_points(const PointCloud& cloud, float cell) {
+    if (cloud.empty()) return cell;
+    const auto [low, high] = cloud.bounds();
+    const double area = static_cast<double>(high.x() - low.x()) * static_cast<double>(high.y() - low.y());
+    return std::max(cell, static_cast<float>(std::sqrt(area / (4.0 * static_cast<double>(cloud.size())))));
+}
+
+Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& requested) {
+    check_options(requested);
+    TerrainOptions options = requested;
+    options.cell_size = grid_cell_for_points(cloud, requested.cell_size);
     Terrain terrain;
     if (cloud.empty()) {
         terrain.ground_source = "none";

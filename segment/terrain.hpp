@@ -62,7 +62,12 @@ struct Terrain {
     std::size_t ground_points = 0;           // points with is_ground = 1
 };
 
-// Ground, DTM and heights for a tile. An empty cloud gives an empty Terrain (empty grid, no
+// The edge of a grid over the cloud's xy extent: `cell`, or coarser where that grid would hold
+// more than 4 cells per point. A grid finer than its points can fill only costs memory: laspy's
+// simple.laz (1,065 points spread over 3.4 x 4.6 km) took 15.6M DTM cells, 1.8 GB and 19 s.
+float grid_cell_for_points(const PointCloud& cloud, float cell);
+
+// Ground, DTM and heights for a tile (the DTM's cell from grid_cell_for_points). An empty cloud gives an empty Terrain (empty grid, no
 // points, ground_source "none"). Throws Error(Usage) for non-positive options and
 // Error(InvalidInput) for non-finite coordinates.
 Terrain analyse_terrain(const PointCloud& cloud, const TerrainOptions& options);

@@ -47,6 +47,7 @@ double f1_against_lidr(const std::string& flags) {
 
 TEST(TileReal, MixedConiferWithTheConiferStandAgreesWithLidR) {
     if (real_data("lidr/MixedConifer.las").empty()) return;
-    EXPECT_GE(f1_against_lidr("--stand conifer"), 0.85);                       // measured 0.865
+    // Measured 0.900 (0.865 with the CHM's discs fixed at 0.15 m, before they grew with the returns' spacing).
+    EXPECT_GE(f1_against_lidr("--stand conifer"), 0.88);
     EXPECT_LT(f1_against_lidr("--stand conifer --max-crown-radius 15"), 0.7);  // the radius is what matters
 }

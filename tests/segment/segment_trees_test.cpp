@@ -108,6 +108,51 @@ TEST(SegmentTrees, AirborneCrownGrowsPastTheHigherCellsAroundASmoothedTop) {
     EXPECT_NEAR(result.trees[0].top.z(), 12.0f, 0.1f);
 }
 
+// A survey of 1 return per m^2 (a national programme's density) over two broad, bumpy crowns:
+// returns 1 m apart on a jittered grid, each 0-0.6 m below its crown's dome. Drawn as 0.15 m discs
+// on 0.5 m cells, most CHM cells stay empty, the passes between the returns fall to the ground
+// and every bump is a top of its own; with the cell and discs grown to the returns' spacing the
+// CHM is whole and each crown one tree.
+TEST(SegmentTrees, ASparseSurveyKeepsEachCrownWhole) {
+    ToyTile tile;
+    std::uint32_t state = 12345u;
+    const auto uniform = [&state] {  // a fixed linear congruential sequence in [0, 1)
+        state = state * 1664525u + 1013904223u;
+        return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+    };
+    const auto add_dome = [&](float cx, float cy, float height, std::int32_t id) {
+        for (float y = cy - 6.0f; y <= cy + 6.0f; y += 1.0f)
+            for (float x = cx - 6.0f; x <= cx + 6.0f; x += 1.0f) {
+                const float px = x + 0.8f * (uniform() - 0.5f), py = y + 0.8f * (uniform() - 0.5f);
+                const float r = std::hypot(px - cx, py - cy);
+                if (r <= 6.0f) tile.add({px, py, height - 0.15f * r * r - 0.6f * uniform()}, id);
+            }
+    };
+    for (float y = 0.0f; y <= 16.0f; y += 1.0f)
+        for (float x = 0.0f; x <= 30.0f; x += 1.0f) tile.add({x + 0.8f * (uniform() - 0.5f), y + 0.8f * (uniform() - 0.5f), 0.0f}, 0);
+    add_dome(8.0f, 8.0f, 15.0f, 1);
+    add_dome(21.0f, 8.0f, 12.0f, 2);
+    test::classify_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    SegmentOptions options;
+    options.mode = ScanMode::Airborne;
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, options);
+    EXPECT_NEAR(result.return_spacing, 1.0f, 0.15f);
+    EXPECT_NEAR(result.chm_point_radius, 0.7071f * result.return_spacing, 1e-4f);
+    EXPECT_NEAR(result.chm_cell, 0.75f * result.return_spacing, 1e-4f);
+    ASSERT_EQ(result.trees.size(), 2u);
+    const auto dominant = dominant_ids(tile, result);
+    EXPECT_EQ(dominant.at(1).first, 1);
+    EXPECT_EQ(dominant.at(2).first, 2);
+    EXPECT_GT(dominant.at(1).second, 0.95);
+    EXPECT_GT(dominant.at(2).second, 0.95);
+
+    options.cell_per_spacing = options.disc_per_spacing = 0.0f;  // the fixed 0.5 m cells and 0.15 m discs
+    const TreeSegmentation fixed = segment_trees(tile.cloud, terrain, options);
+    EXPECT_EQ(fixed.chm_cell, 0.5f);
+    EXPECT_GT(fixed.trees.size(), 2u);
+}
+
 TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
     const ToyTile tile = two_stems_terrestrial();
     const Terrain terrain = analyse_terrain(tile.cloud, {});
@@ -531,6 +576,9 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     };
     const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
     EXPECT_TRUE(rejects(&SegmentOptions::chm_cell, 0.0f));
+    EXPECT_TRUE(rejects(&SegmentOptions::cell_per_spacing, -0.1f));
+    EXPECT_TRUE(rejects(&SegmentOptions::disc_per_spacing, 5.0f));
+    EXPECT_TRUE(rejects(&SegmentOptions::disc_per_spacing, nan));
     EXPECT_TRUE(rejects(&SegmentOptions::stem_slice_high, SegmentOptions{}.stem_slice_low));
     for (const float layer : {0.0f, 1e-9f, 100.0f, nan}) {
         EXPECT_TRUE(rejects(&SegmentOptions::stem_layer_height, layer)) << layer;

@@ -158,6 +158,21 @@ TEST(Terrain, WritesAsciiGridNorthRowFirstAndHillshade) {
     EXPECT_EQ(test::error_code_of([&] { write_ascii_grid(DtmGrid{}, {0, 0, 0}, dir / "x.asc"); }), ExitCode::InvalidInput);
 }
 
+// A few points spread over a wide extent (laspy's simple.laz: 1,065 points on 3.4 x 4.6 km)
+// must not take a 1 m grid of millions of cells: the cell grows to keep at most 4 per point.
+TEST(Terrain, AFewPointsOverAWideExtentGetACoarserGrid) {
+    ToyTile tile;
+    test::add_ground(tile, 0, 2000, 0, 3000, 100.0f, 2.0f, 0.0f, [](float, float) { return false; });  // 651 points
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    EXPECT_EQ(terrain.ground_source, "filtered");
+    EXPECT_LE(static_cast<double>(terrain.dtm.columns) * terrain.dtm.rows,
+              4.0 * static_cast<double>(tile.cloud.size()) * 1.1);  // + the edge cells
+    EXPECT_NEAR(terrain.dtm.cell_size, grid_cell_for_points(tile.cloud, 1.0f), 1e-6f);
+    EXPECT_GT(terrain.dtm.cell_size, 30.0f);
+    // Dense enough points keep the requested cell.
+    EXPECT_EQ(grid_cell_for_points(sloped_forest().cloud, 1.0f), 1.0f);
+}
+
 TEST(Terrain, EmptyCloudGivesAnEmptyTerrain) {
     const Terrain terrain = analyse_terrain(PointCloud{}, {});
     EXPECT_TRUE(terrain.dtm.empty());

@@ -167,6 +167,48 @@ TEST(SurveyCli, KilledBatchResumesWithoutRedoingATile) {
     expect_same_merge(r.merged, dir / "merged");
 }
 
+// With their own airborne segmentation the tiles of one survey draw their canopy height models
+// from one return spacing, measured on the tile of median density (each tile's own estimate
+// differs by a few per cent, and crowns at the tile edges would differ from the uncut run's), or
+// from the one given; a single `tile` run estimates its own.
+TEST(SurveyCli, EveryTileDrawsItsCanopyModelFromOneReturnSpacing) {
+    const Reference& r = reference();
+    TempDir dir;
+    const std::string own = " --mode als --min-tree-points 100000000 --map-size 200";
+    const auto tile_spacings = [&](const fs::path& out) {
+        std::vector<double> spacings;
+        for (int i = 0; i < kTiles; ++i)
+            spacings.push_back(nlohmann::json::parse(
+                    file_bytes(out / ("t_" + std::to_string(i)) / "summary.json"))["options"]["chm"]["return_spacing_m"]);
+        return spacings;
+    };
+    const auto batch = [&](const std::string& name, const std::string& extra) {
+        return shell(cli() + " --log-level warn --json batch '" + r.tiles.string() + "' --out '" + (dir / name).string() + "'" + own +
+                     extra + " >'" + (dir / (name + ".json")).string() + "'");
+    };
+    ASSERT_EQ(batch("measured", ""), 0);
+    const auto summary = nlohmann::json::parse(file_bytes(dir / "measured.json"));
+    const double survey = summary["return_spacing"]["metres"];
+    EXPECT_GT(survey, 0.1);
+    EXPECT_LT(survey, 0.5);  // 20 pulses per m^2
+    EXPECT_EQ(summary["return_spacing"]["measured_on"].get<std::string>().rfind(r.tiles.string(), 0), 0u);
+    for (const double spacing : tile_spacings(dir / "measured")) EXPECT_NEAR(spacing, survey, 5e-4);
+
+    ASSERT_EQ(batch("given", " --return-spacing 0.8"), 0);
+    EXPECT_TRUE(nlohmann::json::parse(file_bytes(dir / "given.json"))["return_spacing"].is_null());
+    for (const double spacing : tile_spacings(dir / "given")) EXPECT_NEAR(spacing, 0.8, 1e-6);
+
+    std::vector<double> alone;
+    for (int i = 0; i < 2; ++i) {
+        const fs::path out = dir / ("alone_" + std::to_string(i));
+        ASSERT_EQ(shell(cli() + " --log-level warn tile '" + (r.tiles / ("t_" + std::to_string(i) + ".las")).string() + "' --out '" +
+                        out.string() + "'" + own + " >/dev/null"),
+                  0);
+        alone.push_back(nlohmann::json::parse(file_bytes(out / "summary.json"))["options"]["chm"]["return_spacing_m"]);
+    }
+    EXPECT_NE(alone[0], alone[1]);
+}
+
 TEST(SurveyCli, ABadTileIsListedAndTheOthersFinish) {
     const Reference& r = reference();
     TempDir dir;
