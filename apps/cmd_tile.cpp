@@ -11,6 +11,7 @@
 #include "apps/summary_values.hpp"
 #include "classify/jointboost.hpp"
 #include "core/atomic_file.hpp"
+#include "core/crs_units.hpp"
 #include "core/cloud_header.hpp"
 #include "core/cloud_io.hpp"
 #include "core/error.hpp"
@@ -121,6 +122,30 @@ json tree_options_json(const TileCliOptions& o) {
             {"breast_height", t.dbh.breast_height},
             {"crown_alpha_factor", t.crown.alpha_factor},
             {"model", o.model}};
+}
+
+// Coordinates are taken as metres. A CRS in feet (US State Plane surveys) or degrees gives
+// heights, crowns and DBH in its own unit and thresholds (a 2 m minimum tree height, 0.5 m CHM
+// cells) that do not fit; the run goes on, and says so.
+void warn_of_a_unit_other_than_metres(const std::string& input, const std::optional<CrsUnit>& unit) {
+    if (!unit || unit->is_metre()) return;
+    if (unit->angular) {
+        log_warn(input +
+                 ": the CRS is geographic (coordinates in degrees); treelobes takes coordinates as metres: reproject the tile "
+                 "to a projected CRS in metres");
+        return;
+    }
+    char metres[32];
+    std::snprintf(metres, sizeof metres, "%.6g", unit->metres);
+    log_warn(input + ": the CRS measures lengths in " + unit->name + " (" + metres +
+             " m); treelobes takes coordinates as metres, so heights, crowns and DBH come out in that unit and its thresholds "
+             "in metres do not fit: reproject the tile to a CRS in metres");
+}
+
+// The CRS's horizontal unit as the WKT names it (null when it names none).
+json crs_unit_json(const std::optional<CrsUnit>& unit) {
+    if (!unit) return nullptr;
+    return {{"name", unit->name}, {"metres", unit->metres}, {"angular", unit->angular}};
 }
 
 // Every flag's value, the segmentation mode the tile got, and the per-tree options.
@@ -397,6 +422,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     buffered.cloud = read_point_cloud(o.input);
     if (buffered.cloud.empty()) throw Error::input(o.input, "the tile holds no points");
     if (buffered.cloud.georef.empty()) log_warn(o.input + ": no CRS in the input; outputs keep its coordinates without one");
+    warn_of_a_unit_other_than_metres(o.input, crs_horizontal_unit(buffered.cloud.georef.crs_wkt));
     buffered.own_points = buffered.cloud.size();
     if (o.buffer > 0) {
         if (!plan.core) plan.core = survey::core_from_points(buffered.cloud);
@@ -563,6 +589,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                             {"trees_failed", failures.size()},
                             {"dbh", dbh}}},
                           {"crs", cloud.georef.empty() ? json(nullptr) : json(cloud.georef.crs_wkt)},
+                          {"crs_unit", crs_unit_json(crs_horizontal_unit(cloud.georef.crs_wkt))},
                           {"outputs",
                            {{"points", out.points.string()},
                             {"trees_csv", out.csv.string()},

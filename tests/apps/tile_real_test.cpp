@@ -1,12 +1,15 @@
-// `treelobes tile` on a real airborne plot (label `real`): lidR's MixedConifer.las with the
-// conifer stand preset, end to end from the command line, against the treeID lidR published.
+// `treelobes tile` on real airborne surveys (label `real`): lidR's MixedConifer.las with the
+// conifer stand preset, end to end from the command line, against the treeID lidR published; and
+// laspy's autzen_trim.laz, whose CRS is in feet.
 #include "core/cloud_io.hpp"
 #include "segment/segmentation_score.hpp"
 #include "support/test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -50,4 +53,20 @@ TEST(TileReal, MixedConiferWithTheConiferStandAgreesWithLidR) {
     // Measured 0.900 (0.865 with the CHM's discs fixed at 0.15 m, before they grew with the returns' spacing).
     EXPECT_GE(f1_against_lidr("--stand conifer"), 0.88);
     EXPECT_LT(f1_against_lidr("--stand conifer --max-crown-radius 15"), 0.7);  // the radius is what matters
+}
+
+// laspy's autzen_trim.laz is an airborne survey in Oregon State Plane feet. Its coordinates are
+// taken as metres, so the run goes on, but it says so and records the unit.
+TEST(TileReal, ATileInFeetIsRunWithAWarningAndItsUnitRecorded) {
+    const auto laz = real_data("laz/laspy/autzen_trim.laz");
+    if (laz.empty()) return;
+    test::TempDir dir;
+    const auto result =
+            run_cli("tile '" + laz.string() + "' --out '" + (dir / "out").string() + "' --min-tree-points 100000000 --map-size 200");
+    EXPECT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.exit_code << result.err;
+    EXPECT_NE(result.err.find("the CRS measures lengths in foot (0.3048 m)"), std::string::npos) << result.err;
+    std::ifstream in(dir / "out" / "summary.json");
+    const auto summary = nlohmann::json::parse(in);
+    EXPECT_EQ(summary["crs_unit"]["name"], "foot");
+    EXPECT_DOUBLE_EQ(summary["crs_unit"]["metres"].get<double>(), 0.3048);
 }
