@@ -10,12 +10,17 @@ namespace {
 
 bool is_name_char(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
+// Does `keyword[` (or `keyword(`) start at `at` as a whole word?
+bool keyword_at(std::string_view text, std::size_t at, std::string_view keyword) {
+    const std::size_t open = at + keyword.size();
+    return text.compare(at, keyword.size(), keyword) == 0 && (at == 0 || !is_name_char(text[at - 1])) && open < text.size() &&
+           (text[open] == '[' || text[open] == '(');
+}
+
 // Offset of `keyword[` as a whole word at or after `from` in `text`; npos when absent.
 std::size_t find_keyword(std::string_view text, std::string_view keyword, std::size_t from = 0) {
-    for (std::size_t at = text.find(keyword, from); at != std::string_view::npos; at = text.find(keyword, at + 1)) {
-        const std::size_t open = at + keyword.size();
-        if ((at == 0 || !is_name_char(text[at - 1])) && open < text.size() && (text[open] == '[' || text[open] == '(')) return at;
-    }
+    for (std::size_t at = text.find(keyword, from); at != std::string_view::npos; at = text.find(keyword, at + 1))
+        if (keyword_at(text, at, keyword)) return at;
     return std::string_view::npos;
 }
 
@@ -57,7 +62,7 @@ std::optional<CrsUnit> own_unit(std::string_view text, std::size_t open, std::si
         if (quoted) continue;
         if (c == '[' || c == '(') ++depth;
         if (c == ']' || c == ')') --depth;
-        if (depth == 1 && find_keyword(text, "UNIT", i) == i) return unit_at(text, i, angular);
+        if (depth == 1 && keyword_at(text, i, "UNIT")) return unit_at(text, i, angular);
     }
     return std::nullopt;
 }

@@ -271,6 +271,22 @@ void text_seeds(const fs::path& source, const fs::path& out) {
         fs::copy_file(entry.path(), out / "lsystem" / entry.path().filename(), fs::copy_options::overwrite_existing);
 }
 
+// CRS texts as LAS files carry them: WKT 1 in feet and in metres, WKT 2, geographic.
+void crs_seeds(const fs::path& out) {
+    write_bytes(out / "crs_units/wkt1_feet.txt",
+                R"wkt(PROJCS["Lambert (ft)",GEOGCS["NAD83",DATUM["D_North_American_1983",SPHEROID["GRS_1980",6378137,298.257222101]],)wkt"
+                R"wkt(PRIMEM["Greenwich",0],UNIT["Degree",0.017453292519943295]],PROJECTION["Lambert_Conformal_Conic"],)wkt"
+                R"wkt(PARAMETER["standard_parallel_1",43],UNIT["Foot_US",0.3048006096012192]])wkt");
+    write_bytes(out / "crs_units/wkt1_compound_metre.txt",
+                R"wkt(COMPD_CS["UTM 32N + height",PROJCS["ETRS89 / UTM zone 32N",GEOGCS["ETRS89",UNIT["degree",0.0174532925199433]],)wkt"
+                R"wkt(UNIT["metre",1,AUTHORITY["EPSG","9001"]]],VERT_CS["DHHN2016 height",UNIT["metre",1]]])wkt");
+    write_bytes(out / "crs_units/wkt2_feet.txt",
+                R"wkt(PROJCRS["State Plane (ftUS)",BASEGEOGCRS["NAD83",ANGLEUNIT["degree",0.0174532925199433]],CONVERSION["SPCS",)wkt"
+                R"wkt(PARAMETER["False easting",600000,LENGTHUNIT["metre",1]]],CS[Cartesian,2],)wkt"
+                R"wkt(AXIS["easting (X)",east,LENGTHUNIT["US survey foot",0.304800609601219]]])wkt");
+    write_bytes(out / "crs_units/geographic.txt", R"wkt(GEOGCRS["WGS 84",ENSEMBLE["World Geodetic System 1984"],CS[ellipsoidal,2]])wkt");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -280,7 +296,7 @@ int main(int argc, char** argv) {
     }
     const fs::path source = argv[1], out = argv[2];
     for (const char* target : {"las", "ply_cloud", "skeleton_ply", "text_cloud", "pcd", "mesh", "dbf6", "dbf6_record", "chain_code",
-                               "forest", "forest_record", "tlobe", "tlobe_payload", "jointboost", "qsm", "export_info"})
+                               "forest", "forest_record", "tlobe", "tlobe_payload", "jointboost", "qsm", "export_info", "crs_units"})
         fs::create_directories(out / target);
     cloud_seeds(source, out);
     skeleton_and_mesh_seeds(source, out);
@@ -289,5 +305,6 @@ int main(int argc, char** argv) {
     jointboost_seeds(out);
     export_seeds(source, out);
     text_seeds(source, out);
+    crs_seeds(out);
     return 0;
 }
