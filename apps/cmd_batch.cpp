@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -100,8 +101,9 @@ fs::path typical_tile(const std::vector<fs::path>& tiles) {
 // options give one or take no airborne segmentation. Tiles that estimate their own draw slightly
 // different CHMs, and the crowns at their edges differ from the uncut survey's: lidR's
 // MixedConifer cut into 45 m tiles with a 7 m buffer kept 180 of its 215 trees as in the uncut
-// run, and all 215 with one spacing. nullopt when the typical tile cannot be read or holds no
-// vegetation: each tile then estimates its own.
+// run, and all 215 with one spacing. nullopt when the typical tile cannot be read, holds no
+// vegetation or is as dense as a terrestrial scan (whose segmentation has no CHM): each tile then
+// estimates its own.
 std::optional<SurveySpacing> survey_return_spacing(const std::vector<fs::path>& tiles, const std::vector<std::string>& arguments) {
     if (has_option(arguments, "--return-spacing") || has_option(arguments, "--use-input-segmentation") || terrestrial_mode(arguments))
         return std::nullopt;
@@ -109,8 +111,9 @@ std::optional<SurveySpacing> survey_return_spacing(const std::vector<fs::path>& 
     try {
         const PointCloud cloud = read_point_cloud(tile);
         const float spacing = vegetation_return_spacing(cloud, analyse_terrain(cloud, {}), {});
-        if (spacing > 0.0f) return SurveySpacing{spacing, tile};
-    } catch (const Error& e) {
+        const float terrestrial_spacing = 1.0f / std::sqrt(SegmentOptions{}.terrestrial_density);
+        if (spacing > terrestrial_spacing) return SurveySpacing{spacing, tile};
+    } catch (const std::exception& e) {  // treelobes::Error for bad input, std::bad_alloc for a tile beyond the memory
         log_warn("the survey's return spacing could not be measured on " + tile.string() + " (" + e.what() +
                  "): each tile estimates its own");
     }

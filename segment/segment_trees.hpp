@@ -52,8 +52,8 @@ struct SegmentOptions {
     float terrestrial_density = 200.0f;
 
     // Airborne (canopy height model and crowns).
-    float chm_cell = 0.5f;       // CHM cell edge (metres) ...
-    float point_radius = 0.15f;  // ... each point drawn as a disc of this radius (pit-free CHM)
+    float chm_cell = 0.5f;       // CHM cell edge (metres)
+    float point_radius = 0.15f;  // each point drawn as a disc of this radius (pit-free CHM)
     // Sparse surveys: the cell is at least cell_per_spacing and the disc radius at least
     // disc_per_spacing times the mean spacing of the vegetation returns (0 = fixed), so that the
     // discs still cover the crowns at 1-2 returns per m^2.
