@@ -370,7 +370,8 @@ void warn_if_buffer_is_narrow(const TileCliOptions& o, std::optional<float> reac
     std::call_once(said, [&] {
         log_warn("--buffer " + summary_value(o.buffer).dump() + " m is narrower than the airborne segmentation's reach (" +
                  summary_value(*reach).dump() +
-                 " m, twice --max-crown-radius): crowns near the tile's edges may differ from a run on the uncut survey "
+                 " m, twice --max-crown-radius and the CHM smoothing): crowns near the tile's edges may differ from a run on the uncut "
+                 "survey "
                  "(docs/survey.md)");
     });
 }

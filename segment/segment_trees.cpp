@@ -1044,7 +1044,7 @@ StandType parse_stand_type(std::string_view text) {
     throw Error::usage("unknown stand type '" + std::string(text) + "': expected broadleaf or conifer");
 }
 
-float airborne_reach(const SegmentOptions& options) { return 2.0f * options.max_crown_radius; }
+float airborne_reach(const SegmentOptions& options) { return 2.0f * (options.max_crown_radius + 3.0f * options.chm_smoothing); }
 
 SegmentOptions with_stand_type(SegmentOptions options, StandType stand) {
     const SegmentOptions broadleaf;

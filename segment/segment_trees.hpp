@@ -63,7 +63,7 @@ struct SegmentOptions {
     // into tiles gives every tile one value, so that they all draw the same CHM.
     float return_spacing = 0.0f;
     float pit_depth = 1.0f;         // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
-    float chm_smoothing = 0.5f;     // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
+    float chm_smoothing = 0.75f;    // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)
     float window_base = 2.0f;       // treetop window diameter at 0 m height (metres) ...
     float window_per_metre = 0.1f;  // ... plus this much per metre of height (Popescu & Wynne 2004)
     float max_window = 20.0f;       // cap of the treetop window diameter (metres)
@@ -127,7 +127,7 @@ struct SegmentOptions {
 // ones, CHM smoothed, crowns up to 15 m from their top; a thick trunk's paths reach farther).
 // Conifer: every window maximum is a tree on the unsmoothed CHM and a crown reaches at most
 // 3.5 m from its top (narrow, pointed crowns side by side; on lidR's MixedConifer F1 0.90
-// against lidR's treeID, 0.34 with the broadleaf preset), and all stems reach alike (narrow
+// against lidR's treeID, 0.20 with the broadleaf preset), and all stems reach alike (narrow
 // crowns of one height whatever the diameter: on TreeLS's pine plot a thick pine's paths would
 // take the top of a thin neighbour).
 enum class StandType { Broadleaf, Conifer };
@@ -138,10 +138,12 @@ StandType parse_stand_type(std::string_view text);
 SegmentOptions with_stand_type(SegmentOptions options, StandType stand);
 
 // How far around a crown the airborne segmentation reads points that can change it: the crown
-// reaches max_crown_radius from its top, and its cells are contested by tops as far again. A
-// tile buffer this wide gives the crowns of the uncut survey (docs/survey.md: measured exact at
-// 30 m with the broadleaf preset, not at 20 m; on MixedConifer cut into 45 m tiles, exact at
-// 7 m with the conifer preset, 3 of 184 trees differing at 3.5 m).
+// reaches max_crown_radius from its top, its top is found on the CHM smoothed over 3 sigma
+// around it, and its cells are contested by tops as far again: 2 x (max_crown_radius + 3 x
+// chm_smoothing), 34.5 m with the broadleaf preset, 7 m with the conifer one. A tile buffer this
+// wide gives the crowns of the uncut survey (docs/survey.md: a synthetic survey exact at 32.5 m
+// with the broadleaf preset, one tree of 24 differing at 30 m; MixedConifer cut into 45 m tiles
+// exact at 7 m with the conifer preset, 4 of 215 trees differing at 3.5 m).
 float airborne_reach(const SegmentOptions& options);
 
 struct SegmentedTree {

@@ -446,19 +446,20 @@ TEST(TileCliBuffer, WithoutNeighboursTheBufferChangesNothing) {
     EXPECT_EQ(slurp(dir / "plain" / "points.las"), slurp(dir / "buffered" / "points.las"));
 }
 
-// A buffer narrower than the airborne segmentation's reach (twice the crown radius) is said once
+// A buffer narrower than the airborne segmentation's reach (twice the crown radius and the CHM
+// smoothing's 3 sigma) is said once
 // on stderr and recorded in the summary; a wide enough one is not; the input's labels have no reach.
 TEST(TileCliBuffer, ANarrowBufferIsSaidAndRecorded) {
     TempDir dir;
     const auto narrow = run_cli("--json " + run_tile(dir / "narrow", "--mode als --buffer 10"));
     ASSERT_TRUE(narrow.exit_code == 0 || narrow.exit_code == 3) << narrow.err;
     EXPECT_NE(narrow.err.find("--buffer 10"), std::string::npos) << narrow.err;
-    EXPECT_NE(narrow.err.find("narrower than the airborne segmentation's reach (30"), std::string::npos) << narrow.err;
+    EXPECT_NE(narrow.err.find("narrower than the airborne segmentation's reach (34.5"), std::string::npos) << narrow.err;
     const auto narrow_summary = nlohmann::json::parse(narrow.out);
-    EXPECT_EQ(narrow_summary["buffer"]["segmentation_reach_m"], 30.0);
+    EXPECT_EQ(narrow_summary["buffer"]["segmentation_reach_m"], 34.5);
     EXPECT_EQ(narrow_summary["buffer"]["wide_enough"], false);
 
-    const auto wide = run_cli("--json " + run_tile(dir / "wide", "--mode als --buffer 10 --max-crown-radius 5"));
+    const auto wide = run_cli("--json " + run_tile(dir / "wide", "--mode als --buffer 10 --max-crown-radius 2.5"));
     ASSERT_TRUE(wide.exit_code == 0 || wide.exit_code == 3) << wide.err;
     EXPECT_EQ(wide.err.find("narrower"), std::string::npos) << wide.err;
     EXPECT_EQ(nlohmann::json::parse(wide.out)["buffer"]["wide_enough"], true);
