@@ -1049,6 +1049,7 @@ float airborne_reach(const SegmentOptions& options) { return 2.0f * (options.max
 SegmentOptions with_stand_type(SegmentOptions options, StandType stand) {
     const SegmentOptions broadleaf;
     options.min_top_prominence = stand == StandType::Conifer ? 0.0f : broadleaf.min_top_prominence;
+    options.top_prominence_ratio = stand == StandType::Conifer ? 0.0f : broadleaf.top_prominence_ratio;
     options.chm_smoothing = stand == StandType::Conifer ? 0.0f : broadleaf.chm_smoothing;
     options.max_crown_radius = stand == StandType::Conifer ? 3.5f : broadleaf.max_crown_radius;
     options.stem_reach_exponent = stand == StandType::Conifer ? 0.0f : broadleaf.stem_reach_exponent;

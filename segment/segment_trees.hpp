@@ -70,10 +70,12 @@ struct SegmentOptions {
     // A top is part of a higher neighbour's crown when it rises less than
     // max(min_top_prominence, top_prominence_ratio x its height) above the highest pass between
     // them (its dynamics, Grimaud 1992) and that pass is at least merge_pass_ratio x the higher top.
-    // The defaults suit broad crowns (the synthetic species library); dense conifer stands such
-    // as lidR's MixedConifer take the conifer preset (StandType below, docs/segment.md).
-    float min_top_prominence = 3.0f;  // metres
-    float top_prominence_ratio = 0.0f;
+    // The bumps of a broad crown rise higher the taller it is: 2 m up to a 17 m top, 3 m at 25 m,
+    // 3.6 m at 30 m. The defaults suit broad crowns (the synthetic species library); dense
+    // conifer stands such as lidR's MixedConifer take the conifer preset (StandType below,
+    // docs/segment.md).
+    float min_top_prominence = 2.0f;  // metres
+    float top_prominence_ratio = 0.12f;
     float merge_pass_ratio = 0.5f;
     float seed_ratio = 0.45f;        // a crown cell must be higher than this share of its top (Dalponte 2016: th_seed)
     float crown_ratio = 0.55f;       // ... and higher than this share of the crown's mean height (th_cr)
@@ -127,7 +129,7 @@ struct SegmentOptions {
 // ones, CHM smoothed, crowns up to 15 m from their top; a thick trunk's paths reach farther).
 // Conifer: every window maximum is a tree on the unsmoothed CHM and a crown reaches at most
 // 3.5 m from its top (narrow, pointed crowns side by side; on lidR's MixedConifer F1 0.90
-// against lidR's treeID, 0.20 with the broadleaf preset), and all stems reach alike (narrow
+// against lidR's treeID, 0.29 with the broadleaf preset), and all stems reach alike (narrow
 // crowns of one height whatever the diameter: on TreeLS's pine plot a thick pine's paths would
 // take the top of a thin neighbour).
 enum class StandType { Broadleaf, Conifer };

@@ -156,6 +156,49 @@ TEST(SegmentTrees, ASparseSurveyKeepsEachCrownWhole) {
     EXPECT_EQ(fixed_dominant.at(2).first, 0);
 }
 
+// Top merging by prominence that grows with the top's height (2 m up to a 17 m top, 0.12 x the
+// height above). Two 12 m cones with tops 7.6 m apart, which on the smoothed CHM rise more than
+// 2 m but less than 3 m above their pass, are two trees; a fixed 3 m joins them. Two bumps 8 m
+// apart on a 30 m dome, which rise more than 3 m but less than 0.12 x their height above their
+// saddle, are one crown; a fixed 3 m splits it.
+TEST(SegmentTrees, TopProminenceGrowsWithTheTopsHeight) {
+    const auto surface_tile = [](auto height_at) {
+        ToyTile tile;
+        for (float y = 0.0f; y <= 30.0f; y += 0.25f)
+            for (float x = 0.0f; x <= 40.0f; x += 0.25f) {
+                const float h = height_at(x, y);
+                tile.add({x, y, h > 0.5f ? h : 0.0f}, h > 0.5f ? 1 : 0);
+            }
+        test::classify_ground(tile);
+        return tile;
+    };
+    // Trees found with the defaults, or with a fixed prominence of 3 m (the setting before).
+    const auto tree_count = [](const ToyTile& tile, bool fixed_prominence) {
+        SegmentOptions options;
+        options.mode = ScanMode::Airborne;
+        if (fixed_prominence) {
+            options.min_top_prominence = 3.0f;
+            options.top_prominence_ratio = 0.0f;
+        }
+        return segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), options).trees.size();
+    };
+    const ToyTile small = surface_tile([](float x, float y) {
+        const float a = 12.0f - std::hypot(x - 16.2f, y - 15.0f), b = 12.0f - std::hypot(x - 23.8f, y - 15.0f);
+        return std::max({a, b, 0.0f}) > 5.0f ? std::max(a, b) : 0.0f;
+    });
+    EXPECT_EQ(tree_count(small, false), 2u);
+    EXPECT_EQ(tree_count(small, true), 1u);
+    const ToyTile broad = surface_tile([](float x, float y) {
+        const float r = std::hypot(x - 20.0f, y - 15.0f);
+        if (r > 12.0f) return 0.0f;
+        const float bumps = 6.0f * std::max(std::exp(-std::pow(std::hypot(x - 16.0f, y - 15.0f) / 1.5f, 2.0f)),
+                                            std::exp(-std::pow(std::hypot(x - 24.0f, y - 15.0f) / 1.5f, 2.0f)));
+        return 26.0f - 0.08f * r * r + bumps;
+    });
+    EXPECT_EQ(tree_count(broad, false), 1u);
+    EXPECT_EQ(tree_count(broad, true), 2u);
+}
+
 TEST(SegmentTrees, TerrestrialGrowsBothTreesFromTheirStemsInOneSearch) {
     const ToyTile tile = two_stems_terrestrial();
     const Terrain terrain = analyse_terrain(tile.cloud, {});
@@ -616,6 +659,7 @@ TEST(SegmentTrees, StandPresets) {
     custom.max_crown_radius = 9.0f;
     const SegmentOptions conifer = with_stand_type(custom, parse_stand_type("conifer"));
     EXPECT_EQ(conifer.min_top_prominence, 0.0f);
+    EXPECT_EQ(conifer.top_prominence_ratio, 0.0f);
     EXPECT_EQ(conifer.chm_smoothing, 0.0f);
     EXPECT_EQ(conifer.max_crown_radius, 3.5f);
     EXPECT_EQ(conifer.stem_reach_exponent, 0.0f);
@@ -623,6 +667,7 @@ TEST(SegmentTrees, StandPresets) {
     const SegmentOptions broadleaf = with_stand_type(conifer, parse_stand_type("broadleaf"));
     const SegmentOptions defaults;
     EXPECT_EQ(broadleaf.min_top_prominence, defaults.min_top_prominence);
+    EXPECT_EQ(broadleaf.top_prominence_ratio, defaults.top_prominence_ratio);
     EXPECT_EQ(broadleaf.chm_smoothing, defaults.chm_smoothing);
     EXPECT_EQ(broadleaf.max_crown_radius, defaults.max_crown_radius);
     EXPECT_EQ(broadleaf.stem_reach_exponent, defaults.stem_reach_exponent);
