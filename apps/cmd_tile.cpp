@@ -652,7 +652,8 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     table->add("--return-spacing", o->segment.return_spacing,
                "Airborne: mean spacing of the survey's vegetation returns, metres, from which the CHM's cell and discs grow (0 = "
                "estimated per tile; give the tiles of one survey one value so that they draw the same CHM)")
-            ->check(NonNegativeNumber);
+            ->check(NonNegativeNumber)
+            ->check(CLI::Range(0.0, 10.0));
     table->add_flag("--use-input-segmentation", o->use_input_segmentation,
                     "Take the input's treeID attribute as the trees (lidR or an earlier run) instead of segmenting afresh");
     table->add("--model", o->model, "Species model (.jb from `classify train`): species per tree with spatial voting");

@@ -40,7 +40,8 @@ void check_options(const SegmentOptions& o) {
     // A cell or disc of several spacings would blur neighbouring crowns into one.
     if (!(o.cell_per_spacing >= 0.0f && o.cell_per_spacing <= 4.0f)) throw Error::usage("segment: cell per spacing must be in 0..4");
     if (!(o.disc_per_spacing >= 0.0f && o.disc_per_spacing <= 4.0f)) throw Error::usage("segment: disc per spacing must be in 0..4");
-    if (!(o.return_spacing >= 0.0f) || !std::isfinite(o.return_spacing)) throw Error::usage("segment: return spacing must be >= 0");
+    // Returns 10 m apart (0.01 per m^2) no longer show a crown.
+    if (!(o.return_spacing >= 0.0f && o.return_spacing <= 10.0f)) throw Error::usage("segment: return spacing must be in 0..10 metres");
     positive(o.pit_depth, "pit depth");
     if (!(o.chm_smoothing >= 0.0f) || !std::isfinite(o.chm_smoothing)) throw Error::usage("segment: CHM smoothing must be >= 0");
     positive(o.window_base, "window base");

@@ -59,8 +59,8 @@ struct SegmentOptions {
     // discs still cover the crowns at 1-2 returns per m^2.
     float cell_per_spacing = 0.75f;
     float disc_per_spacing = 0.7071f;  // 1/sqrt(2): discs of this radius around a square grid of returns cover it
-    // The vegetation returns' mean spacing (metres); 0 = estimated from the cloud. A survey cut
-    // into tiles gives every tile one value, so that they all draw the same CHM.
+    // The vegetation returns' mean spacing (metres, at most 10); 0 = estimated from the cloud. A
+    // survey cut into tiles gives every tile one value, so that they all draw the same CHM.
     float return_spacing = 0.0f;
     float pit_depth = 1.0f;         // a CHM cell this far below its neighbours' median is a pit, set to that median (metres)
     float chm_smoothing = 0.75f;    // Gaussian sigma of the CHM the tops are searched on (metres; 0 = none)

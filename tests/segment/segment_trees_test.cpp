@@ -625,6 +625,7 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     EXPECT_TRUE(rejects(&SegmentOptions::cell_per_spacing, -0.1f));
     EXPECT_TRUE(rejects(&SegmentOptions::disc_per_spacing, 5.0f));
     EXPECT_TRUE(rejects(&SegmentOptions::disc_per_spacing, nan));
+    for (const float spacing : {-0.5f, 10.5f, nan, inf}) EXPECT_TRUE(rejects(&SegmentOptions::return_spacing, spacing)) << spacing;
     EXPECT_TRUE(rejects(&SegmentOptions::stem_slice_high, SegmentOptions{}.stem_slice_low));
     for (const float layer : {0.0f, 1e-9f, 100.0f, nan}) {
         EXPECT_TRUE(rejects(&SegmentOptions::stem_layer_height, layer)) << layer;
