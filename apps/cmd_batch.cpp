@@ -104,16 +104,21 @@ fs::path typical_tile(const std::vector<fs::path>& tiles) {
 // run, and all 215 with one spacing. nullopt when the typical tile cannot be read, holds no
 // vegetation or is as dense as a terrestrial scan (whose segmentation has no CHM): each tile then
 // estimates its own.
-std::optional<SurveySpacing> survey_return_spacing(const std::vector<fs::path>& tiles, const std::vector<std::string>& arguments) {
+std::optional<SurveySpacing> survey_return_spacing(const std::vector<fs::path>& tiles, const std::vector<std::string>& arguments,
+                                                   double memory_budget) {
     if (has_option(arguments, "--return-spacing") || has_option(arguments, "--use-input-segmentation") || terrestrial_mode(arguments))
         return std::nullopt;
     const fs::path tile = typical_tile(tiles);
+    log_info("measuring the survey's return spacing on " + tile.string());
     try {
+        // The same refusal as the tile's own run: a tile beyond the budget is not read here either.
+        if (const auto refusal = memory_refusal(header_point_count(tile), kTileBytesPerPoint, memory_budget))
+            throw Error::input(tile.string(), *refusal);
         const PointCloud cloud = read_point_cloud(tile);
         const float spacing = vegetation_return_spacing(cloud, analyse_terrain(cloud, {}), {});
         const float terrestrial_spacing = 1.0f / std::sqrt(SegmentOptions{}.terrestrial_density);
         if (spacing > terrestrial_spacing) return SurveySpacing{spacing, tile};
-    } catch (const std::exception& e) {  // treelobes::Error for bad input, std::bad_alloc for a tile beyond the memory
+    } catch (const std::exception& e) {  // treelobes::Error for bad input or a tile beyond the budget, std::bad_alloc
         log_warn("the survey's return spacing could not be measured on " + tile.string() + " (" + e.what() +
                  "): each tile estimates its own");
     }
@@ -212,10 +217,11 @@ TileResult process_tile(const fs::path& input, const fs::path& dir, const std::v
 
 int run_batch(BatchCliOptions& o, const OptionTable& table, const GlobalOptions& global) {
     const survey::Shard shard = o.shard.empty() ? survey::Shard{} : survey::parse_shard(o.shard);
-    if (!o.max_memory.empty()) parse_memory_size(o.max_memory);  // a bad size is a usage error before any tile runs
+    // A bad size is a usage error before any tile runs.
+    const double memory_budget = o.max_memory.empty() ? default_memory_budget_bytes() : parse_memory_size(o.max_memory);
     std::vector<std::string> key_arguments = tile_arguments_of(o);
     const std::vector<fs::path> all = survey::list_tiles(o.source);
-    const std::optional<SurveySpacing> spacing = survey_return_spacing(all, key_arguments);
+    const std::optional<SurveySpacing> spacing = survey_return_spacing(all, key_arguments, memory_budget);
     if (spacing) {
         char metres[32];
         std::snprintf(metres, sizeof metres, "%.3f", static_cast<double>(spacing->metres));

@@ -117,22 +117,36 @@ std::vector<std::uint8_t> vegetation_points(const PointCloud& cloud, const Terra
     return keep;
 }
 
+// The vegetation points and the square cells of edge `cell` (metres) that hold any of them.
+struct OccupiedCells {
+    std::size_t points = 0;
+    std::size_t cells = 0;
+    // Points per square metre over the occupied cells (0 without vegetation).
+    double density(double cell) const { return cells ? static_cast<double>(points) / (static_cast<double>(cells) * cell * cell) : 0.0; }
+};
+
+OccupiedCells occupied_cells(const PointCloud& cloud, const std::vector<std::uint8_t>& vegetation, float cell) {
+    std::unordered_set<std::int64_t> cells;
+    OccupiedCells occupied;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        if (!vegetation[i]) continue;
+        const auto x = static_cast<std::int64_t>(std::floor(cloud.positions[i].x() / cell));
+        const auto y = static_cast<std::int64_t>(std::floor(cloud.positions[i].y() / cell));
+        cells.insert(x * 2000003 + y);
+        ++occupied.points;
+    }
+    occupied.cells = cells.size();
+    return occupied;
+}
+
 // Airborne or terrestrial from the density of the vegetation points over the occupied 1 m cells:
 // an airborne survey gives 1-100 points per square metre, a terrestrial scan hundreds to thousands.
 ScanMode choose_mode(const PointCloud& cloud, const std::vector<std::uint8_t>& vegetation, const SegmentOptions& options,
                      std::string& reason) {
-    std::unordered_map<std::int64_t, std::uint32_t> cells;
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        if (!vegetation[i]) continue;
-        const auto x = static_cast<std::int64_t>(std::floor(cloud.positions[i].x()));
-        const auto y = static_cast<std::int64_t>(std::floor(cloud.positions[i].y()));
-        ++cells[x * 2000003 + y];
-        ++count;
-    }
-    const double density = cells.empty() ? 0.0 : static_cast<double>(count) / static_cast<double>(cells.size());
+    const OccupiedCells occupied = occupied_cells(cloud, vegetation, 1.0f);
+    const double density = occupied.density(1.0);
     const bool terrestrial = density >= options.terrestrial_density;
-    reason = format("automatic: %.0f vegetation points per m^2 over %.0f occupied m^2 ", density, static_cast<double>(cells.size())) +
+    reason = format("automatic: %.0f vegetation points per m^2 over %.0f occupied m^2 ", density, static_cast<double>(occupied.cells)) +
              (terrestrial ? ">= " : "< ") + format("%.0f", options.terrestrial_density) +
              (terrestrial ? " (dense: terrestrial)" : " (sparse: airborne)");
     return terrestrial ? ScanMode::Terrestrial : ScanMode::Airborne;
@@ -445,16 +459,8 @@ std::vector<SegmentedTree> collect_trees(const PointCloud& cloud, const Terrain&
 
 // Mean spacing of the vegetation returns seen from above (segment_trees.hpp).
 float return_spacing_of(const PointCloud& cloud, const std::vector<std::uint8_t>& vegetation) {
-    std::unordered_set<std::int64_t> cells;
-    std::size_t count = 0;
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        if (!vegetation[i]) continue;
-        const auto x = static_cast<std::int64_t>(std::floor(cloud.positions[i].x() / 2.0f));
-        const auto y = static_cast<std::int64_t>(std::floor(cloud.positions[i].y() / 2.0f));
-        cells.insert(x * 2000003 + y);
-        ++count;
-    }
-    return count ? static_cast<float>(std::sqrt(4.0 * static_cast<double>(cells.size()) / static_cast<double>(count))) : 0.0f;
+    const double density = occupied_cells(cloud, vegetation, 2.0f).density(2.0);
+    return density > 0.0 ? static_cast<float>(1.0 / std::sqrt(density)) : 0.0f;
 }
 
 // The CHM's cell and discs grow with the returns' spacing (and the cell as for the DTM where the
