@@ -82,48 +82,11 @@ print(f"{seconds:.1f} {peak:.0f} {cpu:.1f} {counts['trees_found']} {modelled} {c
 PY
 }
 
-# accuracy TRUTH_CSV OUT_DIR: the found trees against the true trees taller than 5 m, matched two
-# ways: (1) the found stem base nearest within 2 m (one-to-one, nearest first), and (2) by points,
-# the issue's rule: each holds at least half of the other's points (the output points.las carries
-# the found treeID and the input's true one as treeID_input). A found tree that merges several
-# crowns matches no true tree by points, while by distance it pairs with whichever stem lies
-# nearest; (2) is therefore the fair measure of the per-tree measures. Prints matched trees,
-# height RMSE, stem position RMS and, over fitted DBHs, DBH RMSE for each.
+# accuracy TRUTH_CSV OUT_DIR: the found trees against the true trees taller than 5 m
+# (bench/tile_accuracy.py: matched by points and by the nearest stem within 2 m).
 accuracy() {
   "$BIN" --log-level error convert "$2/points.las" --out "$2/points.csv" >/dev/null
-  python3 - "$1" "$2/trees.csv" "$2/points.csv" <<'PY'
-import csv, math, sys
-from collections import Counter
-truth = {r["tree_id"]: r for r in csv.DictReader(open(sys.argv[1])) if float(r["height_m"]) > 5}
-found = {r["tree_id"]: r for r in csv.DictReader(open(sys.argv[2]))}
-pairs = sorted((math.hypot(float(t["x"]) - float(f["x"]), float(t["y"]) - float(f["y"])), i, j)
-               for i, t in truth.items() for j, f in found.items())
-used_t, used_f, by_distance = set(), set(), []
-for d, i, j in pairs:
-    if d > 2.0 or i in used_t or j in used_f: continue
-    used_t.add(i); used_f.add(j); by_distance.append((truth[i], found[j]))
-rows = csv.reader(open(sys.argv[3]))
-header = next(rows)
-found_column = header.index("treeID")  # with --use-input-segmentation the true ids are the found ones
-true_column = header.index("treeID_input") if "treeID_input" in header else found_column
-shared, found_points, true_points = Counter(), Counter(), Counter()
-for row in rows:
-    f, t = str(int(float(row[found_column]))), str(int(float(row[true_column])))
-    found_points[f] += f != "0"
-    true_points[t] += t != "0"
-    if f != "0" and t != "0": shared[(f, t)] += 1
-by_points = [(truth[t], found[f]) for (f, t), n in shared.items()
-             if t in truth and f in found and 2 * n >= found_points[f] and 2 * n >= true_points[t]]
-rmse = lambda v: math.sqrt(sum(x * x for x in v) / len(v)) if v else float("nan")
-def figures(matches, how):
-    dh = [float(f["height_m"]) - float(t["height_m"]) for t, f in matches]
-    dp = [math.hypot(float(f["x"]) - float(t["x"]), float(f["y"]) - float(t["y"])) for t, f in matches]
-    dd = [float(f["dbh_m"]) - float(t["dbh_m"]) for t, f in matches if f["dbh_m"]]
-    ok = sum(1 for t, f in matches if f["dbh_quality"] == "ok")
-    return (f"{len(matches)} matched {how}: height RMSE {rmse(dh):.2f} m, position RMS {rmse(dp):.2f} m, "
-            f"DBH fitted for {len(dd)} ({ok} ok), DBH RMSE {100 * rmse(dd):.1f} cm")
-print(f"{len(truth)} true trees > 5 m; {figures(by_points, 'by points')}; {figures(by_distance, 'within 2 m')}")
-PY
+  python3 bench/tile_accuracy.py "$1" "$2"
 }
 
 echo "== airborne tiles: scaling (${MODE_FLAGS:-fresh segmentation})"

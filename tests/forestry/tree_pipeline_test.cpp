@@ -1,6 +1,6 @@
 // The per-tree pipeline of a tile (forestry/tree_pipeline.hpp): every tree in its own error
 // boundary, trees too small for a model measured rather than dropped, the height on a slope and
-// the stem position of a crown seen from above.
+// the stem position of a crown seen from above, with or without a limb reaching away.
 #include "forestry/tree_pipeline.hpp"
 
 #include <gtest/gtest.h>
@@ -93,6 +93,22 @@ TEST(TreePipeline, ACrownSeenFromAboveIsPlacedAtItsCentreNotUnderItsTop) {
 
     crown.base_at_stem = true;  // a base found at the stem is kept
     EXPECT_NEAR(process_tree(crown, {}, products).measures.position.x(), 1.5, 1e-9);
+}
+
+TEST(TreePipeline, ALimbReachingAwayDoesNotMoveACrownsStem) {
+    TreeInput crown = stem_and_crown(7, 600);  // the crown alone, and a limb of 80 points 5-8 m east of it
+    crown.points.positions.erase(crown.points.positions.begin(), crown.points.positions.begin() + 1188);
+    crown.height_above_ground.erase(crown.height_above_ground.begin(), crown.height_above_ground.begin() + 1188);
+    for (int k = 0; k < 80; ++k) {
+        crown.points.positions.emplace_back(5.0f + 3.0f * static_cast<float>(k) / 80.0f, 0.0f, 6.0f);
+        crown.height_above_ground.push_back(6.0f);
+    }
+    crown.base = {6.0, 0.0, 0.0};
+    crown.base_at_stem = false;
+    TreeProducts products;
+    const TreeOutcome placed = process_tree(crown, {}, products);
+    EXPECT_NEAR(placed.measures.position.x(), 0.0, 0.25);  // the plain mean x is 0.8 m
+    EXPECT_NEAR(placed.measures.position.y(), 0.0, 0.2);
 }
 
 TEST(TreePipeline, ATreeTooSmallForAModelIsMeasuredOnly) {
