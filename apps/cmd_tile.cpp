@@ -10,6 +10,7 @@
 #include "apps/option_table.hpp"
 #include "apps/summary_values.hpp"
 #include "classify/jointboost.hpp"
+#include "core/asprs_classes.hpp"
 #include "core/atomic_file.hpp"
 #include "core/cloud_header.hpp"
 #include "core/cloud_io.hpp"
@@ -250,6 +251,22 @@ bool write_output(const fs::path& path, bool overwrite, Write&& write) {
     return true;
 }
 
+// The tile's own points whose class says they are no tree's (buildings, water, wires, noise:
+// core/asprs_classes.hpp), by class name; the segmentation leaves them out, and one line says so.
+json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, const std::string& input) {
+    std::map<std::uint8_t, std::size_t> counts;
+    for (std::size_t i = 0; i < own_points && i < cloud.classification.size(); ++i)
+        if (asprs_never_a_tree(cloud.classification[i])) ++counts[cloud.classification[i]];
+    json by_name = json::object();
+    std::string text;
+    for (const auto& [code, count] : counts) {
+        by_name[asprs_class_name(code)] = count;
+        text += (text.empty() ? "" : ", ") + std::to_string(count) + " " + asprs_class_name(code) + " (" + std::to_string(code) + ")";
+    }
+    if (!counts.empty()) log_info(input + ": points left out of the trees by their class: " + text);
+    return by_name;
+}
+
 std::string dbh_counts(const std::vector<forestry::TreeRow>& rows, json& counts) {
     std::map<std::string, int> by_quality{{"ok", 0}, {"partial_arc", 0}, {"not_visible", 0}};
     for (const auto& row : rows) ++by_quality[forestry::dbh_quality_name(row.measures.dbh.quality)];
@@ -431,6 +448,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     }
     const PointCloud& cloud = buffered.cloud;
     seconds["read"] = rounded(lap_seconds(mark));
+    const json left_out = points_left_out_by_class(cloud, buffered.own_points, o.input);
 
     const Terrain terrain = analyse_terrain(cloud, o.terrain);
     seconds["terrain"] = rounded(lap_seconds(mark));
@@ -581,6 +599,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                             {"trees_in_buffer", trees_in_buffer},
                             {"ground_points", terrain.ground_points},
                             {"ground_source", terrain.ground_source},
+                            {"left_out_by_class", left_out},
                             {"tree_points", tree_points},
                             {"trees_found", outcomes.size()},
                             {"trees", rows.size()},

@@ -1,5 +1,6 @@
 #include "segment/segment_trees.hpp"
 
+#include "core/asprs_classes.hpp"
 #include "core/error.hpp"
 #include "geometry/euclidean_clusters.hpp"
 #include "geometry/kd_tree.hpp"
@@ -106,13 +107,13 @@ std::string format(const char* pattern, double a, double b = 0, double c = 0) {
     return text;
 }
 
-// Points that may belong to a tree: not ground, not noise, at least `clearance` above the DTM.
+// Points that may belong to a tree: not ground, not of a class that is never a tree's (noise,
+// buildings, water, wires, ...: core/asprs_classes.hpp), at least `clearance` above the DTM.
 std::vector<std::uint8_t> vegetation_points(const PointCloud& cloud, const Terrain& terrain, float clearance) {
     std::vector<std::uint8_t> keep(cloud.size(), 0);
     for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const bool noise =
-                !cloud.classification.empty() && (cloud.classification[i] == kAsprsLowNoise || cloud.classification[i] == kAsprsHighNoise);
-        keep[i] = !noise && !terrain.is_ground[i] && terrain.height_above_ground[i] >= clearance;
+        const bool not_a_tree = !cloud.classification.empty() && asprs_never_a_tree(cloud.classification[i]);
+        keep[i] = !not_a_tree && !terrain.is_ground[i] && terrain.height_above_ground[i] >= clearance;
     }
     return keep;
 }

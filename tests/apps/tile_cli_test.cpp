@@ -1,6 +1,6 @@
 // End-to-end: `treelobes tile` on a small synthetic tile (outputs present and consistent with
 // each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, trees too small
-// for a model measured only, failures.jsonl with exit 3) and on bad tiles (empty, all ground, one
+// for a model measured only, failures.jsonl with exit 3, buildings left out) and on bad tiles (empty, all ground, one
 // tree, no CRS, NaN coordinates).
 #include "core/cloud_io.hpp"
 #include "core/skeleton_io.hpp"
@@ -176,6 +176,38 @@ TEST(TileCli, AirborneTreesStandOnTheGroundAndTheirStemsCountInTheWoodyVolume) {
     std::sort(ratios.begin(), ratios.end());
     EXPECT_GT(ratios[2], 0.5);  // the median: a guessed stem (height / 50 at its foot), not a measured one
     EXPECT_LT(ratios[2], 2.0);
+}
+
+// A classified survey's buildings (and water, wires, noise) are no tree's: the points of one tree
+// of the small tile classified as a building (6) are left out of the fresh segmentation, and the
+// summary and one line on stderr count them.
+TEST(TileCli, PointsClassifiedAsBuildingsAreNoTrees) {
+    TempDir dir;
+    PointCloud cloud = read_point_cloud(small_tile());
+    const ExtraAttribute* truth = cloud.extra("treeID");
+    ASSERT_NE(truth, nullptr);
+    ASSERT_EQ(cloud.classification.size(), cloud.size());
+    std::size_t building = 0;
+    for (std::size_t i = 0; i < cloud.size(); ++i)
+        if (truth->values[i] == 1) {
+            cloud.classification[i] = 6;
+            ++building;
+        }
+    ASSERT_GT(building, 100u);
+    write_point_cloud(cloud, dir / "tile.las");
+    const auto r = run_cli("--json tile " + quoted(dir / "tile.las") + " --mode als --out " + quoted(dir / "o"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto summary = nlohmann::json::parse(r.out);
+    EXPECT_EQ(summary["counts"]["left_out_by_class"]["building"], building);
+    EXPECT_NE(r.err.find("left out of the trees by their class: " + std::to_string(building) + " building (6)"), std::string::npos)
+            << r.err;
+    const PointCloud labelled = read_point_cloud(dir / "o" / "points.las");
+    const ExtraAttribute* found = labelled.extra("treeID");
+    ASSERT_NE(found, nullptr);
+    std::size_t building_in_trees = 0;
+    for (std::size_t i = 0; i < labelled.size(); ++i) building_in_trees += labelled.classification[i] == 6 && found->values[i] != 0;
+    EXPECT_EQ(building_in_trees, 0u);
+    EXPECT_EQ(std::count(labelled.classification.begin(), labelled.classification.end(), 6), static_cast<long>(building));
 }
 
 // --budget-kb bounds every tree's .tlobe (2.0-3.8 kB at the default 39 kB on this tile): the

@@ -1,5 +1,6 @@
 // Tree segmentation on toy tiles: two airborne crowns, two terrestrial stems sharing a crown
-// space (multi-source Dijkstra), the automatic mode, and the degenerate tiles.
+// space (multi-source Dijkstra), points of classes that are no tree's, the automatic mode, and
+// the degenerate tiles.
 #include "segment/segment_trees.hpp"
 
 #include "core/error.hpp"
@@ -84,6 +85,30 @@ TEST(SegmentTrees, AirborneSeparatesTwoCrownsHighestFirst) {
         if (!tile.truth[i]) {
             ASSERT_EQ(result.tree_id[i], 0) << "ground point " << i;
         }
+}
+
+// A classified survey marks buildings, wires and water, and their points are no tree's: a flat
+// roof 6 m up, 6 x 4 m, beside the crowns of two_crowns_airborne.
+TEST(SegmentTrees, PointsOfClassesThatAreNoTreesAreLeftOut) {
+    ToyTile tile = two_crowns_airborne();
+    const std::size_t roof_begin = tile.cloud.size();
+    for (float y = 1.0f; y <= 5.0f; y += 0.3f)
+        for (float x = 13.0f; x <= 19.0f; x += 0.3f) tile.add({x, y + 6.0f, test::ground_height(x, y + 6.0f, 5.0f, 0.1f) + 6.0f}, 0);
+    test::classify_ground(tile);  // the roof too is "ground" here; it gets its own class below
+    SegmentOptions options;
+    options.mode = ScanMode::Airborne;
+    for (std::uint8_t roof_class : {std::uint8_t{6}, std::uint8_t{1}}) {
+        for (std::size_t i = roof_begin; i < tile.cloud.size(); ++i) tile.cloud.classification[i] = roof_class;
+        const TreeSegmentation result = segment_trees(tile.cloud, analyse_terrain(tile.cloud, {}), options);
+        std::size_t roof_in_trees = 0;
+        for (std::size_t i = roof_begin; i < tile.cloud.size(); ++i) roof_in_trees += result.tree_id[i] != 0;
+        if (roof_class == 6) {  // a building
+            EXPECT_EQ(result.trees.size(), 2u);
+            EXPECT_EQ(roof_in_trees, 0u);
+        } else {  // unclassified: nothing tells the roof from a crown
+            EXPECT_GT(roof_in_trees, 0u);
+        }
+    }
 }
 
 // The tops are found on the smoothed CHM, and a crown whose highest returns ring a lower centre
