@@ -267,6 +267,25 @@ json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, c
     return by_name;
 }
 
+// One line for all the trees whose points look like a building's (an unclassified urban tile's
+// roofs and walls), rather than a warning per tree; trees.csv marks them in `not_a_tree`.
+void warn_of_trees_that_are_not(const std::string& input, const std::vector<forestry::TreeRow>& rows) {
+    std::vector<int> ids;
+    std::size_t assessed = 0;
+    for (const forestry::TreeRow& row : rows) {
+        if (!row.measures.not_a_tree) continue;
+        ++assessed;
+        if (*row.measures.not_a_tree) ids.push_back(row.measures.id);
+    }
+    if (ids.empty()) return;
+    constexpr std::size_t kIdsNamed = 10;
+    std::string named;
+    for (std::size_t k = 0; k < std::min(ids.size(), kIdsNamed); ++k) named += (k ? ", " : "") + std::to_string(ids[k]);
+    if (ids.size() > kIdsNamed) named += ", ...";
+    log_warn(input + ": " + std::to_string(ids.size()) + " of " + std::to_string(assessed) +
+             " modelled trees do not look like trees (wide planes: roofs, walls; trees.csv column not_a_tree): " + named);
+}
+
 std::string dbh_counts(const std::vector<forestry::TreeRow>& rows, json& counts) {
     std::map<std::string, int> by_quality{{"ok", 0}, {"partial_arc", 0}, {"not_visible", 0}};
     for (const auto& row : rows) ++by_quality[forestry::dbh_quality_name(row.measures.dbh.quality)];
@@ -543,6 +562,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         forest.push_back(std::move(placed));
     }
     if (model) assign_species(rows, outcomes, row_of, *model, o.voting);
+    warn_of_trees_that_are_not(o.input, rows);
     for (std::size_t i : todo_index)  // after the tree's files: a record marks a finished tree
         if (row_of[i] != SIZE_MAX && rows[row_of[i]].modelled)
             write_file_atomically(out.tree_file(outcomes[i].id, kRecordSuffix), forestry::tree_record(rows[row_of[i]], cloud.origin, key));

@@ -68,7 +68,8 @@ json row_properties(const TreeRow& row, const Eigen::Vector3d& origin) {
             {"species_confidence", value_or_null(row.species_confidence, 3)},
             {"points", m.points},
             {"lobes", row.modelled ? json(row.lobes) : json(nullptr)},
-            {"model", model_name(row)}};
+            {"model", model_name(row)},
+            {"not_a_tree", m.not_a_tree ? json(*m.not_a_tree) : json(nullptr)}};
 }
 
 }  // namespace
@@ -134,7 +135,7 @@ std::vector<TreeInput> split_trees(const PointCloud& cloud, std::span<const std:
 std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin) {
     std::string csv =
             "global_id,tree_id,x,y,z,height_m,dbh_m,dbh_quality,stems,crown_base_height_m,crown_diameter_m,crown_area_m2,crown_volume_m3,"
-            "woody_volume_m3,species,species_confidence,points,lobes,model\n";
+            "woody_volume_m3,species,species_confidence,points,lobes,model,not_a_tree\n";
     for (const TreeRow& row : rows) {
         const TreeMeasures& m = row.measures;
         const Eigen::Vector3d p = origin + m.position;
@@ -143,7 +144,8 @@ std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& o
                (m.dbh.stems > 0 ? std::to_string(m.dbh.stems) : std::string()) + "," + cell(m.crown.base_height, 2) + "," +
                cell(m.crown.diameter, 2) + "," + cell(m.crown.projected_area, 2) + "," + cell(m.crown.volume, 2) + "," +
                cell(m.woody_volume, 4) + "," + row.species + "," + cell(row.species_confidence, 3) + "," + std::to_string(m.points) + "," +
-               (row.modelled ? std::to_string(row.lobes) : std::string()) + "," + model_name(row) + "\n";
+               (row.modelled ? std::to_string(row.lobes) : std::string()) + "," + model_name(row) + "," +
+               (m.not_a_tree ? (*m.not_a_tree ? "true" : "false") : "") + "\n";
     }
     return csv;
 }
@@ -222,6 +224,7 @@ std::optional<TreeRow> read_tree_record(const std::string& text, const std::stri
         m.crown.volume_failure = crown.at("volume_failure").get<std::string>();
         m.woody_volume = optional_from(e.at("woody_volume"));
         m.species_probabilities = e.at("species_probabilities").get<std::vector<double>>();
+        if (const json& flag = record.at("not_a_tree"); !flag.is_null()) m.not_a_tree = flag.get<bool>();
         return row;
     } catch (const json::exception&) {
         return std::nullopt;  // an older or damaged record: the tree is made again

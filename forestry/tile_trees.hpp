@@ -55,8 +55,10 @@ std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3
 // measured by an older treelobes is measured again (3: stem position and height at the stem,
 // measured-only trees; 4: crown base above the ground at the stem; 5: the DBH of multi-stemmed
 // trees and the stem count; 6: the DBH circle cut level, not along the terrain, and a
-// multi-stemmed tree's trunks followed down below their twigs).
-inline constexpr int kTreeRecordRevision = 6;
+// multi-stemmed tree's trunks followed down below their twigs; 7: a crown seen from above placed
+// at the centre of its points without their outer fifth, and whether a modelled tree looks like a
+// building, not_a_tree).
+inline constexpr int kTreeRecordRevision = 7;
 
 // The record of one finished tree (trees/tree_<id>.json): its row in full precision plus the
 // options key it was made with. read_tree_record returns nullopt when the text is not such a

@@ -92,7 +92,9 @@ TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& optio
     // An airborne crown's skeleton is joined to the ground at the stem's position.
     ReconstructOptions reconstruct = options.reconstruct;
     reconstruct.hidden_stem_foot = outcome.measures.position.cast<float>();
+    reconstruct.warn_if_not_a_tree = false;  // the tile counts them in one line
     const TreeReconstruction reconstruction = reconstruct_tree(tree.points, reconstruct, name);
+    outcome.measures.not_a_tree = reconstruction.summary.quality.not_a_tree;
     outcome.seconds.emplace_back("reconstruct", seconds_since(mark));
     products.skeleton = reconstruction.skeleton;
     products.branches = build_branch_mesh(reconstruction.skeleton, options.mesh);

@@ -70,6 +70,10 @@ struct TreeMeasures {
     std::optional<double> woody_volume;  // cubic metres, from the skeleton's cylinders (none without a model)
     std::size_t points = 0;
     std::vector<double> species_probabilities;  // per model class; empty without a model
+    // Modelled trees: whether the points look like a building's rather than a tree's (more than a
+    // share of them on wide planes: roofs, walls; reconstruct/tree_quality.hpp). Unset for trees
+    // measured only.
+    std::optional<bool> not_a_tree;
 };
 
 // The per-tree files' contents, handed to the caller once and then dropped.

@@ -150,7 +150,7 @@ TreeReconstruction reconstruct_tree(const PointCloud& cloud, const ReconstructOp
     s.root_diameter = static_cast<float>(d_root);
     out.diameters = apply_allometry(sk.tree, d_root, o.allometry);
     describe_tree(sk.tree, s);
-    if (s.quality.not_a_tree)
+    if (s.quality.not_a_tree && o.warn_if_not_a_tree)
         log_warn(name + ": does not look like a tree (" + std::to_string(s.quality.planar_fraction) + " of the points lie on wide planes)");
     clock.mark("trunk and radii");
 

@@ -32,6 +32,9 @@ struct ReconstructOptions {
     // Where the stem meets the ground when the scan may not show it (a tile's airborne crowns), in
     // the cloud's local frame: a hidden stem is added from there to the skeleton (add_hidden_trunk).
     std::optional<Eigen::Vector3f> hidden_stem_foot;
+    // A warning per cloud that does not look like a tree (summary.quality); a tile reports all of
+    // its trees that do not in one line instead.
+    bool warn_if_not_a_tree = true;
 };
 
 struct TreeSummary {

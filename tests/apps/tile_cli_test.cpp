@@ -1,7 +1,7 @@
 // End-to-end: `treelobes tile` on a small synthetic tile (outputs present and consistent with
 // each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, trees too small
 // for a model measured only, failures.jsonl with exit 3, buildings left out) and on bad tiles (empty, all ground, one
-// tree, no CRS, NaN coordinates).
+// tree, no CRS, NaN coordinates, an unclassified building).
 #include "core/cloud_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
@@ -434,6 +434,37 @@ TEST(TileCliBadTiles, AllGroundGivesTheDocumentedEmptyResult) {
     EXPECT_TRUE(nlohmann::json::parse(slurp(dir / "o" / "trees.geojson"))["features"].empty());
     EXPECT_EQ(encode::ForestReader(dir / "o" / "tile.forest").size(), 0u);
     for (const char* file : {"dtm.asc", "points.las", "top_view.png", "summary.json"}) EXPECT_TRUE(fs::exists(dir / "o" / file)) << file;
+}
+
+// An unclassified tile's building: a box house (roof 6 m up, walls) on flat ground becomes a
+// "tree" that trees.csv, the GeoJSON and one line on stderr mark as not looking like one.
+TEST(TileCliBadTiles, AnUnclassifiedBuildingIsMarkedNotATree) {
+    TempDir dir;
+    std::string text;
+    const auto point = [&](double x, double y, double z) {
+        text += std::to_string(x) + " " + std::to_string(y) + " " + std::to_string(z) + "\n";
+    };
+    for (int i = 0; i <= 60; ++i)
+        for (int j = 0; j <= 60; ++j) point(0.5 * i, 0.5 * j, 0.0);
+    for (int i = 0; i <= 32; ++i)
+        for (int j = 0; j <= 32; ++j) point(10 + 0.25 * i, 10 + 0.25 * j, 6.0);
+    for (int k = 0; k <= 32; ++k)
+        for (int h = 1; h < 24; ++h) {
+            point(10 + 0.25 * k, 10, 0.25 * h);
+            point(10 + 0.25 * k, 18, 0.25 * h);
+            point(10, 10 + 0.25 * k, 0.25 * h);
+            point(18, 10 + 0.25 * k, 0.25 * h);
+        }
+    std::ofstream(dir / "house.xyz") << text;
+    const auto r = run_cli("tile " + quoted(dir / "house.xyz") + " --mode als --out " + quoted(dir / "o"));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("1 of 1 modelled trees do not look like trees"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("tree 1: does not look like a tree"), std::string::npos) << r.err;  // one line, not one per tree
+    const auto lines = lines_of(slurp(dir / "o" / "trees.csv"));
+    ASSERT_EQ(lines.size(), 2u);
+    EXPECT_TRUE(lines[0].ends_with(",model,not_a_tree")) << lines[0];
+    EXPECT_TRUE(lines[1].ends_with(",ok,true")) << lines[1];
+    EXPECT_EQ(nlohmann::json::parse(slurp(dir / "o" / "trees.geojson"))["features"][0]["properties"]["not_a_tree"], true);
 }
 
 TEST(TileCliBadTiles, ASingleTree) {
