@@ -125,25 +125,35 @@ json tree_options_json(const TileCliOptions& o) {
             {"model", o.model}};
 }
 
+std::string unit_text(const CrsUnit& unit) {
+    char metres[32];
+    std::snprintf(metres, sizeof metres, "%.6g", unit.metres);
+    return unit.name + " (" + metres + " m)";
+}
+
 // Coordinates are taken as metres. A CRS in feet (US State Plane surveys) or degrees gives
 // heights, crowns and DBH in its own unit and thresholds (a 2 m minimum tree height, 0.5 m CHM
-// cells) that do not fit; the run goes on, and says so.
-void warn_of_a_unit_other_than_metres(const std::string& input, const std::optional<CrsUnit>& unit) {
-    if (!unit || unit->is_metre()) return;
-    if (unit->angular) {
+// cells) that do not fit; heights in feet under metres across (a compound CRS with a vertical
+// part in feet) give tree heights in feet. The run goes on, and says so.
+void warn_of_units_other_than_metres(const std::string& input, const CrsUnits& units) {
+    const std::optional<CrsUnit>& across = units.horizontal;
+    if (across && across->angular) {
         log_warn(input +
                  ": the CRS is geographic (coordinates in degrees); treelobes takes coordinates as metres: reproject the tile "
                  "to a projected CRS in metres");
-        return;
+    } else if (across && !across->is_metre()) {
+        log_warn(input + ": the CRS measures lengths in " + unit_text(*across) +
+                 "; treelobes takes coordinates as metres, so heights, crowns and DBH come out in that unit and its thresholds "
+                 "in metres do not fit: reproject the tile to a CRS in metres");
+        return;  // the heights' unit is said with it
     }
-    char metres[32];
-    std::snprintf(metres, sizeof metres, "%.6g", unit->metres);
-    log_warn(input + ": the CRS measures lengths in " + unit->name + " (" + metres +
-             " m); treelobes takes coordinates as metres, so heights, crowns and DBH come out in that unit and its thresholds "
-             "in metres do not fit: reproject the tile to a CRS in metres");
+    if (units.vertical && !units.vertical->is_metre())
+        log_warn(input + ": the CRS measures heights in " + unit_text(*units.vertical) +
+                 "; treelobes takes heights as metres, so tree heights, crown bases and volumes come out in that unit and its "
+                 "height thresholds in metres do not fit: convert the heights to metres");
 }
 
-// The CRS's horizontal unit as the WKT names it (null when it names none).
+// A unit as the CRS names it (null when it names none).
 json crs_unit_json(const std::optional<CrsUnit>& unit) {
     if (!unit) return nullptr;
     return {{"name", unit->name}, {"metres", unit->metres}, {"angular", unit->angular}};
@@ -459,7 +469,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     buffered.cloud = read_point_cloud(o.input);
     if (buffered.cloud.empty()) throw Error::input(o.input, "the tile holds no points");
     if (buffered.cloud.georef.empty()) log_warn(o.input + ": no CRS in the input; outputs keep its coordinates without one");
-    warn_of_a_unit_other_than_metres(o.input, crs_horizontal_unit(buffered.cloud.georef.crs_wkt));
+    warn_of_units_other_than_metres(o.input, crs_units_of(buffered.cloud.georef));
     buffered.own_points = buffered.cloud.size();
     if (o.buffer > 0) {
         if (!plan.core) plan.core = survey::core_from_points(buffered.cloud);
@@ -629,7 +639,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                             {"trees_failed", failures.size()},
                             {"dbh", dbh}}},
                           {"crs", cloud.georef.empty() ? json(nullptr) : json(cloud.georef.crs_wkt)},
-                          {"crs_unit", crs_unit_json(crs_horizontal_unit(cloud.georef.crs_wkt))},
+                          {"crs_unit", crs_unit_json(crs_units_of(cloud.georef).horizontal)},
+                          {"crs_vertical_unit", crs_unit_json(crs_units_of(cloud.georef).vertical)},
                           {"outputs",
                            {{"points", out.points.string()},
                             {"trees_csv", out.csv.string()},

@@ -67,6 +67,12 @@ std::optional<CrsUnit> own_unit(std::string_view text, std::size_t open, std::si
     return std::nullopt;
 }
 
+// The first UNIT or LENGTHUNIT at or after `from` and before `end`; npos when none.
+std::size_t first_unit(std::string_view text, std::size_t from, std::size_t end) {
+    const std::size_t unit = std::min(find_keyword(text, "LENGTHUNIT", from), find_keyword(text, "UNIT", from));
+    return unit < end ? unit : std::string_view::npos;
+}
+
 }  // namespace
 
 std::optional<CrsUnit> crs_horizontal_unit(std::string_view wkt) {
@@ -75,7 +81,7 @@ std::optional<CrsUnit> crs_horizontal_unit(std::string_view wkt) {
         // carry their own (a false easting in metres for a CRS in feet).
         const std::size_t cs = find_keyword(wkt, "CS", at);
         if (cs == std::string_view::npos) return std::nullopt;
-        const std::size_t unit = std::min(find_keyword(wkt, "LENGTHUNIT", cs), find_keyword(wkt, "UNIT", cs));
+        const std::size_t unit = first_unit(wkt, cs, wkt.size());
         return unit == std::string_view::npos ? std::nullopt : unit_at(wkt, unit, false);
     }
     if (const std::size_t at = find_keyword(wkt, "PROJCS"); at != std::string_view::npos) {
@@ -85,6 +91,52 @@ std::optional<CrsUnit> crs_horizontal_unit(std::string_view wkt) {
     for (const std::string_view geographic : {"GEOGCRS", "GEOGCS", "GEODCRS"})
         if (find_keyword(wkt, geographic) != std::string_view::npos) return CrsUnit{"degree", 0.0, true};
     return std::nullopt;
+}
+
+std::optional<CrsUnit> crs_vertical_unit(std::string_view wkt) {
+    for (const std::string_view vertical : {"VERTCRS", "VERTICALCRS"})
+        if (const std::size_t at = find_keyword(wkt, vertical); at != std::string_view::npos) {
+            const std::size_t open = wkt.find_first_of("[(", at), close = matching_bracket(wkt, open);
+            const std::size_t cs = close == std::string_view::npos ? close : find_keyword(wkt, "CS", open);
+            if (cs == std::string_view::npos || cs > close) return std::nullopt;
+            const std::size_t unit = first_unit(wkt, cs, close);
+            return unit == std::string_view::npos ? std::nullopt : unit_at(wkt, unit, false);
+        }
+    if (const std::size_t at = find_keyword(wkt, "VERT_CS"); at != std::string_view::npos) {
+        const std::size_t open = wkt.find_first_of("[(", at), close = matching_bracket(wkt, open);
+        return close == std::string_view::npos ? std::nullopt : own_unit(wkt, open, close, false);
+    }
+    return std::nullopt;
+}
+
+std::optional<CrsUnit> epsg_linear_unit(int code) {
+    switch (code) {
+        case 9001:
+            return CrsUnit{"metre", 1.0, false};
+        case 9002:
+            return CrsUnit{"foot", 0.3048, false};
+        case 9003:
+            return CrsUnit{"US survey foot", 1200.0 / 3937.0, false};
+        case 9005:
+            return CrsUnit{"Clarke's foot", 0.3047972654, false};
+        case 9036:
+            return CrsUnit{"kilometre", 1000.0, false};
+        case 9041:
+            return CrsUnit{"British foot (Sears 1922)", 0.304799471538676, false};
+        case 9070:
+            return CrsUnit{"British foot (1936)", 0.3048007491, false};
+        case 9096:
+            return CrsUnit{"yard", 0.9144, false};
+        default:
+            return std::nullopt;
+    }
+}
+
+CrsUnits crs_units_of(const Georeference& georef) {
+    CrsUnits units{crs_horizontal_unit(georef.crs_wkt), crs_vertical_unit(georef.crs_wkt)};
+    if (!units.horizontal) units.horizontal = epsg_linear_unit(georef.linear_unit_code);
+    if (!units.vertical) units.vertical = epsg_linear_unit(georef.vertical_unit_code);
+    return units;
 }
 
 }  // namespace treelobes

@@ -1,8 +1,11 @@
-// The unit a coordinate reference system measures lengths in, read from its WKT. The pipeline
-// takes coordinates as metres; a tile in feet (US State Plane surveys) or in degrees (a geographic
-// CRS) must be reprojected first, and `tile` says so instead of measuring trees 3.28 times too
-// tall.
+// The units a coordinate reference system measures lengths and heights in, read from its WKT or
+// from the unit codes of a LAS file's GeoTIFF keys. The pipeline takes coordinates as metres; a
+// tile in feet (US State Plane surveys), with heights in feet (a compound CRS whose vertical part
+// is in feet) or in degrees (a geographic CRS) must be reprojected first, and `tile` says so
+// instead of measuring trees 3.28 times too tall.
 #pragma once
+
+#include "core/point_cloud.hpp"
 
 #include <optional>
 #include <string>
@@ -21,5 +24,23 @@ struct CrsUnit {
 // (PROJCRS: the first unit of its coordinate system, CS; GEOGCRS alone: angular) text, a compound
 // CRS's horizontal part; nullopt when the text names none (empty, "EPSG:26917", unreadable).
 std::optional<CrsUnit> crs_horizontal_unit(std::string_view wkt);
+
+// The unit of a compound CRS's vertical part (WKT 1 VERT_CS, WKT 2 VERTCRS: the first unit of its
+// CS); nullopt when the text has no vertical part or it names no unit.
+std::optional<CrsUnit> crs_vertical_unit(std::string_view wkt);
+
+// A linear unit by its EPSG code, as GeoTIFF keys give it (ProjLinearUnitsGeoKey 3076,
+// VerticalUnitsGeoKey 4099): metre 9001, foot 9002, US survey foot 9003, Clarke's foot 9005,
+// kilometre 9036, British foot (Sears 1922) 9041, British foot (1936) 9070, yard 9096; nullopt for
+// other codes.
+std::optional<CrsUnit> epsg_linear_unit(int code);
+
+// Horizontal and vertical units of a cloud's CRS: from its WKT when it has one, else from the
+// GeoTIFF keys' unit codes (the WKT of a LAS 1.0-1.3 file is then "EPSG:nnnn", which names none).
+struct CrsUnits {
+    std::optional<CrsUnit> horizontal;
+    std::optional<CrsUnit> vertical;
+};
+CrsUnits crs_units_of(const Georeference& georef);
 
 }  // namespace treelobes

@@ -490,10 +490,12 @@ std::vector<ExtraField> find_extra_fields(const InputFile& file, const std::vect
     return {};
 }
 
-// "EPSG:nnnn" from ProjectedCSTypeGeoKey (3072), else GeographicTypeGeoKey (2048); empty when
-// neither holds an EPSG code (32767 means user-defined).
-std::string epsg_from_geokeys(const Bytes& data) {
-    if (data.size() < 8) return "";
+// From a GeoKeyDirectory: "EPSG:nnnn" from ProjectedCSTypeGeoKey (3072), else
+// GeographicTypeGeoKey (2048), empty when neither holds an EPSG code (32767 means user-defined);
+// and the EPSG codes of the linear and vertical units (ProjLinearUnitsGeoKey 3076,
+// VerticalUnitsGeoKey 4099; 0 when absent), which a code alone does not tell without the registry.
+void read_geokeys(const Bytes& data, Georeference& georef) {
+    if (data.size() < 8) return;
     const std::size_t declared = load<std::uint16_t>(data.data() + 6);
     const std::size_t count = std::min(declared, data.size() / 8 - 1);
     int projected = 0, geographic = 0;
@@ -504,9 +506,11 @@ std::string epsg_from_geokeys(const Bytes& data) {
         if (location != 0) continue;  // value stored elsewhere: not a plain code
         if (id == 3072) projected = value;
         if (id == 2048) geographic = value;
+        if (id == 3076) georef.linear_unit_code = value;
+        if (id == 4099) georef.vertical_unit_code = value;
     }
     const int code = projected > 0 && projected < 32767 ? projected : geographic;
-    return code > 0 && code < 32767 ? "EPSG:" + std::to_string(code) : "";
+    if (georef.crs_wkt.empty() && code > 0 && code < 32767) georef.crs_wkt = "EPSG:" + std::to_string(code);
 }
 
 Georeference georeference_from(const std::vector<RawVlr>& records) {
@@ -516,9 +520,8 @@ Georeference georeference_from(const std::vector<RawVlr>& records) {
         georef.las_vlrs.push_back(r);
         if (r.record_id == kWktRecord && georef.crs_wkt.empty()) georef.crs_wkt = load_string(r.data.data(), r.data.size());
     }
-    if (georef.crs_wkt.empty())
-        for (const RawVlr& r : georef.las_vlrs)
-            if (r.record_id == kGeoKeyDirectoryRecord) georef.crs_wkt = epsg_from_geokeys(r.data);
+    for (const RawVlr& r : georef.las_vlrs)
+        if (r.record_id == kGeoKeyDirectoryRecord) read_geokeys(r.data, georef);
     return georef;
 }
 

@@ -43,6 +43,10 @@ struct RawVlr {
 struct Georeference {
     std::string crs_wkt;           // empty when unknown
     std::vector<RawVlr> las_vlrs;  // CRS VLRs to pass through on LAS write
+    // EPSG codes of the linear units the GeoTIFF keys declare (ProjLinearUnitsGeoKey 3076,
+    // VerticalUnitsGeoKey 4099: 9001 metre, 9002 foot, 9003 US survey foot); 0 when not declared.
+    int linear_unit_code = 0;
+    int vertical_unit_code = 0;
     bool empty() const { return crs_wkt.empty() && las_vlrs.empty(); }
 };
 

@@ -271,7 +271,8 @@ void text_seeds(const fs::path& source, const fs::path& out) {
         fs::copy_file(entry.path(), out / "lsystem" / entry.path().filename(), fs::copy_options::overwrite_existing);
 }
 
-// CRS texts as LAS files carry them: WKT 1 in feet and in metres, WKT 2, geographic.
+// CRS texts as LAS files carry them: WKT 1 in feet and in metres, WKT 2, geographic, a WKT 2
+// compound CRS with heights in feet.
 void crs_seeds(const fs::path& out) {
     write_bytes(out / "crs_units/wkt1_feet.txt",
                 R"wkt(PROJCS["Lambert (ft)",GEOGCS["NAD83",DATUM["D_North_American_1983",SPHEROID["GRS_1980",6378137,298.257222101]],)wkt"
@@ -285,6 +286,10 @@ void crs_seeds(const fs::path& out) {
                 R"wkt(PARAMETER["False easting",600000,LENGTHUNIT["metre",1]]],CS[Cartesian,2],)wkt"
                 R"wkt(AXIS["easting (X)",east,LENGTHUNIT["US survey foot",0.304800609601219]]])wkt");
     write_bytes(out / "crs_units/geographic.txt", R"wkt(GEOGCRS["WGS 84",ENSEMBLE["World Geodetic System 1984"],CS[ellipsoidal,2]])wkt");
+    write_bytes(out / "crs_units/wkt2_compound_height_feet.txt",
+                R"wkt(COMPOUNDCRS["NAD83 / Oregon LCC (m) + NAVD88 height (ftUS)",PROJCRS["NAD83 / Oregon LCC (m)",CS[Cartesian,2],)wkt"
+                R"wkt(AXIS["easting",east,LENGTHUNIT["metre",1]]],VERTCRS["NAVD88 height (ftUS)",VDATUM["NAVD88"],CS[vertical,1],)wkt"
+                R"wkt(AXIS["gravity-related height (H)",up,LENGTHUNIT["US survey foot",0.304800609601219]]]])wkt");
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // `treelobes tile` on real airborne surveys (label `real`): lidR's MixedConifer.las with the
 // conifer stand preset, end to end from the command line, against the treeID lidR published; and
-// laspy's autzen_trim.laz, whose CRS is in feet.
+// laspy's autzen_trim.laz, whose CRS is in feet, and simple.copc.laz, whose heights are.
 #include "core/cloud_io.hpp"
 #include "segment/segmentation_score.hpp"
 #include "support/test_support.hpp"
@@ -69,4 +69,30 @@ TEST(TileReal, ATileInFeetIsRunWithAWarningAndItsUnitRecorded) {
     const auto summary = nlohmann::json::parse(in);
     EXPECT_EQ(summary["crs_unit"]["name"], "foot");
     EXPECT_DOUBLE_EQ(summary["crs_unit"]["metres"].get<double>(), 0.3048);
+}
+
+// laspy's simple.copc.laz has a compound CRS: metres across (Oregon Lambert), US survey feet up
+// (NAVD88 height (ftUS)). Its heights would come out in feet as metres; the run says so. MixedConifer.las
+// gives its units only as GeoTIFF key codes (metre and metre), and no warning.
+TEST(TileReal, HeightsInFeetUnderMetresAcrossAreSaid) {
+    const auto copc = real_data("laz/laspy/simple.copc.laz");
+    const auto conifer = real_data("lidr/MixedConifer.las");
+    if (copc.empty() || conifer.empty()) return;
+    test::TempDir dir;
+    const auto result =
+            run_cli("tile '" + copc.string() + "' --out '" + (dir / "copc").string() + "' --min-tree-points 100000000 --map-size 200");
+    EXPECT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.exit_code << result.err;
+    EXPECT_NE(result.err.find("the CRS measures heights in US survey foot (0.304801 m)"), std::string::npos) << result.err;
+    EXPECT_EQ(result.err.find("measures lengths in"), std::string::npos) << result.err;
+    const auto summary = nlohmann::json::parse(std::ifstream(dir / "copc" / "summary.json"));
+    EXPECT_EQ(summary["crs_unit"]["name"], "metre");
+    EXPECT_EQ(summary["crs_vertical_unit"]["name"], "US survey foot");
+
+    const auto metres = run_cli("tile '" + conifer.string() + "' --out '" + (dir / "conifer").string() +
+                                "' --stand conifer --min-tree-points 100000000 --map-size 200");
+    EXPECT_EQ(metres.exit_code, 0) << metres.err;
+    EXPECT_EQ(metres.err.find("the CRS measures"), std::string::npos) << metres.err;
+    const auto conifer_summary = nlohmann::json::parse(std::ifstream(dir / "conifer" / "summary.json"));
+    EXPECT_EQ(conifer_summary["crs_unit"]["name"], "metre");
+    EXPECT_EQ(conifer_summary["crs_vertical_unit"]["name"], "metre");
 }

@@ -1,5 +1,6 @@
-// The horizontal unit of a CRS read from its WKT: WKT 1 and 2, projected in metres or feet,
-// compound, geographic, and texts that name none.
+// The units of a CRS read from its WKT: WKT 1 and 2, projected in metres or feet, compound (and
+// its vertical part), geographic, and texts that name none; units by the EPSG codes of GeoTIFF
+// keys.
 #include "core/crs_units.hpp"
 
 #include <gtest/gtest.h>
@@ -47,4 +48,46 @@ TEST(CrsUnits, GeographicIsAngularAndOtherTextsNameNone) {
     EXPECT_FALSE(geographic->is_metre());
     for (const char* none : {"", "EPSG:26917", "PROJCS[\"broken\",UNIT[", "PROJCS[\"no unit\"]"})
         EXPECT_FALSE(crs_horizontal_unit(none)) << none;
+}
+
+TEST(CrsUnits, TheVerticalPartOfACompoundCrsHasItsOwnUnit) {
+    // laspy's simple.copc.laz: metres across, US survey feet up (WKT 1 and WKT 2 spellings).
+    const auto wkt1 = crs_vertical_unit(
+            R"wkt(COMPD_CS["NAD83 / Oregon LCC (m) + NAVD88 height (ftUS)",PROJCS["NAD83 / Oregon LCC (m)",GEOGCS["NAD83",)wkt"
+            R"wkt(UNIT["degree",0.0174532925199433]],UNIT["metre",1]],VERT_CS["NAVD88 height (ftUS)",VERT_DATUM["x",2005],)wkt"
+            R"wkt(UNIT["US survey foot",0.304800609601219],AXIS["Gravity-related height",UP]]])wkt");
+    ASSERT_TRUE(wkt1);
+    EXPECT_EQ(wkt1->name, "US survey foot");
+    const auto wkt2 = crs_vertical_unit(
+            R"wkt(COMPOUNDCRS["x",PROJCRS["y",CS[Cartesian,2],AXIS["easting",east,LENGTHUNIT["metre",1]]],VERTCRS["NAVD88 height (ftUS)",)wkt"
+            R"wkt(VDATUM["NAVD88"],CS[vertical,1],AXIS["gravity-related height (H)",up,LENGTHUNIT["US survey foot",0.304800609601219]]]])wkt");
+    ASSERT_TRUE(wkt2);
+    EXPECT_NEAR(wkt2->metres, 0.3048006, 1e-7);
+    const auto metre = crs_vertical_unit(R"wkt(COMPD_CS["x",PROJCS["y",UNIT["metre",1]],VERT_CS["DHHN2016 height",UNIT["metre",1]]])wkt");
+    ASSERT_TRUE(metre);
+    EXPECT_TRUE(metre->is_metre());
+    for (const char* none :
+         {"", "EPSG:26917", R"wkt(PROJCS["y",UNIT["foot",0.3048]])wkt", "VERT_CS[\"broken\",UNIT[", "VERTCRS[\"no cs\"]"})
+        EXPECT_FALSE(crs_vertical_unit(none)) << none;
+}
+
+TEST(CrsUnits, GeoTiffKeyUnitCodesServeWhenTheCrsIsOnlyACode) {
+    EXPECT_TRUE(epsg_linear_unit(9001)->is_metre());
+    EXPECT_DOUBLE_EQ(epsg_linear_unit(9002)->metres, 0.3048);
+    EXPECT_EQ(epsg_linear_unit(9003)->name, "US survey foot");
+    EXPECT_FALSE(epsg_linear_unit(0));
+    EXPECT_FALSE(epsg_linear_unit(9102));  // degree: an angular unit, not a length
+    Georeference georef;
+    georef.crs_wkt = "EPSG:2992";  // NAD83 / Oregon GIC Lambert (ft): a code names no unit
+    georef.linear_unit_code = 9002;
+    georef.vertical_unit_code = 9003;
+    CrsUnits units = crs_units_of(georef);
+    ASSERT_TRUE(units.horizontal && units.vertical);
+    EXPECT_EQ(units.horizontal->name, "foot");
+    EXPECT_EQ(units.vertical->name, "US survey foot");
+    georef.crs_wkt = R"wkt(PROJCS["y",UNIT["metre",1]])wkt";  // a WKT says it itself
+    units = crs_units_of(georef);
+    EXPECT_TRUE(units.horizontal->is_metre());
+    EXPECT_EQ(units.vertical->name, "US survey foot");
+    EXPECT_FALSE(crs_units_of(Georeference{}).horizontal);
 }

@@ -374,6 +374,8 @@ TEST(LasGeoref, GeoTiffRecordsPassThroughUnchanged) {
         EXPECT_EQ(back.georef.las_vlrs[k].data, cloud.georef.las_vlrs[k].data);
     }
     EXPECT_EQ(back.georef.crs_wkt, "EPSG:32632");
+    EXPECT_EQ(back.georef.linear_unit_code, 9001);  // ProjLinearUnits: metre
+    EXPECT_EQ(back.georef.vertical_unit_code, 0);   // not declared
     EXPECT_EQ(back.source.version, "1.2");
 }
 
