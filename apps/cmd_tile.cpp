@@ -144,13 +144,13 @@ void warn_of_units_other_than_metres(const std::string& input, const CrsUnits& u
     } else if (across && !across->is_metre()) {
         log_warn(input + ": the CRS measures lengths in " + unit_text(*across) +
                  "; treelobes takes coordinates as metres, so heights, crowns and DBH come out in that unit and its thresholds "
-                 "in metres do not fit: reproject the tile to a CRS in metres");
+                 "in metres do not fit: convert it first (treelobes convert TILE --out TILE_M.las --to-metres)");
         return;  // the heights' unit is said with it
     }
     if (units.vertical && !units.vertical->is_metre())
         log_warn(input + ": the CRS measures heights in " + unit_text(*units.vertical) +
                  "; treelobes takes heights as metres, so tree heights, crown bases and volumes come out in that unit and its "
-                 "height thresholds in metres do not fit: convert the heights to metres");
+                 "height thresholds in metres do not fit: convert it first (treelobes convert TILE --out TILE_M.las --to-metres)");
 }
 
 // A unit as the CRS names it (null when it names none).

@@ -12,7 +12,7 @@ PACKAGES=(
   g++ cmake ninja-build pkg-config
   libeigen3-dev libboost-dev libpcl-dev libcgal-dev libgmp-dev libmpfr-dev libflann-dev libopenmesh-dev
   libembree-dev libtbb-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-  libpng-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev libxgboost-dev
+  libproj-dev libpng-dev zlib1g-dev libgtest-dev libgmock-dev libbenchmark-dev libxgboost-dev
   libbz2-dev liblzma-dev libzstd-dev libbrotli-dev liblzf-dev
   parallel slurm-wlm munge
 )

@@ -1,6 +1,6 @@
 // `treelobes tile` on real airborne surveys (label `real`): lidR's MixedConifer.las with the
 // conifer stand preset, end to end from the command line, against the treeID lidR published; and
-// laspy's autzen_trim.laz, whose CRS is in feet, and simple.copc.laz, whose heights are.
+// laspy's autzen_trim.laz, whose CRS is in feet (as it is, and converted to metres), and simple.copc.laz, whose heights are.
 #include "core/cloud_io.hpp"
 #include "segment/segmentation_score.hpp"
 #include "support/test_support.hpp"
@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -95,4 +97,40 @@ TEST(TileReal, HeightsInFeetUnderMetresAcrossAreSaid) {
     const auto conifer_summary = nlohmann::json::parse(std::ifstream(dir / "conifer" / "summary.json"));
     EXPECT_EQ(conifer_summary["crs_unit"]["name"], "metre");
     EXPECT_EQ(conifer_summary["crs_vertical_unit"]["name"], "metre");
+}
+
+// The way out the warning names: `convert --to-metres` gives autzen_trim.laz its coordinates in
+// metres, and `tile` then finds trees of plausible sizes (in feet, taken as metres, every crown
+// was 3.28 times too small for the thresholds: 1,567 "trees", most under 50 points).
+TEST(TileReal, ATileInFeetConvertedToMetresGivesTreesOfPlausibleSize) {
+    const auto laz = real_data("laz/laspy/autzen_trim.laz");
+    if (laz.empty()) return;
+    test::TempDir dir;
+    const auto converted = run_cli("convert '" + laz.string() + "' --out '" + (dir / "metres.las").string() + "' --to-metres");
+    ASSERT_EQ(converted.exit_code, 0) << converted.err;
+    const auto result = run_cli("tile '" + (dir / "metres.las").string() + "' --out '" + (dir / "out").string() +
+                                "' --min-tree-points 100000000 --map-size 200");
+    EXPECT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.exit_code << result.err;
+    EXPECT_EQ(result.err.find("the CRS measures"), std::string::npos) << result.err;
+    const auto summary = nlohmann::json::parse(std::ifstream(dir / "out" / "summary.json"));
+    EXPECT_EQ(summary["crs_unit"]["name"], "metre");
+    const int trees = summary["counts"]["trees"].get<int>();
+    EXPECT_GT(trees, 30);
+    EXPECT_LT(trees, 150);
+    const auto cells = [](const std::string& line) {
+        std::vector<std::string> out;
+        std::istringstream row(line);
+        for (std::string cell; std::getline(row, cell, ',');) out.push_back(cell);
+        return out;
+    };
+    std::ifstream csv(dir / "out" / "trees.csv");
+    std::string line;
+    std::getline(csv, line);
+    const auto header = cells(line);
+    const auto height = static_cast<std::size_t>(std::find(header.begin(), header.end(), "height_m") - header.begin());
+    ASSERT_LT(height, header.size());
+    double tallest = 0;
+    while (std::getline(csv, line)) tallest = std::max(tallest, std::stod(cells(line).at(height)));
+    EXPECT_GT(tallest, 15.0);
+    EXPECT_LT(tallest, 45.0);  // in feet, taken as metres, the tallest was over 100
 }
