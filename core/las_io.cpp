@@ -850,14 +850,27 @@ int source_minor_version(const PointCloud& cloud) {
     return v[2] - '0';
 }
 
+bool has_record(const std::vector<RawVlr>& records, std::string_view user, std::uint16_t id) {
+    return std::any_of(records.begin(), records.end(), [&](const RawVlr& r) { return r.user_id == user && r.record_id == id; });
+}
+
+// Whether the CRS is written as a new WKT record: it came as WKT text from elsewhere (a PLY
+// sidecar, `convert --to-metres`) rather than as LAS records, and is not a bare EPSG code.
+bool writes_new_wkt_record(const PointCloud& cloud) {
+    const std::string& wkt = cloud.georef.crs_wkt;
+    return !wkt.empty() && !wkt.starts_with("EPSG:") && !has_record(cloud.georef.las_vlrs, kProjectionUser, kWktRecord);
+}
+
 // The input's version (1.2 without a LAS source), raised to what the format needs; 1.4 for
-// Extra Bytes (DESIGN.md: tree ids go in a LAS 1.4 Extra Bytes attribute), EVLRs and more than
-// 2^32 - 1 points.
+// Extra Bytes (DESIGN.md: tree ids go in a LAS 1.4 Extra Bytes attribute), EVLRs, more than
+// 2^32 - 1 points and a new WKT record (LAS defines the CRS as WKT, with the global encoding's
+// WKT bit, from 1.4 on).
 int choose_minor_version(const PointCloud& cloud, int format, bool has_evlrs) {
     int minor = source_minor_version(cloud);
     if (minor < 0) minor = 2;
     minor = std::max(minor, minimum_minor_version(format));
-    if (!cloud.extras.empty() || has_evlrs || cloud.size() > std::numeric_limits<std::uint32_t>::max()) minor = 4;
+    if (!cloud.extras.empty() || has_evlrs || cloud.size() > std::numeric_limits<std::uint32_t>::max() || writes_new_wkt_record(cloud))
+        minor = 4;
     return minor;
 }
 
@@ -893,10 +906,6 @@ RawVlr extra_bytes_vlr(const std::vector<ExtraAttribute>& extras, const std::str
     return record;
 }
 
-bool has_record(const std::vector<RawVlr>& records, std::string_view user, std::uint16_t id) {
-    return std::any_of(records.begin(), records.end(), [&](const RawVlr& r) { return r.user_id == user && r.record_id == id; });
-}
-
 // Extra Bytes description (rebuilt from cloud.extras), the CRS records unchanged, and a WKT
 // record when the CRS came from elsewhere (PLY sidecar) as WKT text rather than as LAS records.
 std::vector<RawVlr> records_to_write(const PointCloud& cloud, const std::string& file) {
@@ -904,8 +913,8 @@ std::vector<RawVlr> records_to_write(const PointCloud& cloud, const std::string&
     if (!cloud.extras.empty()) records.push_back(extra_bytes_vlr(cloud.extras, file));
     for (const RawVlr& r : cloud.georef.las_vlrs)
         if (!(r.user_id == kSpecUser && r.record_id == kExtraBytesRecord)) records.push_back(r);
-    const std::string& wkt = cloud.georef.crs_wkt;
-    if (!wkt.empty() && !wkt.starts_with("EPSG:") && !has_record(records, kProjectionUser, kWktRecord)) {
+    if (writes_new_wkt_record(cloud)) {
+        const std::string& wkt = cloud.georef.crs_wkt;
         RawVlr record{std::string(kProjectionUser), kWktRecord, "OGC coordinate system WKT", {}};
         record.data.assign(wkt.begin(), wkt.end());
         record.data.push_back(0);

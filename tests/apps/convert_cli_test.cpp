@@ -85,6 +85,7 @@ TEST(ConvertCli, ToMetresMultipliesTheCoordinatesAndRewritesTheCrs) {
     EXPECT_NEAR(metres.global(1).x(), 1312100.0 * 0.3048, 1e-3);
     EXPECT_NEAR(metres.global(1).z(), 365.6 * 0.3048, 1e-3);
     EXPECT_TRUE(crs_horizontal_unit(metres.georef.crs_wkt)->is_metre()) << metres.georef.crs_wkt;
+    EXPECT_EQ(metres.source.version, "1.4");  // a WKT CRS, with the global encoding's WKT bit
 
     for (const std::string& crs :
          {std::string(),

@@ -399,7 +399,9 @@ TEST(LasGeoref, CrsTextWithoutRecordsIsWrittenAsWkt) {
     TempDir dir;
     PointCloud cloud = cloud_of_format(0, 3);
     cloud.georef.crs_wkt = "GEOGCS[\"WGS 84\"]";  // e.g. from a PLY georef sidecar
-    EXPECT_EQ(write_then_read(cloud, dir).georef.crs_wkt, cloud.georef.crs_wkt);
+    const PointCloud back = write_then_read(cloud, dir);
+    EXPECT_EQ(back.georef.crs_wkt, cloud.georef.crs_wkt);
+    EXPECT_EQ(back.source.version, "1.4");  // LAS defines a WKT CRS from 1.4 on
     cloud.georef.crs_wkt = "EPSG:25832";  // not WKT: no record is made up
     EXPECT_TRUE(write_then_read(cloud, dir).georef.las_vlrs.empty());
 }
