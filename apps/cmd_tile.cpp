@@ -561,7 +561,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
         }
         row_of[i] = rows.size();
         rows.push_back({outcome.measures, {}, std::nullopt, lobe_counts[i], outcome.modelled, global_ids.at(outcome.id)});
-        stems.push_back({outcome.id, outcome.measures.position});
+        stems.push_back({outcome.id, outcome.measures.position, outcome.measures.not_a_tree.value_or(false)});
         if (!outcome.modelled) continue;
         encode::ForestTree placed;
         placed.skeleton = outcome.skeleton;

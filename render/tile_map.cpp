@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <unordered_set>
 
 namespace treelobes::render {
 
@@ -128,15 +129,21 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
             }
     }
     const float span = std::max(highest - lowest, 1e-3f);
+    std::unordered_set<int> not_trees;
+    for (const auto& stem : stems)
+        if (stem.not_a_tree) not_trees.insert(stem.id);
     Image image(width, height, {255, 255, 255, 255});
     for (std::size_t cell = 0; cell < owner.size(); ++cell) {
         const std::size_t i = owner[cell];
         if (i == cloud.size()) continue;
         const float h = height_above_ground.empty() ? cloud.positions[i].z() : height_above_ground[i];
         const double light = 0.55 + 0.45 * (h - lowest) / span;  // higher is brighter
-        Rgba colour = tree_id[i] > 0 ? tree_colour(tree_id[i]) : Rgba{170, 170, 165, 255};
+        const int x = static_cast<int>(cell % width), y = static_cast<int>(cell / width);
+        Rgba colour = tree_id[i] <= 0                  ? Rgba{170, 170, 165, 255}
+                      : not_trees.contains(tree_id[i]) ? ((x + y) / 3 % 2 ? Rgba{235, 235, 240, 255} : Rgba{90, 90, 105, 255})
+                                                       : tree_colour(tree_id[i]);
         for (int c = 0; c < 3; ++c) colour[c] = static_cast<std::uint8_t>(colour[c] * light);
-        image.set(static_cast<int>(cell % width), static_cast<int>(cell / width), colour);
+        image.set(x, y, colour);
     }
     const int mark = std::clamp(width / 160, 3, 8), scale = std::clamp(width / 250, 2, 5);
     std::vector<Eigen::Vector2i> marks, sizes;
@@ -146,6 +153,7 @@ Image draw_tile_map(const PointCloud& cloud, std::span<const int> tree_id, std::
         sizes.emplace_back(text_width(std::to_string(stem.id), scale) + 2, text_height(scale) + 2);
         draw_disc(image, marks.back().x(), marks.back().y(), mark + 1, {255, 255, 255, 255});
         draw_disc(image, marks.back().x(), marks.back().y(), mark, {0, 0, 0, 255});
+        if (stem.not_a_tree) draw_disc(image, marks.back().x(), marks.back().y(), mark / 2, {255, 255, 255, 255});  // a ring
     }
     if (!options.labels) return image;
     const auto boxes = place_labels(width, height, marks, mark + 1, sizes);

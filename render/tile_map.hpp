@@ -1,6 +1,6 @@
 // The top view of a segmented tile: every point seen from above, coloured by its tree (ground
-// and points of no tree in grey), shaded by height, with each tree's stem position marked and
-// its id written beside it. The map is what people look at first after `treelobes tile`.
+// and points of no tree in grey, "trees" that look like buildings in grey stripes), shaded by
+// height, with each tree's stem position marked and its id written beside it. The map is what people look at first after `treelobes tile`.
 #pragma once
 
 #include "core/point_cloud.hpp"
@@ -17,6 +17,7 @@ namespace treelobes::render {
 struct TileMapStem {
     int id = 0;
     Eigen::Vector3d position{0, 0, 0};  // local frame of the cloud
+    bool not_a_tree = false;            // a "tree" that looks like a building: grey stripes and a ring, not a tree's colour and a dot
 };
 
 struct TileMapOptions {
