@@ -123,7 +123,7 @@ void add_convert_command(CLI::App& app, const GlobalOptions& global, Job& job) {
                "read only the octree nodes that meet the box");
     table->add_flag("--to-metres", options->to_metres,
                     "Give a survey in feet (or another length unit) its coordinates and CRS in metres, as treelobes measures: x "
-                    "and y by the CRS's unit, z by its vertical part's, else by x's; the same projection, so exact (docs/tile.md)");
+                    "and y by the CRS's unit, z by its vertical part's, else by x's; the same projection, so exact (docs/laz.md)");
     sub->callback([options, table, &global, &job] { job = [options, table, &global] { return run_convert(*options, *table, global); }; });
 }
 

@@ -36,12 +36,16 @@ AxisUnit axis_unit(PJ_CONTEXT* context, PJ* crs, int axis, const std::string& so
     return {factor, name ? name : ""};
 }
 
+std::string name_of(const PJ* object) {
+    const char* name = proj_get_name(object);
+    return name ? name : "";
+}
+
 // The CRS with its axes in metres; its name says so when the unit changed ("NAD83 / Oregon GIC
 // Lambert (ft) (in metres)"), as the name often names the old unit.
 Object in_metres(PJ_CONTEXT* context, PJ* crs, double metres_per_unit, const std::string& source) {
     Object altered(proj_crs_alter_cs_linear_unit(context, crs, "metre", 1.0, "EPSG", "9001"));
-    if (altered && metres_per_unit != 1.0)
-        altered.reset(proj_alter_name(context, altered.get(), (proj_get_name(crs) + std::string(" (in metres)")).c_str()));
+    if (altered && metres_per_unit != 1.0) altered.reset(proj_alter_name(context, altered.get(), (name_of(crs) + " (in metres)").c_str()));
     if (!altered) throw Error::input(source, "PROJ cannot give the CRS's axes in metres");
     return altered;
 }
@@ -85,7 +89,7 @@ MetricCrs crs_in_metres(const Georeference& georef, const std::string& source) {
         metric.vertical_unit = up.name;
         metric.vertical_source = "vertical CRS";
         const Object vertical_metres = in_metres(context.get(), vertical.get(), metric.vertical, source);
-        const std::string name = proj_get_name(result.get()) + std::string(" + ") + proj_get_name(vertical_metres.get());
+        const std::string name = name_of(result.get()) + " + " + name_of(vertical_metres.get());
         result.reset(proj_create_compound_crs(context.get(), name.c_str(), result.get(), vertical_metres.get()));
         if (!result) throw Error::input(source, "PROJ cannot join the CRS's parts in metres");
     } else if (cs && proj_cs_get_axis_count(context.get(), cs.get()) == 3) {
