@@ -6,6 +6,7 @@
 #include <proj_experimental.h>  // the CRS builders: alter a unit, a name; join a compound CRS
 
 #include <memory>
+#include <optional>
 
 namespace treelobes {
 
@@ -25,15 +26,21 @@ struct AxisUnit {
     std::string name;
 };
 
-// The unit of axis `axis` of a CRS's coordinate system.
-AxisUnit axis_unit(PJ_CONTEXT* context, PJ* crs, int axis, const std::string& source) {
+// The unit of axis `axis` of a CRS's coordinate system; nullopt when it has no such axis or unit.
+std::optional<AxisUnit> axis_unit_of(PJ_CONTEXT* context, PJ* crs, int axis) {
     const Object cs(proj_crs_get_coordinate_system(context, crs));
     double factor = 0.0;
     const char* name = nullptr;
-    if (!cs || !proj_cs_get_axis_info(context, cs.get(), axis, nullptr, nullptr, nullptr, &factor, &name, nullptr, nullptr) ||
-        !(factor > 0.0))
-        throw Error::input(source, "the CRS's axes name no unit");
-    return {factor, name ? name : ""};
+    if (!cs || axis >= proj_cs_get_axis_count(context, cs.get()) ||
+        !proj_cs_get_axis_info(context, cs.get(), axis, nullptr, nullptr, nullptr, &factor, &name, nullptr, nullptr) || !(factor > 0.0))
+        return std::nullopt;
+    return AxisUnit{factor, name ? name : ""};
+}
+
+AxisUnit axis_unit(PJ_CONTEXT* context, PJ* crs, int axis, const std::string& source) {
+    const std::optional<AxisUnit> unit = axis_unit_of(context, crs, axis);
+    if (!unit) throw Error::input(source, "the CRS's axes name no unit");
+    return *unit;
 }
 
 std::string name_of(const PJ* object) {
@@ -106,6 +113,35 @@ MetricCrs crs_in_metres(const Georeference& georef, const std::string& source) {
     if (!wkt) throw Error::input(source, "PROJ cannot write the CRS in metres as WKT");
     metric.wkt = wkt;
     return metric;
+}
+
+CrsUnits crs_units_by_proj(const std::string& text) {
+    CrsUnits units;
+    if (text.empty()) return units;
+    const Context context(proj_context_create());
+    proj_log_level(context.get(), PJ_LOG_NONE);
+    Object crs(proj_create(context.get(), text.c_str()));
+    if (crs && proj_get_type(crs.get()) == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(context.get(), crs.get()));
+    if (!crs) return units;
+    Object horizontal, vertical;
+    if (proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
+        horizontal.reset(proj_crs_get_sub_crs(context.get(), crs.get(), 0));
+        vertical.reset(proj_crs_get_sub_crs(context.get(), crs.get(), 1));
+    } else {
+        horizontal = std::move(crs);
+    }
+    const auto unit_of = [&](PJ* part, int axis) -> std::optional<CrsUnit> {
+        const std::optional<AxisUnit> unit = axis_unit_of(context.get(), part, axis);
+        if (!unit) return std::nullopt;
+        const bool angular = geographic(proj_get_type(part));
+        return CrsUnit{unit->name, angular ? 0.0 : unit->metres, angular};
+    };
+    if (horizontal) {
+        units.horizontal = unit_of(horizontal.get(), 0);
+        if (!vertical && !geographic(proj_get_type(horizontal.get()))) units.vertical = unit_of(horizontal.get(), 2);
+    }
+    if (vertical) units.vertical = unit_of(vertical.get(), 0);
+    return units;
 }
 
 void convert_to_metres(PointCloud& cloud, const MetricCrs& metric) {

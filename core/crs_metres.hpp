@@ -1,11 +1,13 @@
 // The same coordinate reference system with its axes in metres, for a survey in feet: US State
 // Plane tiles in feet, heights in US survey feet. treelobes measures in metres; `convert
-// --to-metres` rewrites such a tile so that `tile` can read it. A projected CRS in another length
+// --to-metres` rewrites such a tile so that `tile` can read it. And the units of a CRS known only
+// by its EPSG code, which its text does not name (core/crs_units.hpp reads those of a WKT). A projected CRS in another length
 // unit is the same projection with its coordinates multiplied by that unit's size in metres, so the
 // conversion is exact (no reprojection). PROJ reads the CRS (WKT 1 or 2, ESRI WKT, or an EPSG code
 // from its registry) and writes the altered one; it stays private to the .cpp file.
 #pragma once
 
+#include "core/crs_units.hpp"
 #include "core/point_cloud.hpp"
 
 #include <string>
@@ -27,6 +29,11 @@ struct MetricCrs {
 // Throws Error(InvalidInput) naming `source` when the cloud has no CRS, PROJ cannot read it, or it
 // is geographic (degrees: a reprojection, not a change of unit).
 MetricCrs crs_in_metres(const Georeference& georef, const std::string& source);
+
+// The units of a CRS as PROJ reads it, an EPSG code from PROJ's registry too: across, its first
+// axis's (angular for a geographic CRS); up, a compound CRS's vertical part's or a 3D CRS's third
+// axis's. Both empty when PROJ cannot read the text or it names no unit.
+CrsUnits crs_units_by_proj(const std::string& crs);
 
 // The cloud's coordinates and LAS scale and offset multiplied into metres (the stored integers
 // stay the same), its CRS replaced by `metric`'s WKT (the input's CRS records dropped).

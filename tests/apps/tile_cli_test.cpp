@@ -1,7 +1,7 @@
 // End-to-end: `treelobes tile` on a small synthetic tile (outputs present and consistent with
 // each other, the labelled LAS, resume and --overwrite, byte-identical re-runs, trees too small
 // for a model measured only, failures.jsonl with exit 3, buildings left out) and on bad tiles (empty, all ground, one
-// tree, no CRS, NaN coordinates, an unclassified building).
+// tree, no CRS, NaN coordinates, an unclassified building, a CRS in feet known only by its code).
 #include "core/cloud_io.hpp"
 #include "core/skeleton_io.hpp"
 #include "encode/forest_file.hpp"
@@ -465,6 +465,27 @@ TEST(TileCliBadTiles, AnUnclassifiedBuildingIsMarkedNotATree) {
     EXPECT_TRUE(lines[0].ends_with(",model,not_a_tree")) << lines[0];
     EXPECT_TRUE(lines[1].ends_with(",ok,true")) << lines[1];
     EXPECT_EQ(nlohmann::json::parse(slurp(dir / "o" / "trees.geojson"))["features"][0]["properties"]["not_a_tree"], true);
+}
+
+// A LAS 1.2 file gives its CRS as GeoTIFF keys: an EPSG code, here NAD83 / Oregon GIC Lambert
+// (ft) without the unit keys. PROJ's registry tells its unit, and the run says so.
+TEST(TileCliBadTiles, ACrsInFeetKnownOnlyByItsCodeIsSaid) {
+    TempDir dir;
+    PointCloud cloud = read_point_cloud(small_tile());
+    const std::vector<std::uint16_t> keys = {1, 1, 0, 1, 3072, 0, 1, 2992};
+    RawVlr directory{"LASF_Projection", 34735, "GeoKeyDirectoryTag", {}};
+    for (std::uint16_t k : keys) {
+        directory.data.push_back(static_cast<std::uint8_t>(k & 0xff));
+        directory.data.push_back(static_cast<std::uint8_t>(k >> 8));
+    }
+    cloud.georef = {};
+    cloud.georef.las_vlrs = {directory};
+    write_point_cloud(cloud, dir / "feet.las");
+    ASSERT_EQ(read_point_cloud(dir / "feet.las").georef.crs_wkt, "EPSG:2992");
+    const auto r = run_cli("--json tile " + quoted(dir / "feet.las") + " --out " + quoted(dir / "o") + " --use-input-segmentation");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find("the CRS measures lengths in foot (0.3048 m)"), std::string::npos) << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["crs_unit"]["name"], "foot");
 }
 
 TEST(TileCliBadTiles, ASingleTree) {

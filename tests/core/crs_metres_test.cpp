@@ -91,3 +91,26 @@ TEST(CrsMetres, TheCloudIsMultipliedAndTakesTheNewCrs) {
 
 }  // namespace
 }  // namespace treelobes
+
+namespace treelobes {
+namespace {
+
+TEST(CrsMetres, TheUnitsOfACrsKnownOnlyByItsCode) {
+    const CrsUnits feet = crs_units_by_proj("EPSG:2992");  // NAD83 / Oregon GIC Lambert (ft), 2D
+    ASSERT_TRUE(feet.horizontal);
+    EXPECT_DOUBLE_EQ(feet.horizontal->metres, 0.3048);
+    EXPECT_FALSE(feet.vertical);  // a 2D CRS names no unit for heights
+    const CrsUnits compound = crs_units_by_proj("EPSG:2994+6360");
+    ASSERT_TRUE(compound.vertical);
+    EXPECT_NEAR(compound.vertical->metres, 1200.0 / 3937.0, 1e-12);
+    const CrsUnits geographic = crs_units_by_proj("EPSG:4326");
+    ASSERT_TRUE(geographic.horizontal);
+    EXPECT_TRUE(geographic.horizontal->angular);
+    for (const char* none : {"", "EPSG:0", "not a CRS"}) {
+        const CrsUnits units = crs_units_by_proj(none);
+        EXPECT_FALSE(units.horizontal || units.vertical) << none;
+    }
+}
+
+}  // namespace
+}  // namespace treelobes
