@@ -154,13 +154,6 @@ void warn_of_units_other_than_metres(const std::string& input, const CrsUnits& u
                  "height thresholds in metres do not fit: convert it first (treelobes convert TILE --out TILE_M.las --to-metres)");
 }
 
-// The units of the tile's CRS: as its WKT or its GeoTIFF keys name them, else as PROJ's registry
-// gives them for a CRS known only by its EPSG code.
-CrsUnits tile_crs_units(const Georeference& georef) {
-    const CrsUnits named = crs_units_of(georef);
-    return named.horizontal ? named : crs_units_by_proj(georef.crs_wkt);
-}
-
 // A unit as the CRS names it (null when it names none).
 json crs_unit_json(const std::optional<CrsUnit>& unit) {
     if (!unit) return nullptr;
@@ -477,7 +470,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     buffered.cloud = read_point_cloud(o.input);
     if (buffered.cloud.empty()) throw Error::input(o.input, "the tile holds no points");
     if (buffered.cloud.georef.empty()) log_warn(o.input + ": no CRS in the input; outputs keep its coordinates without one");
-    warn_of_units_other_than_metres(o.input, tile_crs_units(buffered.cloud.georef));
+    warn_of_units_other_than_metres(o.input, crs_units_of(buffered.cloud.georef));
     buffered.own_points = buffered.cloud.size();
     if (o.buffer > 0) {
         if (!plan.core) plan.core = survey::core_from_points(buffered.cloud);
@@ -647,8 +640,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                             {"trees_failed", failures.size()},
                             {"dbh", dbh}}},
                           {"crs", cloud.georef.empty() ? json(nullptr) : json(cloud.georef.crs_wkt)},
-                          {"crs_unit", crs_unit_json(tile_crs_units(cloud.georef).horizontal)},
-                          {"crs_vertical_unit", crs_unit_json(tile_crs_units(cloud.georef).vertical)},
+                          {"crs_unit", crs_unit_json(crs_units_of(cloud.georef).horizontal)},
+                          {"crs_vertical_unit", crs_unit_json(crs_units_of(cloud.georef).vertical)},
                           {"outputs",
                            {{"points", out.points.string()},
                             {"trees_csv", out.csv.string()},

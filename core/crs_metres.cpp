@@ -62,45 +62,84 @@ bool geographic(PJ_TYPE type) {
            type == PJ_TYPE_GEOGRAPHIC_CRS;
 }
 
+// A CRS as PROJ reads it (WKT 1 or 2, ESRI WKT, an EPSG code from its registry), split into its
+// horizontal part and, for a compound CRS, its vertical one; a bound CRS gives its source CRS
+// (its TOWGS84 clause left out). No horizontal part when PROJ cannot read the text.
+struct CrsParts {
+    Object horizontal, vertical;
+};
+CrsParts read_crs(PJ_CONTEXT* context, const std::string& text) {
+    CrsParts parts;
+    Object crs(proj_create(context, text.c_str()));
+    if (crs && proj_get_type(crs.get()) == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(context, crs.get()));
+    if (crs && proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
+        parts.horizontal.reset(proj_crs_get_sub_crs(context, crs.get(), 0));
+        parts.vertical.reset(proj_crs_get_sub_crs(context, crs.get(), 1));
+    } else {
+        parts.horizontal = std::move(crs);
+    }
+    return parts;
+}
+
+Context quiet_context() {
+    Context context(proj_context_create());
+    proj_log_level(context.get(), PJ_LOG_NONE);
+    return context;
+}
+
+// The units as PROJ reads them: across, the first axis's (angular for a geographic CRS); up, a
+// compound CRS's vertical part's or a 3D CRS's third axis's.
+CrsUnits units_by_proj(const std::string& text) {
+    CrsUnits units;
+    if (text.empty()) return units;
+    const Context context = quiet_context();
+    const CrsParts parts = read_crs(context.get(), text);
+    const auto unit_of = [&](PJ* part, int axis) -> std::optional<CrsUnit> {
+        const std::optional<AxisUnit> unit = axis_unit_of(context.get(), part, axis);
+        if (!unit) return std::nullopt;
+        const bool angular = geographic(proj_get_type(part));
+        return CrsUnit{unit->name, angular ? 0.0 : unit->metres, angular};
+    };
+    if (parts.horizontal) {
+        units.horizontal = unit_of(parts.horizontal.get(), 0);
+        if (!parts.vertical && !geographic(proj_get_type(parts.horizontal.get()))) units.vertical = unit_of(parts.horizontal.get(), 2);
+    }
+    if (parts.vertical) units.vertical = unit_of(parts.vertical.get(), 0);
+    return units;
+}
+
 }  // namespace
 
 MetricCrs crs_in_metres(const Georeference& georef, const std::string& source) {
     if (georef.crs_wkt.empty()) throw Error::input(source, "no CRS: the coordinates' unit is unknown");
-    const Context context(proj_context_create());
-    proj_log_level(context.get(), PJ_LOG_NONE);
-    Object crs(proj_create(context.get(), georef.crs_wkt.c_str()));
-    if (!crs) throw Error::input(source, "PROJ cannot read the CRS (" + georef.crs_wkt.substr(0, 60) + ")");
-    if (proj_get_type(crs.get()) == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(context.get(), crs.get()));  // TOWGS84 left out
-    Object horizontal, vertical;
-    if (crs && proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
-        horizontal.reset(proj_crs_get_sub_crs(context.get(), crs.get(), 0));
-        vertical.reset(proj_crs_get_sub_crs(context.get(), crs.get(), 1));
-    } else {
-        horizontal = std::move(crs);
-    }
-    if (!horizontal || proj_get_type(horizontal.get()) != PJ_TYPE_PROJECTED_CRS) {
-        if (horizontal && geographic(proj_get_type(horizontal.get())))
+    const Context context = quiet_context();
+    const CrsParts parts = read_crs(context.get(), georef.crs_wkt);
+    PJ* horizontal = parts.horizontal.get();
+    PJ* vertical = parts.vertical.get();
+    if (!horizontal) throw Error::input(source, "PROJ cannot read the CRS (" + georef.crs_wkt.substr(0, 60) + ")");
+    if (proj_get_type(horizontal) != PJ_TYPE_PROJECTED_CRS) {
+        if (geographic(proj_get_type(horizontal)))
             throw Error::input(source,
                                "the CRS is geographic (degrees): reproject it to a projected CRS, which a change of unit cannot do");
         throw Error::input(source, "the CRS is not a projected one");
     }
     MetricCrs metric;
-    const AxisUnit across = axis_unit(context.get(), horizontal.get(), 0, source);
+    const AxisUnit across = axis_unit(context.get(), horizontal, 0, source);
     metric.horizontal = across.metres;
     metric.horizontal_unit = across.name;
-    Object result = in_metres(context.get(), horizontal.get(), metric.horizontal, source);
-    const Object cs(proj_crs_get_coordinate_system(context.get(), horizontal.get()));
+    Object result = in_metres(context.get(), horizontal, metric.horizontal, source);
+    const Object cs(proj_crs_get_coordinate_system(context.get(), horizontal));
     if (vertical) {
-        const AxisUnit up = axis_unit(context.get(), vertical.get(), 0, source);
+        const AxisUnit up = axis_unit(context.get(), vertical, 0, source);
         metric.vertical = up.metres;
         metric.vertical_unit = up.name;
         metric.vertical_source = "vertical CRS";
-        const Object vertical_metres = in_metres(context.get(), vertical.get(), metric.vertical, source);
+        const Object vertical_metres = in_metres(context.get(), vertical, metric.vertical, source);
         const std::string name = name_of(result.get()) + " + " + name_of(vertical_metres.get());
         result.reset(proj_create_compound_crs(context.get(), name.c_str(), result.get(), vertical_metres.get()));
         if (!result) throw Error::input(source, "PROJ cannot join the CRS's parts in metres");
     } else if (cs && proj_cs_get_axis_count(context.get(), cs.get()) == 3) {
-        const AxisUnit up = axis_unit(context.get(), horizontal.get(), 2, source);
+        const AxisUnit up = axis_unit(context.get(), horizontal, 2, source);
         metric.vertical = up.metres;
         metric.vertical_unit = up.name;
         metric.vertical_source = "CRS axes";
@@ -115,33 +154,11 @@ MetricCrs crs_in_metres(const Georeference& georef, const std::string& source) {
     return metric;
 }
 
-CrsUnits crs_units_by_proj(const std::string& text) {
-    CrsUnits units;
-    if (text.empty()) return units;
-    const Context context(proj_context_create());
-    proj_log_level(context.get(), PJ_LOG_NONE);
-    Object crs(proj_create(context.get(), text.c_str()));
-    if (crs && proj_get_type(crs.get()) == PJ_TYPE_BOUND_CRS) crs.reset(proj_get_source_crs(context.get(), crs.get()));
-    if (!crs) return units;
-    Object horizontal, vertical;
-    if (proj_get_type(crs.get()) == PJ_TYPE_COMPOUND_CRS) {
-        horizontal.reset(proj_crs_get_sub_crs(context.get(), crs.get(), 0));
-        vertical.reset(proj_crs_get_sub_crs(context.get(), crs.get(), 1));
-    } else {
-        horizontal = std::move(crs);
-    }
-    const auto unit_of = [&](PJ* part, int axis) -> std::optional<CrsUnit> {
-        const std::optional<AxisUnit> unit = axis_unit_of(context.get(), part, axis);
-        if (!unit) return std::nullopt;
-        const bool angular = geographic(proj_get_type(part));
-        return CrsUnit{unit->name, angular ? 0.0 : unit->metres, angular};
-    };
-    if (horizontal) {
-        units.horizontal = unit_of(horizontal.get(), 0);
-        if (!vertical && !geographic(proj_get_type(horizontal.get()))) units.vertical = unit_of(horizontal.get(), 2);
-    }
-    if (vertical) units.vertical = unit_of(vertical.get(), 0);
-    return units;
+CrsUnits crs_units_of(const Georeference& georef) {
+    CrsUnits units{crs_horizontal_unit(georef.crs_wkt), crs_vertical_unit(georef.crs_wkt)};
+    if (!units.horizontal) units.horizontal = epsg_linear_unit(georef.linear_unit_code);
+    if (!units.vertical) units.vertical = epsg_linear_unit(georef.vertical_unit_code);
+    return units.horizontal ? units : units_by_proj(georef.crs_wkt);
 }
 
 void convert_to_metres(PointCloud& cloud, const MetricCrs& metric) {

@@ -30,10 +30,12 @@ struct MetricCrs {
 // is geographic (degrees: a reprojection, not a change of unit).
 MetricCrs crs_in_metres(const Georeference& georef, const std::string& source);
 
-// The units of a CRS as PROJ reads it, an EPSG code from PROJ's registry too: across, its first
-// axis's (angular for a geographic CRS); up, a compound CRS's vertical part's or a 3D CRS's third
-// axis's. Both empty when PROJ cannot read the text or it names no unit.
-CrsUnits crs_units_by_proj(const std::string& crs);
+// Horizontal and vertical units of a cloud's CRS: as its WKT names them (crs_horizontal_unit,
+// crs_vertical_unit), else as the unit codes of its GeoTIFF keys do (a LAS 1.0-1.3 file, whose
+// WKT is then "EPSG:nnnn"), else as PROJ reads the CRS (an EPSG code from its registry; across,
+// the first axis's unit, angular for a geographic CRS; up, a compound CRS's vertical part's or a
+// 3D CRS's third axis's). Empty where none of them names a unit.
+CrsUnits crs_units_of(const Georeference& georef);
 
 // The cloud's coordinates and LAS scale and offset multiplied into metres (the stored integers
 // stay the same), its CRS replaced by `metric`'s WKT (the input's CRS records dropped).

@@ -132,11 +132,4 @@ std::optional<CrsUnit> epsg_linear_unit(int code) {
     }
 }
 
-CrsUnits crs_units_of(const Georeference& georef) {
-    CrsUnits units{crs_horizontal_unit(georef.crs_wkt), crs_vertical_unit(georef.crs_wkt)};
-    if (!units.horizontal) units.horizontal = epsg_linear_unit(georef.linear_unit_code);
-    if (!units.vertical) units.vertical = epsg_linear_unit(georef.vertical_unit_code);
-    return units;
-}
-
 }  // namespace treelobes

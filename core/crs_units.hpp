@@ -5,8 +5,6 @@
 // instead of measuring trees 3.28 times too tall.
 #pragma once
 
-#include "core/point_cloud.hpp"
-
 #include <optional>
 #include <string>
 #include <string_view>
@@ -35,12 +33,10 @@ std::optional<CrsUnit> crs_vertical_unit(std::string_view wkt);
 // other codes.
 std::optional<CrsUnit> epsg_linear_unit(int code);
 
-// Horizontal and vertical units of a cloud's CRS: from its WKT when it has one, else from the
-// GeoTIFF keys' unit codes (the WKT of a LAS 1.0-1.3 file is then "EPSG:nnnn", which names none).
+// Horizontal and vertical units of a CRS; crs_units_of (core/crs_metres.hpp) gives a cloud's.
 struct CrsUnits {
     std::optional<CrsUnit> horizontal;
     std::optional<CrsUnit> vertical;
 };
-CrsUnits crs_units_of(const Georeference& georef);
 
 }  // namespace treelobes

@@ -1,5 +1,6 @@
 // A CRS in feet given in metres (core/crs_metres.hpp): projected in feet (WKT and an EPSG code),
-// a compound CRS with heights in US survey feet, and what cannot be converted.
+// a compound CRS with heights in US survey feet, and what cannot be converted; a cloud's units by
+// its WKT, its GeoTIFF keys' unit codes or PROJ's registry.
 #include "core/crs_metres.hpp"
 
 #include "core/crs_units.hpp"
@@ -89,25 +90,40 @@ TEST(CrsMetres, TheCloudIsMultipliedAndTakesTheNewCrs) {
     EXPECT_TRUE(cloud.georef.las_vlrs.empty());  // the records in feet would contradict it
 }
 
-}  // namespace
-}  // namespace treelobes
+TEST(CrsMetres, GeoTiffKeyUnitCodesServeWhenTheCrsIsOnlyACode) {
+    EXPECT_TRUE(epsg_linear_unit(9001)->is_metre());
+    EXPECT_DOUBLE_EQ(epsg_linear_unit(9002)->metres, 0.3048);
+    EXPECT_EQ(epsg_linear_unit(9003)->name, "US survey foot");
+    EXPECT_FALSE(epsg_linear_unit(0));
+    EXPECT_FALSE(epsg_linear_unit(9102));  // degree: an angular unit, not a length
+    Georeference georef;
+    georef.crs_wkt = "EPSG:2992";  // NAD83 / Oregon GIC Lambert (ft): the code names no unit, the keys do
+    georef.linear_unit_code = 9002;
+    georef.vertical_unit_code = 9003;
+    CrsUnits units = crs_units_of(georef);
+    ASSERT_TRUE(units.horizontal && units.vertical);
+    EXPECT_EQ(units.horizontal->name, "foot");
+    EXPECT_EQ(units.vertical->name, "US survey foot");
+    georef.crs_wkt = R"wkt(PROJCS["y",UNIT["metre",1]])wkt";  // a WKT says it itself
+    units = crs_units_of(georef);
+    EXPECT_TRUE(units.horizontal->is_metre());
+    EXPECT_EQ(units.vertical->name, "US survey foot");
+    EXPECT_FALSE(crs_units_of(Georeference{}).horizontal);
+}
 
-namespace treelobes {
-namespace {
-
-TEST(CrsMetres, TheUnitsOfACrsKnownOnlyByItsCode) {
-    const CrsUnits feet = crs_units_by_proj("EPSG:2992");  // NAD83 / Oregon GIC Lambert (ft), 2D
+TEST(CrsMetres, TheUnitsOfACrsKnownOnlyByItsCodeComeFromProjsRegistry) {
+    const CrsUnits feet = crs_units_of(georef_of("EPSG:2992"));  // NAD83 / Oregon GIC Lambert (ft), 2D
     ASSERT_TRUE(feet.horizontal);
     EXPECT_DOUBLE_EQ(feet.horizontal->metres, 0.3048);
     EXPECT_FALSE(feet.vertical);  // a 2D CRS names no unit for heights
-    const CrsUnits compound = crs_units_by_proj("EPSG:2994+6360");
+    const CrsUnits compound = crs_units_of(georef_of("EPSG:2994+6360"));
     ASSERT_TRUE(compound.vertical);
     EXPECT_NEAR(compound.vertical->metres, 1200.0 / 3937.0, 1e-12);
-    const CrsUnits geographic = crs_units_by_proj("EPSG:4326");
+    const CrsUnits geographic = crs_units_of(georef_of("EPSG:4326"));
     ASSERT_TRUE(geographic.horizontal);
     EXPECT_TRUE(geographic.horizontal->angular);
-    for (const char* none : {"", "EPSG:0", "not a CRS"}) {
-        const CrsUnits units = crs_units_by_proj(none);
+    for (const char* none : {"EPSG:0", "not a CRS"}) {
+        const CrsUnits units = crs_units_of(georef_of(none));
         EXPECT_FALSE(units.horizontal || units.vertical) << none;
     }
 }

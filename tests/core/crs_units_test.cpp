@@ -1,6 +1,6 @@
 // The units of a CRS read from its WKT: WKT 1 and 2, projected in metres or feet, compound (and
 // its vertical part), geographic, and texts that name none; units by the EPSG codes of GeoTIFF
-// keys.
+// keys (a cloud's units, which fall back to PROJ: crs_metres_test.cpp).
 #include "core/crs_units.hpp"
 
 #include <gtest/gtest.h>
@@ -69,25 +69,4 @@ TEST(CrsUnits, TheVerticalPartOfACompoundCrsHasItsOwnUnit) {
     for (const char* none :
          {"", "EPSG:26917", R"wkt(PROJCS["y",UNIT["foot",0.3048]])wkt", "VERT_CS[\"broken\",UNIT[", "VERTCRS[\"no cs\"]"})
         EXPECT_FALSE(crs_vertical_unit(none)) << none;
-}
-
-TEST(CrsUnits, GeoTiffKeyUnitCodesServeWhenTheCrsIsOnlyACode) {
-    EXPECT_TRUE(epsg_linear_unit(9001)->is_metre());
-    EXPECT_DOUBLE_EQ(epsg_linear_unit(9002)->metres, 0.3048);
-    EXPECT_EQ(epsg_linear_unit(9003)->name, "US survey foot");
-    EXPECT_FALSE(epsg_linear_unit(0));
-    EXPECT_FALSE(epsg_linear_unit(9102));  // degree: an angular unit, not a length
-    Georeference georef;
-    georef.crs_wkt = "EPSG:2992";  // NAD83 / Oregon GIC Lambert (ft): a code names no unit
-    georef.linear_unit_code = 9002;
-    georef.vertical_unit_code = 9003;
-    CrsUnits units = crs_units_of(georef);
-    ASSERT_TRUE(units.horizontal && units.vertical);
-    EXPECT_EQ(units.horizontal->name, "foot");
-    EXPECT_EQ(units.vertical->name, "US survey foot");
-    georef.crs_wkt = R"wkt(PROJCS["y",UNIT["metre",1]])wkt";  // a WKT says it itself
-    units = crs_units_of(georef);
-    EXPECT_TRUE(units.horizontal->is_metre());
-    EXPECT_EQ(units.vertical->name, "US survey foot");
-    EXPECT_FALSE(crs_units_of(Georeference{}).horizontal);
 }
