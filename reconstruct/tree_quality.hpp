@@ -1,7 +1,8 @@
 // Is this scan a tree? Buildings, walls and cars are made of large flat faces; trees are not
 // (even a thick stem only fits a narrow strip of a plane). The check peels up to a few RANSAC
-// planes off a subsample and measures how much of the cloud lies on planes that are wide in
-// both in-plane directions. Skeleton statistics add softer flags.
+// planes off a subsample and measures how much of the cloud lies on faces: planes that are wide
+// in both in-plane directions with nothing just beside them (a sparse crown's returns fall into
+// lucky planes too, but with more returns beside them). Skeleton statistics add softer flags.
 #pragma once
 
 #include <Eigen/Core>
@@ -14,17 +15,26 @@ namespace treelobes {
 
 struct QualityOptions {
     std::size_t sample_points = 3000;  // subsample used for the plane search
-    int max_planes = 4;
+    int max_planes = 4;                // wide planes counted at most (twice as many are tried)
     int iterations = 150;               // RANSAC iterations per plane
     float plane_tolerance = 0.03f;      // metres: inlier band of a plane
     float min_plane_extent = 1.5f;      // metres: a plane counts when wider than this in both directions
     float max_planar_fraction = 0.35f;  // more of the cloud on wide planes than this: not a tree
+    // A plane counts only when the bands beside it (assess_planarity) hold at most this many
+    // points per point of its own band; points scattered through a volume give about 2.
+    float max_beside_ratio = 0.5f;
+    // Whether steep planes (normal less than steep_plane_normal_z up from horizontal: within 15
+    // degrees of vertical) may be walls. Not in an airborne scan: its beams fall nearly vertically
+    // and see roofs; its steep planes are scan lines through a crown as often as walls, so their
+    // points are left out and the rest is judged (a building's roof, a crown's lucky planes).
+    bool count_steep_planes = true;
+    float steep_plane_normal_z = 0.26f;
 };
 
 struct QualityReport {
     bool not_a_tree = false;
-    float planar_fraction = 0.0f;  // fraction of the points on wide planes
-    int wide_planes = 0;
+    float planar_fraction = 0.0f;    // fraction of the (judged) points on faces
+    int wide_planes = 0;             // faces found (assess_planarity)
     std::vector<std::string> flags;  // "not_a_tree", "stem_not_visible", ...
 };
 

@@ -47,6 +47,30 @@ PointCloud house() {
     return c;
 }
 
+// An airborne crown: an ellipsoid of horizontal radius `radius` and half height 5 m whose
+// returns lie in the scan's vertical planes, lines `line_spacing` apart across the flight
+// direction, a pulse every `pulse_spacing` along each, one to three returns per pulse at depths
+// through the crown below it.
+PointCloud airborne_crown(float radius, float line_spacing, float pulse_spacing) {
+    PointCloud c;
+    std::mt19937 random(7);
+    const Eigen::Vector2f across = Eigen::Vector2f(0.9f, 0.44f).normalized();  // normal of the scan-line planes
+    const Eigen::Vector2f along(-across.y(), across.x());
+    for (float line = -radius; line <= radius; line += line_spacing)
+        for (float t = -radius; t <= radius; t += pulse_spacing) {
+            const Eigen::Vector2f xy = line * across + t * along;
+            const float inside = 1.0f - xy.squaredNorm() / (radius * radius);
+            if (inside <= 0.0f) continue;
+            const float half_depth = 5.0f * std::sqrt(inside);  // the crown's half height over this point
+            const int returns = 1 + static_cast<int>(random() % 3);
+            for (int r = 0; r < returns; ++r) {
+                const float depth = 2.0f * half_depth * static_cast<float>(random() % 1000) / 1000.0f;
+                c.positions.push_back({xy.x(), xy.y(), 15.0f + half_depth - depth});
+            }
+        }
+    return c;
+}
+
 }  // namespace
 
 TEST(Preprocess, DuplicatesOutliersAndMapping) {
@@ -210,4 +234,36 @@ TEST(TreeQuality, HouseIsNotATreeButATreeIs) {
     const QualityReport t = assess_planarity(test::cloud_from(test::y_tree(), 3000).positions);
     EXPECT_FALSE(t.not_a_tree);
     EXPECT_LT(t.planar_fraction, 0.1f);
+}
+
+// The scan lines of a sparse airborne crown are vertical sheets of returns 10 m wide with
+// nothing within 0.1 m of them, but their neighbours lie a line spacing away, nearer than the
+// returns within a sheet lie to each other: no wall. (lidR's Megaplot gave ten such "roofs".)
+TEST(TreeQuality, TheScanLinesOfASparseAirborneCrownAreNoWalls) {
+    const PointCloud crown = airborne_crown(4.0f, 0.7f, 0.7f);  // about 1.5 returns per square metre
+    ASSERT_GT(crown.size(), 80u);
+    ASSERT_LT(crown.size(), 200u);
+    const QualityReport r = assess_planarity(crown.positions);
+    EXPECT_FALSE(r.not_a_tree) << r.planar_fraction;
+    EXPECT_EQ(r.wide_planes, 0);
+}
+
+// A narrow crown crossed by three scan lines, each a sheet of returns with no other line within
+// its points' spacing: as walls they would hold half the crown. An airborne scan's steep planes
+// are not judged (idtrees' crown OSBS02703 was such a "building").
+TEST(TreeQuality, AnAirborneScanJudgesItsRoofsNotItsSteepPlanes) {
+    const PointCloud crown = airborne_crown(1.7f, 1.1f, 0.25f);
+    QualityOptions airborne;
+    airborne.count_steep_planes = false;
+    const QualityReport r = assess_planarity(crown.positions, airborne);
+    EXPECT_FALSE(r.not_a_tree) << r.planar_fraction;
+    // A building seen from above: its roof and a few returns down its walls.
+    PointCloud building;
+    for (float a = 0; a <= 8; a += 0.5f)
+        for (float b = 0; b <= 6; b += 0.5f) building.positions.push_back({a, b, 6.0f});
+    for (float a = 0; a <= 8; a += 0.5f)
+        for (float z = 1; z < 6; z += 1.0f) building.positions.push_back({a, 0, z});
+    const QualityReport b = assess_planarity(building.positions, airborne);
+    EXPECT_TRUE(b.not_a_tree) << b.planar_fraction;
+    EXPECT_EQ(b.wide_planes, 1);
 }
