@@ -57,8 +57,8 @@ std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3
 // trees and the stem count; 6: the DBH circle cut level, not along the terrain, and a
 // multi-stemmed tree's trunks followed down below their twigs; 7: a crown seen from above placed
 // at the centre of its points without their outer fifth, and whether a modelled tree looks like a
-// building, not_a_tree).
-inline constexpr int kTreeRecordRevision = 7;
+// building, not_a_tree; 8: not_a_tree judged by faces, without an airborne crown's scan lines).
+inline constexpr int kTreeRecordRevision = 8;
 
 // The record of one finished tree (trees/tree_<id>.json): its row in full precision plus the
 // options key it was made with. read_tree_record returns nullopt when the text is not such a

@@ -94,8 +94,8 @@ TreeOutcome process_tree(const TreeInput& tree, const TreePipelineOptions& optio
     reconstruct.hidden_stem_foot = outcome.measures.position.cast<float>();
     reconstruct.warn_if_not_a_tree = false;  // the tile counts them in one line
     // An airborne crown (its base only placed under the treetop) was scanned from above: its
-    // steep planes are scan lines, not walls (reconstruct/tree_quality.hpp).
-    reconstruct.quality.count_steep_planes = tree.base_at_stem;
+    // sparse steep planes are scan lines, not walls (reconstruct/tree_quality.hpp).
+    reconstruct.quality.airborne = !tree.base_at_stem;
     const TreeReconstruction reconstruction = reconstruct_tree(tree.points, reconstruct, name);
     outcome.measures.not_a_tree = reconstruction.summary.quality.not_a_tree;
     outcome.seconds.emplace_back("reconstruct", seconds_since(mark));

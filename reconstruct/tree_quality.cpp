@@ -73,6 +73,28 @@ bool is_face(const std::vector<Eigen::Vector3f>& whole_sample, const std::vector
     return beside <= o.max_beside_ratio * static_cast<float>(plane.inliers.size());
 }
 
+// Area of the points' plan: the box of their 5th to 95th percentiles in x and y (at least 1 m^2).
+float plan_area(const std::vector<Eigen::Vector3f>& points) {
+    Eigen::Vector2f extent;
+    for (int k = 0; k < 2; ++k) {
+        std::vector<float> v;
+        v.reserve(points.size());
+        for (const Eigen::Vector3f& p : points) v.push_back(p[k]);
+        std::sort(v.begin(), v.end());
+        extent[k] = v[v.size() * 95 / 100] - v[v.size() * 5 / 100];
+    }
+    return std::max(1.0f, extent.x() * extent.y());
+}
+
+// A steep plane of an airborne scan sampled far more sparsely than its plan: one scan line
+// through a crown (QualityOptions::airborne).
+bool is_scan_line(const std::vector<Eigen::Vector3f>& sample, const PlaneFit& plane, float plan_density, const QualityOptions& o) {
+    if (std::abs(plane.normal.z()) >= o.steep_plane_normal_z) return false;
+    const Eigen::Vector2f extent = in_plane_box(sample, plane.inliers, plane.normal).extent();
+    const float density = static_cast<float>(plane.inliers.size()) / std::max(1e-6f, extent.x() * extent.y());
+    return density < o.min_wall_density * plan_density;
+}
+
 }  // namespace
 
 QualityReport assess_planarity(std::span<const Eigen::Vector3f> points, const QualityOptions& o) {
@@ -85,13 +107,14 @@ QualityReport assess_planarity(std::span<const Eigen::Vector3f> points, const Qu
     const std::size_t total = sample.size();
     const std::vector<Eigen::Vector3f> whole_sample = sample;  // the bands beside a plane count the points peeled off before
     std::size_t on_planes = 0;
-    std::size_t on_steep_planes = 0;  // left out of the judgement (count_steep_planes false)
+    std::size_t on_scan_lines = 0;  // left out of the judgement (airborne)
+    const float plan_density = static_cast<float>(total) / plan_area(sample);
     // Planes that are no face are peeled off too, so that up to twice max_planes are tried.
     for (int tried = 0; tried < 2 * o.max_planes && report.wide_planes < o.max_planes && sample.size() >= 50; ++tried) {
         const PlaneFit plane = fit_plane(sample, o.plane_tolerance, o.iterations);
         if (!plane.ok || plane.inliers.size() < total / 50) break;
-        if (!o.count_steep_planes && std::abs(plane.normal.z()) < o.steep_plane_normal_z) {
-            on_steep_planes += plane.inliers.size();
+        if (o.airborne && is_scan_line(sample, plane, plan_density, o)) {
+            on_scan_lines += plane.inliers.size();
         } else if (is_face(whole_sample, sample, plane, o)) {
             on_planes += plane.inliers.size();
             ++report.wide_planes;
@@ -103,8 +126,8 @@ QualityReport assess_planarity(std::span<const Eigen::Vector3f> points, const Qu
             if (!drop[i]) rest.push_back(sample[i]);
         sample.swap(rest);
     }
-    // Fewer than 50 points off the steep planes cannot show a roof.
-    const std::size_t judged = total - on_steep_planes;
+    // Fewer than 50 points off the scan lines cannot show a roof.
+    const std::size_t judged = total - on_scan_lines;
     report.planar_fraction = judged < 50 ? 0.0f : static_cast<float>(on_planes) / static_cast<float>(judged);
     report.not_a_tree = report.planar_fraction > o.max_planar_fraction;
     if (report.not_a_tree) report.flags.push_back("not_a_tree");

@@ -1,7 +1,7 @@
 // `treelobes tile` on real airborne surveys (label `real`): lidR's MixedConifer.las with the
 // conifer stand preset, end to end from the command line, against the treeID lidR published; and
 // laspy's autzen_trim.laz, whose CRS is in feet (as it is, and converted to metres), and simple.copc.laz, whose heights are;
-// lidR's Megaplot.las, a forest whose scan lines are no walls.
+// lidR's Megaplot.las, a forest whose scan lines are no walls, and AdTree's house.xyz, whose walls are.
 #include "core/cloud_io.hpp"
 #include "segment/segmentation_score.hpp"
 #include "support/test_support.hpp"
@@ -155,4 +155,17 @@ TEST(TileReal, TheScanLinesOfAnAirborneForestAreNoBuildings) {
         EXPECT_FALSE(flag.get<bool>()) << feature["properties"]["tree_id"];
     }
     EXPECT_GT(modelled, 100);
+}
+
+// AdTree's house.xyz, a house's walls scanned from the street, is sparse enough for `tile` to
+// take it for an airborne scan; its walls are sampled as densely as its plan, unlike the scan
+// lines above, and it stays "not a tree".
+TEST(TileReal, AHouseScannedFromTheStreetIsNoTree) {
+    const auto house = real_data("adtree/house.xyz");
+    if (house.empty()) return;
+    test::TempDir dir;
+    const auto result = run_cli("tile '" + house.string() + "' --out '" + (dir / "out").string() + "' --map-size 200");
+    ASSERT_EQ(result.exit_code, 0) << result.err;
+    EXPECT_NE(result.out.find("als segmentation"), std::string::npos) << result.out;
+    EXPECT_NE(result.err.find("1 of 1 modelled trees do not look like trees"), std::string::npos) << result.err;
 }
