@@ -41,6 +41,8 @@ double f1_against_lidr(const std::string& flags) {
             run_cli("tile '" + real_data("lidr/MixedConifer.las").string() + "' --out '" + (dir / "out").string() + "' " + flags);
     // 3: some small crowns fail the per-tree pipeline (failures.jsonl); the points keep their ids.
     EXPECT_TRUE(result.exit_code == 0 || result.exit_code == 3) << result.exit_code << result.err;
+    // A forest: no crown looks like a building (36 of 183 did, by their scan lines, until 7 December 2026).
+    EXPECT_EQ(result.err.find("do not look like trees"), std::string::npos) << result.err;
     const PointCloud points = read_point_cloud(dir / "out" / "points.las");
     const ExtraAttribute* height = points.extra("HeightAboveGround");
     EXPECT_NE(height, nullptr);
