@@ -21,13 +21,14 @@ struct QualityOptions {
     float min_plane_extent = 1.5f;      // metres: a plane counts when wider than this in both directions
     float max_planar_fraction = 0.35f;  // more of the cloud on wide planes than this: not a tree
     // A plane counts only when the bands beside it (assess_planarity) hold at most this many
-    // points per point of its own band; points scattered through a volume give about 2.
+    // points per point of its own band; points scattered through a volume give 2 or more.
     float max_beside_ratio = 0.5f;
     // An airborne scan's beams fall nearly vertically: they sample roofs as densely as the ground
     // plan, but walls sparsely, and a steep plane (normal less than steep_plane_normal_z up from
     // horizontal: within 15 degrees of vertical) among its returns is as often one scan line
-    // through a crown, whose returns lie over the crown's depth at 1-16 % of the plan's density
-    // (Megaplot: median 9 %; a house's walls scanned from the street: 23-35 %). With
+    // through a crown, whose returns lie over the crown's depth, mostly at under 16 % of the
+    // plan's density (Megaplot's crowns: median 9 %, 90th percentile 16 %; a house's walls
+    // scanned from the street: 23-35 %). With
     // `airborne`, a steep plane sampled less densely than min_wall_density x the points per
     // square metre of the cloud's plan is such a line: its points are left out and the rest is
     // judged.
