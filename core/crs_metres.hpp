@@ -1,9 +1,9 @@
 // The same coordinate reference system with its axes in metres, for a survey in feet: US State
 // Plane tiles in feet, heights in US survey feet. treelobes measures in metres; `convert
 // --to-metres` rewrites such a tile so that `tile` can read it. And the units of a CRS known only
-// by its EPSG code, which its text does not name (core/crs_units.hpp reads those of a WKT). A projected CRS in another length
-// unit is the same projection with its coordinates multiplied by that unit's size in metres, so the
-// conversion is exact (no reprojection). PROJ reads the CRS (WKT 1 or 2, ESRI WKT, or an EPSG code
+// by its EPSG code, which its text does not name (core/crs_units.hpp reads those of a WKT). A
+// projected CRS in another length unit is the same projection with its coordinates multiplied by
+// that unit's size in metres, so the conversion is exact (no reprojection). PROJ reads the CRS (WKT 1 or 2, ESRI WKT, or an EPSG code
 // from its registry) and writes the altered one; it stays private to the .cpp file.
 #pragma once
 

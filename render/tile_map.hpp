@@ -1,6 +1,7 @@
 // The top view of a segmented tile: every point seen from above, coloured by its tree (ground
 // and points of no tree in grey, "trees" that look like buildings in grey stripes), shaded by
-// height, with each tree's stem position marked and its id written beside it. The map is what people look at first after `treelobes tile`.
+// height, with each tree's stem position marked and its id written beside it. The map is what
+// people look at first after `treelobes tile`.
 #pragma once
 
 #include "core/point_cloud.hpp"
