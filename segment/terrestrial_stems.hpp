@@ -12,10 +12,12 @@
 
 namespace treelobes {
 
+// One tree's stem as the slice shows it: the circle (or the equivalent circle of a multi-stemmed
+// tree's trunks) and the slice points that seed the tree's paths.
 struct Stem {
-    Eigen::Vector2f centre;
-    float radius = 0;
-    std::size_t inliers = 0;
+    Eigen::Vector2f centre;   // local frame
+    float radius = 0;         // metres
+    std::size_t inliers = 0;  // slice points on the circle
     std::vector<int> points;  // indices into the cloud: the stem's slice points
 };
 
