@@ -278,6 +278,20 @@ json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, c
     return by_name;
 }
 
+// An airborne survey sparser than the segmentation was measured on splits its crowns: said once,
+// with the measured spacing, so that a user does not take the trees for what the scan can show.
+void warn_if_sparser_than_measured(const std::string& input, const TreeSegmentation& segmentation) {
+    if (segmentation.mode_used != ScanMode::Airborne || !(segmentation.return_spacing > kSparsestMeasuredReturnSpacing)) return;
+    const double spacing = segmentation.return_spacing;
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  ": the vegetation returns lie %.2f m apart, farther than in the sparsest surveys the airborne segmentation is "
+                  "measured on (1.3 m at 0.5 pulses per m^2); expect crowns split into several trees (docs/segment.md, \"Sparse "
+                  "airborne surveys\")",
+                  spacing);
+    log_warn(input + text);
+}
+
 // One line for all the trees whose points look like a building's (an unclassified urban tile's
 // roofs and walls), rather than a warning per tree; trees.csv marks them in `not_a_tree`.
 void warn_of_trees_that_are_not(const std::string& input, const std::vector<forestry::TreeRow>& rows) {
@@ -489,6 +503,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     } else {
         segmentation = segment_trees(cloud, terrain, o.segment);
         for (const auto& tree : segmentation.trees) bases[tree.id] = tree.base.cast<double>();
+        warn_if_sparser_than_measured(o.input, segmentation);
     }
     const std::optional<float> reach = segmentation_reach(o, segmentation);
     if (plan.core) warn_if_buffer_is_narrow(o, reach);

@@ -174,6 +174,14 @@ struct TreeSegmentation {
 // as it would be over the 1 m cells that happen to be hit. 0 without vegetation.
 float vegetation_return_spacing(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options);
 
+// The sparsest airborne surveys the segmentation is measured on give 0.5 pulses per m^2, whose
+// vegetation returns lie 1.31-1.33 m apart by vegetation_return_spacing. At 0.25 and 0.1 pulses
+// per m^2 it gives 1.53-1.67 and 1.68-1.80 m (2 m cells can show no more than 2 m), F1 falls to
+// 0.48-0.81 and 0.20-0.34, and 1.4-2.2 and 3.6-4.4 times as many trees are found as there are
+// (docs/segment.md, "Sparse airborne surveys"). A survey whose spacing exceeds this is sparser
+// than measured.
+inline constexpr float kSparsestMeasuredReturnSpacing = 1.45f;
+
 // Segments the tile into trees. `terrain` must come from analyse_terrain on the same cloud
 // (Error(Internal) when its sizes differ). An empty cloud, or one without points above
 // `min_tree_height`, gives no trees and all ids 0. Throws Error(Usage) for invalid options.
