@@ -160,6 +160,12 @@ json crs_unit_json(const std::optional<CrsUnit>& unit) {
     return {{"name", unit->name}, {"metres", unit->metres}, {"angular", unit->angular}};
 }
 
+// An airborne segmentation of a survey sparser than the sparsest it is measured on
+// (segment_trees.hpp, kSparsestMeasuredReturnSpacing).
+bool sparser_than_measured(const TreeSegmentation& segmentation) {
+    return segmentation.mode_used == ScanMode::Airborne && segmentation.return_spacing > kSparsestMeasuredReturnSpacing;
+}
+
 // Every flag's value, the segmentation mode the tile got, and the per-tree options.
 json options_json(const OptionTable& table, const TileCliOptions& o, const TreeSegmentation& segmentation) {
     json options = table.json();
@@ -167,6 +173,7 @@ json options_json(const OptionTable& table, const TileCliOptions& o, const TreeS
     options["mode_reason"] = o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason;
     if (!o.use_input_segmentation && segmentation.mode_used == ScanMode::Airborne)
         options["chm"] = {{"return_spacing_m", segmentation.return_spacing},
+                          {"sparser_than_measured", sparser_than_measured(segmentation)},
                           {"cell_m", segmentation.chm_cell},
                           {"point_radius_m", segmentation.chm_point_radius}};
     options["trees"] = tree_options_json(o);
@@ -281,7 +288,7 @@ json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, c
 // An airborne survey sparser than the segmentation was measured on splits its crowns: said once,
 // with the measured spacing, so that a user does not take the trees for what the scan can show.
 void warn_if_sparser_than_measured(const std::string& input, const TreeSegmentation& segmentation) {
-    if (segmentation.mode_used != ScanMode::Airborne || !(segmentation.return_spacing > kSparsestMeasuredReturnSpacing)) return;
+    if (!sparser_than_measured(segmentation)) return;
     const double spacing = segmentation.return_spacing;
     char text[320];
     std::snprintf(text, sizeof text,

@@ -352,11 +352,14 @@ TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparserThanMeasured) {
     const auto sparse = run_cli("tile " + quoted(dir / "sparse" / "tile.las") + " --out " + quoted(dir / "a") + measure_only);
     ASSERT_EQ(sparse.exit_code, 0) << sparse.err;
     EXPECT_NE(sparse.err.find(warning), std::string::npos) << sparse.err;
+    const auto chm = [&](const char* run) { return nlohmann::json::parse(slurp(dir / run / "summary.json"))["options"]["chm"]; };
+    EXPECT_TRUE(chm("a")["sparser_than_measured"].get<bool>());
     // A spacing given for the survey is taken as it is, and the dense sample tile is no sparse survey.
     const auto given =
             run_cli("tile " + quoted(dir / "sparse" / "tile.las") + " --out " + quoted(dir / "b") + measure_only + " --return-spacing 0.8");
     ASSERT_EQ(given.exit_code, 0) << given.err;
     EXPECT_EQ(given.err.find(warning), std::string::npos) << given.err;
+    EXPECT_FALSE(chm("b")["sparser_than_measured"].get<bool>());
     const auto dense = run_cli(run_tile(dir / "c", measure_only));
     ASSERT_EQ(dense.exit_code, 0) << dense.err;
     EXPECT_EQ(dense.err.find(warning), std::string::npos) << dense.err;
