@@ -160,10 +160,9 @@ json crs_unit_json(const std::optional<CrsUnit>& unit) {
     return {{"name", unit->name}, {"metres", unit->metres}, {"angular", unit->angular}};
 }
 
-// An airborne segmentation of a survey sparser than the sparsest it is measured on
-// (segment_trees.hpp, kSparsestMeasuredReturnSpacing).
-bool sparser_than_measured(const TreeSegmentation& segmentation) {
-    return segmentation.mode_used == ScanMode::Airborne && segmentation.return_spacing > kSparsestMeasuredReturnSpacing;
+// An airborne segmentation of a sparse survey (segment_trees.hpp, kSparseSurveyReturnSpacing).
+bool sparse_survey(const TreeSegmentation& segmentation) {
+    return segmentation.mode_used == ScanMode::Airborne && segmentation.return_spacing > kSparseSurveyReturnSpacing;
 }
 
 // Every flag's value, the segmentation mode the tile got, and the per-tree options.
@@ -173,7 +172,7 @@ json options_json(const OptionTable& table, const TileCliOptions& o, const TreeS
     options["mode_reason"] = o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason;
     if (!o.use_input_segmentation && segmentation.mode_used == ScanMode::Airborne)
         options["chm"] = {{"return_spacing_m", segmentation.return_spacing},
-                          {"sparser_than_measured", sparser_than_measured(segmentation)},
+                          {"sparse_survey", sparse_survey(segmentation)},
                           {"cell_m", segmentation.chm_cell},
                           {"point_radius_m", segmentation.chm_point_radius}};
     options["trees"] = tree_options_json(o);
@@ -285,16 +284,16 @@ json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, c
     return by_name;
 }
 
-// An airborne survey sparser than the segmentation was measured on splits its crowns: said once,
-// with the measured spacing, so that a user does not take the trees for what the scan can show.
-void warn_if_sparser_than_measured(const std::string& input, const TreeSegmentation& segmentation) {
-    if (!sparser_than_measured(segmentation)) return;
+// A sparse airborne survey splits its crowns: said once, with the measured spacing, so that a
+// user does not take the trees for what the scan can show.
+void warn_if_sparse_survey(const std::string& input, const TreeSegmentation& segmentation) {
+    if (!sparse_survey(segmentation)) return;
     const double spacing = segmentation.return_spacing;
     char text[320];
     std::snprintf(text, sizeof text,
-                  ": the vegetation returns lie %.2f m apart, farther than in the sparsest surveys the airborne segmentation is "
-                  "measured on (1.3 m at 0.5 pulses per m^2); expect crowns split into several trees (docs/segment.md, \"Sparse "
-                  "airborne surveys\")",
+                  ": the vegetation returns lie %.2f m apart, a survey sparser than about 0.5 pulses per m^2: expect crowns "
+                  "split into several trees (mean F1 0.58-0.82 on synthetic stands at 0.1-0.35 pulses per m^2; docs/segment.md, "
+                  "\"Sparse airborne surveys\")",
                   spacing);
     log_warn(input + text);
 }
@@ -510,7 +509,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     } else {
         segmentation = segment_trees(cloud, terrain, o.segment);
         for (const auto& tree : segmentation.trees) bases[tree.id] = tree.base.cast<double>();
-        warn_if_sparser_than_measured(o.input, segmentation);
+        warn_if_sparse_survey(o.input, segmentation);
     }
     const std::optional<float> reach = segmentation_reach(o, segmentation);
     if (plan.core) warn_if_buffer_is_narrow(o, reach);

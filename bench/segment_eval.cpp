@@ -100,6 +100,7 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"point_radius", &o.point_radius},
                                                   {"cell_per_spacing", &o.cell_per_spacing},
                                                   {"disc_per_spacing", &o.disc_per_spacing},
+                                                  {"sparse_disc_per_spacing", &o.sparse_disc_per_spacing},
                                                   {"pit_depth", &o.pit_depth},
                                                   {"window_base", &o.window_base},
                                                   {"window_per_metre", &o.window_per_metre},

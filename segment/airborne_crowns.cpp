@@ -288,9 +288,12 @@ std::vector<std::int32_t> grow_crowns(const Raster& chm, const std::vector<std::
 // points are too few for the tile's extent). At 1-2 pulses per m^2 (many national surveys) 0.15 m
 // discs on 0.5 m cells leave most cells empty, every return stands alone as a local maximum, and
 // synthetic tiles with 25 trees gave 100-380 "trees" each (docs/segment.md).
+// In a sparse survey the spacing reads short, and discs of s/sqrt(2) leave the crowns in pieces
+// that no pass joins; discs of the whole spacing close them, coarser cells would not.
 SegmentOptions with_chm_grid_for_spacing(const PointCloud& cloud, SegmentOptions options, float spacing) {
     options.chm_cell = grid_cell_for_points(cloud, std::max(options.chm_cell, options.cell_per_spacing * spacing));
-    options.point_radius = std::max(options.point_radius, options.disc_per_spacing * spacing);
+    const bool sparse = spacing > kSparseSurveyReturnSpacing && options.disc_per_spacing > 0.0f;
+    options.point_radius = std::max(options.point_radius, (sparse ? options.sparse_disc_per_spacing : options.disc_per_spacing) * spacing);
     return options;
 }
 

@@ -27,6 +27,8 @@ void check_options(const SegmentOptions& o) {
     // A cell or disc of several spacings would blur neighbouring crowns into one.
     if (!(o.cell_per_spacing >= 0.0f && o.cell_per_spacing <= 4.0f)) throw Error::usage("segment: cell per spacing must be in 0..4");
     if (!(o.disc_per_spacing >= 0.0f && o.disc_per_spacing <= 4.0f)) throw Error::usage("segment: disc per spacing must be in 0..4");
+    if (!(o.sparse_disc_per_spacing >= 0.0f && o.sparse_disc_per_spacing <= 4.0f))
+        throw Error::usage("segment: sparse disc per spacing must be in 0..4");
     // Returns 10 m apart (0.01 per m^2) no longer show a crown.
     if (!(o.return_spacing >= 0.0f && o.return_spacing <= 10.0f)) throw Error::usage("segment: return spacing must be in 0..10 metres");
     positive(o.pit_depth, "pit depth");

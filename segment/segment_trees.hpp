@@ -59,6 +59,9 @@ struct SegmentOptions {
     // discs still cover the crowns at 1-2 returns per m^2.
     float cell_per_spacing = 0.75f;
     float disc_per_spacing = 0.7071f;  // 1/sqrt(2): discs of this radius around a square grid of returns cover it
+    // The same for a sparse survey (spacing above kSparseSurveyReturnSpacing), whose spacing reads
+    // short; only when disc_per_spacing is not 0 (docs/segment.md, "Sparse airborne surveys").
+    float sparse_disc_per_spacing = 1.0f;
     // The vegetation returns' mean spacing (metres, at most 10); 0 = estimated from the cloud. A
     // survey cut into tiles gives every tile one value, so that they all draw the same CHM.
     float return_spacing = 0.0f;
@@ -174,13 +177,13 @@ struct TreeSegmentation {
 // as it would be over the 1 m cells that happen to be hit. 0 without vegetation.
 float vegetation_return_spacing(const PointCloud& cloud, const Terrain& terrain, const SegmentOptions& options);
 
-// The sparsest airborne surveys the segmentation is measured on give 0.5 pulses per m^2, whose
-// vegetation returns lie 1.31-1.33 m apart by vegetation_return_spacing. At 0.25 and 0.1 pulses
-// per m^2 it gives 1.53-1.67 and 1.68-1.80 m (2 m cells can show no more than 2 m), F1 falls to
-// 0.48-0.81 and 0.20-0.34, and 1.4-2.2 and 3.6-4.4 times as many trees are found as there are
-// (docs/segment.md, "Sparse airborne surveys"). A survey whose spacing exceeds this is sparser
-// than measured.
-inline constexpr float kSparsestMeasuredReturnSpacing = 1.45f;
+// A sparse survey: fewer than about 0.5 pulses per m^2, whose vegetation returns read farther
+// apart than this by vegetation_return_spacing (0.5 pulses per m^2 read 1.29-1.33 m, 0.35 read
+// 1.46-1.51 m). The reading falls short there, as 2 m cells that mostly hold one return cannot
+// show more than 2 m (0.1 pulses per m^2 read 1.68-1.80 m for about 3 m), so the CHM's discs take
+// the whole spacing (sparse_disc_per_spacing). Crowns still split: on synthetic stands at
+// 0.1-0.35 pulses per m^2, mean F1 is 0.58-0.82 (docs/segment.md, "Sparse airborne surveys").
+inline constexpr float kSparseSurveyReturnSpacing = 1.45f;
 
 // Segments the tile into trees. `terrain` must come from analyse_terrain on the same cloud
 // (Error(Internal) when its sizes differ). An empty cloud, or one without points above

@@ -340,7 +340,7 @@ TEST(TileCli, TheSummaryLineNamesTheStandPreset) {
     EXPECT_EQ(input.out.find(" stand)"), std::string::npos) << input.out;
 }
 
-TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparserThanMeasured) {
+TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparse) {
     TempDir dir;
     const auto made =
             run_cli("--log-level warn synth tile --trees 6 --size 40 --seed 3 --scanner als --pulse-density 0.1 "
@@ -348,18 +348,18 @@ TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparserThanMeasured) {
                     quoted(dir / "sparse"));
     ASSERT_EQ(made.exit_code, 0) << made.err;
     const std::string measure_only = " --mode als --min-tree-points 100000000";
-    const std::string warning = "m apart, farther than in the sparsest surveys the airborne segmentation is measured on";
+    const std::string warning = "m apart, a survey sparser than about 0.5 pulses per m^2: expect crowns split";
     const auto sparse = run_cli("tile " + quoted(dir / "sparse" / "tile.las") + " --out " + quoted(dir / "a") + measure_only);
     ASSERT_EQ(sparse.exit_code, 0) << sparse.err;
     EXPECT_NE(sparse.err.find(warning), std::string::npos) << sparse.err;
     const auto chm = [&](const char* run) { return nlohmann::json::parse(slurp(dir / run / "summary.json"))["options"]["chm"]; };
-    EXPECT_TRUE(chm("a")["sparser_than_measured"].get<bool>());
+    EXPECT_TRUE(chm("a")["sparse_survey"].get<bool>());
     // A spacing given for the survey is taken as it is, and the dense sample tile is no sparse survey.
     const auto given =
             run_cli("tile " + quoted(dir / "sparse" / "tile.las") + " --out " + quoted(dir / "b") + measure_only + " --return-spacing 0.8");
     ASSERT_EQ(given.exit_code, 0) << given.err;
     EXPECT_EQ(given.err.find(warning), std::string::npos) << given.err;
-    EXPECT_FALSE(chm("b")["sparser_than_measured"].get<bool>());
+    EXPECT_FALSE(chm("b")["sparse_survey"].get<bool>());
     const auto dense = run_cli(run_tile(dir / "c", measure_only));
     ASSERT_EQ(dense.exit_code, 0) << dense.err;
     EXPECT_EQ(dense.err.find(warning), std::string::npos) << dense.err;

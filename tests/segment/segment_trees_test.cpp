@@ -181,6 +181,49 @@ TEST(SegmentTrees, ASparseSurveyKeepsEachCrownWhole) {
     EXPECT_EQ(fixed_dominant.at(2).first, 0);
 }
 
+// Below about 0.5 pulses per m^2 the spacing reads short (2 m cells that mostly hold one return
+// cannot show more than 2 m), and discs of s/sqrt(2) leave a crown in pieces: there the discs take
+// the whole spacing (on synthetic stands at 0.1-0.35 pulses per m^2 F1 rose from 0.25-0.78 to
+// 0.58-0.82, docs/segment.md). Two domes of 7 m radius, a return every 2.6 m (0.15 per m^2).
+TEST(SegmentTrees, ASparserSurveyDrawsDiscsOfTheWholeSpacing) {
+    ToyTile tile;
+    std::uint32_t state = 777u;
+    const auto uniform = [&state] {  // a fixed linear congruential sequence in [0, 1)
+        state = state * 1664525u + 1013904223u;
+        return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+    };
+    const float step = 2.6f;
+    for (float y = 0.0f; y <= 20.0f; y += step)
+        for (float x = 0.0f; x <= 36.0f; x += step) tile.add({x + uniform() - 0.5f, y + uniform() - 0.5f, 0.0f}, 0);
+    const auto add_dome = [&](float cx, float cy, float height, std::int32_t id) {
+        for (float y = cy - 7.0f; y <= cy + 7.0f; y += step)
+            for (float x = cx - 7.0f; x <= cx + 7.0f; x += step) {
+                const float px = x + uniform() - 0.5f, py = y + uniform() - 0.5f;
+                const float r = std::hypot(px - cx, py - cy);
+                if (r <= 7.0f) tile.add({px, py, height - 0.12f * r * r - 0.5f * uniform()}, id);
+            }
+    };
+    add_dome(9.0f, 10.0f, 16.0f, 1);
+    add_dome(27.0f, 10.0f, 14.0f, 2);
+    test::classify_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    SegmentOptions options;
+    options.mode = ScanMode::Airborne;
+    const TreeSegmentation sparse = segment_trees(tile.cloud, terrain, options);
+    ASSERT_GT(sparse.return_spacing, kSparseSurveyReturnSpacing);
+    EXPECT_NEAR(sparse.chm_point_radius, 1.0f * sparse.return_spacing, 1e-4f);
+    EXPECT_NEAR(sparse.chm_cell, 0.75f * sparse.return_spacing, 1e-4f);
+    const auto whole = dominant_ids(tile, sparse);
+    EXPECT_EQ(whole.at(1).first, 1);
+    EXPECT_EQ(whole.at(2).first, 2);
+
+    options.sparse_disc_per_spacing = options.disc_per_spacing;  // as a denser survey would draw them
+    const TreeSegmentation narrow = segment_trees(tile.cloud, terrain, options);
+    EXPECT_NEAR(narrow.chm_point_radius, 0.7071f * narrow.return_spacing, 1e-4f);
+    options.disc_per_spacing = options.cell_per_spacing = 0.0f;  // the fixed grid stays fixed
+    EXPECT_EQ(segment_trees(tile.cloud, terrain, options).chm_point_radius, options.point_radius);
+}
+
 // Top merging by prominence that grows with the top's height (2 m up to a 17 m top, 0.12 x the
 // height above). Two 12 m cones with tops 7.6 m apart, which on the smoothed CHM rise more than
 // 2 m but less than 3 m above their pass, are two trees; a fixed 3 m joins them. Two bumps 8 m
@@ -650,6 +693,8 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     EXPECT_TRUE(rejects(&SegmentOptions::cell_per_spacing, -0.1f));
     EXPECT_TRUE(rejects(&SegmentOptions::disc_per_spacing, 5.0f));
     EXPECT_TRUE(rejects(&SegmentOptions::disc_per_spacing, nan));
+    EXPECT_TRUE(rejects(&SegmentOptions::sparse_disc_per_spacing, -1.0f));
+    EXPECT_TRUE(rejects(&SegmentOptions::sparse_disc_per_spacing, nan));
     for (const float spacing : {-0.5f, 10.5f, nan, inf}) EXPECT_TRUE(rejects(&SegmentOptions::return_spacing, spacing)) << spacing;
     EXPECT_TRUE(rejects(&SegmentOptions::stem_slice_high, SegmentOptions{}.stem_slice_low));
     for (const float layer : {0.0f, 1e-9f, 100.0f, nan}) {
