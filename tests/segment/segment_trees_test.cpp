@@ -133,6 +133,45 @@ TEST(SegmentTrees, AirborneCrownGrowsPastTheHigherCellsAroundASmoothedTop) {
     EXPECT_NEAR(result.trees[0].top.z(), 12.0f, 0.1f);
 }
 
+namespace {
+
+// Flat classified ground over [0, width] x [0, depth] and dome-shaped crowns (x, y, height; ids
+// 1, 2, ...) as an airborne survey sees them: a return every `step` metres, moved at random by up
+// to +-jitter/2 across and by up to `noise` down (a fixed sequence from `seed`).
+struct DomeScan {
+    float step, jitter, radius, curvature, noise;
+    std::uint32_t seed;
+};
+
+ToyTile sparse_domes(const DomeScan& scan, float width, float depth, std::initializer_list<Eigen::Vector3f> domes) {
+    ToyTile tile;
+    std::uint32_t state = scan.seed;
+    const auto uniform = [&state] {  // a fixed linear congruential sequence in [0, 1)
+        state = state * 1664525u + 1013904223u;
+        return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+    };
+    const auto jittered = [&](float v) { return v + scan.jitter * (uniform() - 0.5f); };
+    for (float y = 0.0f; y <= depth; y += scan.step)
+        for (float x = 0.0f; x <= width; x += scan.step) {
+            const float px = jittered(x), py = jittered(y);
+            tile.add({px, py, 0.0f}, 0);
+        }
+    std::int32_t id = 0;
+    for (const Eigen::Vector3f& dome : domes) {
+        ++id;
+        for (float y = dome.y() - scan.radius; y <= dome.y() + scan.radius; y += scan.step)
+            for (float x = dome.x() - scan.radius; x <= dome.x() + scan.radius; x += scan.step) {
+                const float px = jittered(x), py = jittered(y);
+                const float r = std::hypot(px - dome.x(), py - dome.y());
+                if (r <= scan.radius) tile.add({px, py, dome.z() - scan.curvature * r * r - scan.noise * uniform()}, id);
+            }
+    }
+    test::classify_ground(tile);
+    return tile;
+}
+
+}  // namespace
+
 // A survey of 1 return per m^2 (a national programme's density) over two broad, bumpy crowns:
 // returns 1 m apart on a jittered grid, each 0-0.6 m below its crown's dome. Drawn as 0.15 m discs
 // on 0.5 m cells, most CHM cells stay empty and a crown grown from its top cannot cross them:
@@ -140,25 +179,8 @@ TEST(SegmentTrees, AirborneCrownGrowsPastTheHigherCellsAroundASmoothedTop) {
 // too). With the cell and discs grown to the returns' spacing the CHM is whole and each crown one
 // tree.
 TEST(SegmentTrees, ASparseSurveyKeepsEachCrownWhole) {
-    ToyTile tile;
-    std::uint32_t state = 12345u;
-    const auto uniform = [&state] {  // a fixed linear congruential sequence in [0, 1)
-        state = state * 1664525u + 1013904223u;
-        return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
-    };
-    const auto add_dome = [&](float cx, float cy, float height, std::int32_t id) {
-        for (float y = cy - 6.0f; y <= cy + 6.0f; y += 1.0f)
-            for (float x = cx - 6.0f; x <= cx + 6.0f; x += 1.0f) {
-                const float px = x + 0.8f * (uniform() - 0.5f), py = y + 0.8f * (uniform() - 0.5f);
-                const float r = std::hypot(px - cx, py - cy);
-                if (r <= 6.0f) tile.add({px, py, height - 0.15f * r * r - 0.6f * uniform()}, id);
-            }
-    };
-    for (float y = 0.0f; y <= 16.0f; y += 1.0f)
-        for (float x = 0.0f; x <= 30.0f; x += 1.0f) tile.add({x + 0.8f * (uniform() - 0.5f), y + 0.8f * (uniform() - 0.5f), 0.0f}, 0);
-    add_dome(8.0f, 8.0f, 15.0f, 1);
-    add_dome(21.0f, 8.0f, 12.0f, 2);
-    test::classify_ground(tile);
+    ToyTile tile = sparse_domes({.step = 1.0f, .jitter = 0.8f, .radius = 6.0f, .curvature = 0.15f, .noise = 0.6f, .seed = 12345u}, 30.0f,
+                                16.0f, {{8.0f, 8.0f, 15.0f}, {21.0f, 8.0f, 12.0f}});
     const Terrain terrain = analyse_terrain(tile.cloud, {});
     SegmentOptions options;
     options.mode = ScanMode::Airborne;
@@ -186,26 +208,8 @@ TEST(SegmentTrees, ASparseSurveyKeepsEachCrownWhole) {
 // the whole spacing (on synthetic stands at 0.1-0.35 pulses per m^2 F1 rose from 0.25-0.78 to
 // 0.58-0.82, docs/segment.md). Two domes of 7 m radius, a return every 2.6 m (0.15 per m^2).
 TEST(SegmentTrees, ASparserSurveyDrawsDiscsOfTheWholeSpacing) {
-    ToyTile tile;
-    std::uint32_t state = 777u;
-    const auto uniform = [&state] {  // a fixed linear congruential sequence in [0, 1)
-        state = state * 1664525u + 1013904223u;
-        return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
-    };
-    const float step = 2.6f;
-    for (float y = 0.0f; y <= 20.0f; y += step)
-        for (float x = 0.0f; x <= 36.0f; x += step) tile.add({x + uniform() - 0.5f, y + uniform() - 0.5f, 0.0f}, 0);
-    const auto add_dome = [&](float cx, float cy, float height, std::int32_t id) {
-        for (float y = cy - 7.0f; y <= cy + 7.0f; y += step)
-            for (float x = cx - 7.0f; x <= cx + 7.0f; x += step) {
-                const float px = x + uniform() - 0.5f, py = y + uniform() - 0.5f;
-                const float r = std::hypot(px - cx, py - cy);
-                if (r <= 7.0f) tile.add({px, py, height - 0.12f * r * r - 0.5f * uniform()}, id);
-            }
-    };
-    add_dome(9.0f, 10.0f, 16.0f, 1);
-    add_dome(27.0f, 10.0f, 14.0f, 2);
-    test::classify_ground(tile);
+    ToyTile tile = sparse_domes({.step = 2.6f, .jitter = 1.0f, .radius = 7.0f, .curvature = 0.12f, .noise = 0.5f, .seed = 777u}, 36.0f,
+                                20.0f, {{9.0f, 10.0f, 16.0f}, {27.0f, 10.0f, 14.0f}});
     const Terrain terrain = analyse_terrain(tile.cloud, {});
     SegmentOptions options;
     options.mode = ScanMode::Airborne;
