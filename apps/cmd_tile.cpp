@@ -172,6 +172,7 @@ json options_json(const OptionTable& table, const TileCliOptions& o, const TreeS
     options["mode_reason"] = o.use_input_segmentation ? "--use-input-segmentation" : segmentation.mode_reason;
     if (!o.use_input_segmentation && segmentation.mode_used == ScanMode::Airborne)
         options["chm"] = {{"return_spacing_m", segmentation.return_spacing},
+                          {"pulse_density_per_m2", segmentation.pulse_density},
                           {"sparse_survey", sparse_survey(segmentation)},
                           {"cell_m", segmentation.chm_cell},
                           {"point_radius_m", segmentation.chm_point_radius}};
@@ -284,17 +285,26 @@ json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, c
     return by_name;
 }
 
-// A sparse airborne survey splits its crowns: said once, with the measured spacing, so that a
-// user does not take the trees for what the scan can show.
+// A sparse airborne survey splits its crowns: said once, with the survey's pulse density, so
+// that a user does not take the trees for what the scan can show.
 void warn_if_sparse_survey(const std::string& input, const TreeSegmentation& segmentation) {
-    if (!sparse_survey(segmentation)) return;
-    const double spacing = segmentation.return_spacing;
-    char text[320];
-    std::snprintf(text, sizeof text,
-                  ": the vegetation returns lie %.2f m apart, a survey sparser than about 0.5 pulses per m^2: expect crowns "
-                  "split into several trees (mean F1 0.58-0.82 on synthetic stands at 0.1-0.35 pulses per m^2; docs/segment.md, "
-                  "\"Sparse airborne surveys\")",
-                  spacing);
+    if (segmentation.mode_used != ScanMode::Airborne) return;
+    const double pulses = segmentation.pulse_density;
+    char text[400];
+    if (pulses < kTooSparseForTrees)
+        std::snprintf(text, sizeof text,
+                      ": the survey holds about %.2g pulses per m^2 (first returns over its footprint), too few to tell single "
+                      "trees apart: its trees are patches of a few returns (mean F1 0.33-0.43 on synthetic stands at "
+                      "0.025-0.05 pulses per m^2; docs/segment.md, \"Sparse airborne surveys\")",
+                      pulses);
+    else if (sparse_survey(segmentation))
+        std::snprintf(text, sizeof text,
+                      ": the survey holds about %.2g pulses per m^2 (first returns over its footprint; the vegetation returns "
+                      "read %.2f m apart), fewer than about 0.5: expect crowns split into several trees (mean F1 0.58-0.82 "
+                      "on synthetic stands at 0.1-0.35 pulses per m^2; docs/segment.md, \"Sparse airborne surveys\")",
+                      pulses, static_cast<double>(segmentation.return_spacing));
+    else
+        return;
     log_warn(input + text);
 }
 

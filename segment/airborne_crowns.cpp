@@ -3,6 +3,7 @@
 #include "geometry/union_find.hpp"
 #include "segment/tree_labels.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -304,9 +305,26 @@ float return_spacing_of(const PointCloud& cloud, const std::vector<std::uint8_t>
     return density > 0.0 ? static_cast<float>(1.0 / std::sqrt(density)) : 0.0f;
 }
 
+float survey_pulse_density(const PointCloud& cloud) {
+    std::vector<std::uint8_t> first_return(cloud.size(), 1);
+    if (cloud.return_number.size() == cloud.size())
+        for (std::size_t i = 0; i < cloud.size(); ++i) first_return[i] = cloud.return_number[i] <= 1;
+    constexpr float kFootprintCell = 10.0f;
+    const OccupiedCells cells = occupied_cells(cloud, first_return, kFootprintCell);
+    if (!cells.points) return 0.0f;
+    Eigen::AlignedBox3f box;
+    for (const Eigen::Vector3f& p : cloud.positions) box.extend(p);
+    const double box_area = std::max(static_cast<double>(box.sizes().x()) * box.sizes().y(), 1.0);
+    const double cell_area = static_cast<double>(cells.cells) * kFootprintCell * kFootprintCell;
+    // Cells that hold one or two pulses each cannot show the footprint's gaps, nor a density below 0.01-0.02.
+    const bool sparse_cells = cells.points < 2 * cells.cells;
+    return static_cast<float>(static_cast<double>(cells.points) / (sparse_cells ? box_area : std::min(box_area, cell_area)));
+}
+
 void segment_airborne(const PointCloud& cloud, const Terrain& terrain, const std::vector<std::uint8_t>& vegetation,
                       const SegmentOptions& requested, TreeSegmentation& result) {
     result.return_spacing = requested.return_spacing > 0.0f ? requested.return_spacing : return_spacing_of(cloud, vegetation);
+    result.pulse_density = survey_pulse_density(cloud);
     const SegmentOptions options = with_chm_grid_for_spacing(cloud, requested, result.return_spacing);
     result.chm_cell = options.chm_cell;
     result.chm_point_radius = options.point_radius;

@@ -348,12 +348,16 @@ TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparse) {
                     quoted(dir / "sparse"));
     ASSERT_EQ(made.exit_code, 0) << made.err;
     const std::string measure_only = " --mode als --min-tree-points 100000000";
-    const std::string warning = "m apart, a survey sparser than about 0.5 pulses per m^2: expect crowns split";
+    const std::string warning = "m apart), fewer than about 0.5: expect crowns split";
+    const std::string too_sparse = "pulses per m^2 (first returns over its footprint), too few to tell single trees apart";
     const auto sparse = run_cli("tile " + quoted(dir / "sparse" / "tile.las") + " --out " + quoted(dir / "a") + measure_only);
     ASSERT_EQ(sparse.exit_code, 0) << sparse.err;
+    EXPECT_NE(sparse.err.find("the survey holds about 0.1"), std::string::npos) << sparse.err;
     EXPECT_NE(sparse.err.find(warning), std::string::npos) << sparse.err;
+    EXPECT_EQ(sparse.err.find(too_sparse), std::string::npos) << sparse.err;
     const auto chm = [&](const char* run) { return nlohmann::json::parse(slurp(dir / run / "summary.json"))["options"]["chm"]; };
     EXPECT_TRUE(chm("a")["sparse_survey"].get<bool>());
+    EXPECT_NEAR(chm("a")["pulse_density_per_m2"].get<double>(), 0.1, 0.02);
     // A spacing given for the survey is taken as it is, and the dense sample tile is no sparse survey.
     const auto given =
             run_cli("tile " + quoted(dir / "sparse" / "tile.las") + " --out " + quoted(dir / "b") + measure_only + " --return-spacing 0.8");
@@ -363,6 +367,19 @@ TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparse) {
     const auto dense = run_cli(run_tile(dir / "c", measure_only));
     ASSERT_EQ(dense.exit_code, 0) << dense.err;
     EXPECT_EQ(dense.err.find(warning), std::string::npos) << dense.err;
+    EXPECT_EQ(dense.err.find(too_sparse), std::string::npos) << dense.err;
+    EXPECT_GT(chm("c")["pulse_density_per_m2"].get<double>(), 1.0);
+    // A third of that tells too few crowns apart to be of use, and the warning says so.
+    ASSERT_EQ(run_cli("--log-level warn synth tile --trees 6 --size 40 --seed 3 --scanner als --pulse-density 0.03 "
+                      "--max-leaves 2000 --out " +
+                      quoted(dir / "sparser"))
+                      .exit_code,
+              0);
+    const auto sparser = run_cli("tile " + quoted(dir / "sparser" / "tile.las") + " --out " + quoted(dir / "d") + measure_only);
+    ASSERT_EQ(sparser.exit_code, 0) << sparser.err;
+    EXPECT_NE(sparser.err.find(too_sparse), std::string::npos) << sparser.err;
+    EXPECT_EQ(sparser.err.find(warning), std::string::npos) << sparser.err;
+    EXPECT_NEAR(chm("d")["pulse_density_per_m2"].get<double>(), 0.03, 0.01);
 }
 
 TEST(TileCli, ATreeThatFailsIsListedAndTheOthersGoOn) {

@@ -228,6 +228,29 @@ TEST(SegmentTrees, ASparserSurveyDrawsDiscsOfTheWholeSpacing) {
     EXPECT_EQ(segment_trees(tile.cloud, terrain, options).chm_point_radius, options.point_radius);
 }
 
+// Pulses per m^2, as surveys are ordered: first returns over the footprint. A pulse through a
+// crown gives several returns in one place, so the returns' spacing reads 1.7 m in every survey
+// of 0.025-0.1 pulses per m^2; the pulse density does not saturate.
+TEST(SegmentTrees, SurveyPulseDensityCountsPulsesNotReturns) {
+    const auto survey = [](float step, float width, int returns) {
+        PointCloud cloud;
+        for (float y = 0.5f * step; y < width; y += step)
+            for (float x = 0.5f * step; x < width; x += step)
+                for (int r = 1; r <= returns; ++r) {
+                    cloud.positions.emplace_back(x, y, 10.0f - 3.0f * static_cast<float>(r));
+                    cloud.return_number.push_back(static_cast<std::uint8_t>(r));
+                }
+        return cloud;
+    };
+    PointCloud sparse = survey(std::sqrt(10.0f), 100.0f, 3);  // 0.1 pulses per m^2, three returns each
+    EXPECT_NEAR(survey_pulse_density(sparse), 0.1f, 0.015f);
+    sparse.return_number.clear();  // without return numbers every point counts
+    EXPECT_NEAR(survey_pulse_density(sparse), 0.3f, 0.045f);
+    EXPECT_NEAR(survey_pulse_density(survey(1.0f / 3.0f, 12.0f, 2)), 9.0f, 0.6f);  // a clip of one crown, within 10 m cells
+    EXPECT_NEAR(survey_pulse_density(survey(100.0f, 1000.0f, 1)), 1e-4f, 3e-5f);   // one pulse per hectare, one per cell
+    EXPECT_EQ(survey_pulse_density(PointCloud{}), 0.0f);
+}
+
 // Top merging by prominence that grows with the top's height (2 m up to a 17 m top, 0.12 x the
 // height above). Two 12 m cones with tops 7.6 m apart, which on the smoothed CHM rise more than
 // 2 m but less than 3 m above their pass, are two trees; a fixed 3 m joins them. Two bumps 8 m
