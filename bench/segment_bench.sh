@@ -9,7 +9,7 @@
 #      filtered afresh (--ignore-classification); and the same stands with crown competition
 #      (`synth tile --competition`: crowns cut where a neighbour owns the canopy); and two dense
 #      conifer stands (80 pines on 50 x 50 m, crowns touching) with both stand presets;
-#   2. sparse airborne surveys (the ALS stands at 0.1-4 pulses per m^2) with the CHM grid from the
+#   2. sparse airborne surveys (the ALS stands at 0.025-4 pulses per m^2) with the CHM grid from the
 #      returns' spacing and fixed, and lidR/Megaplot.las (1.5 returns per m^2) trees found;
 #   3. lidR/MixedConifer.las against lidR's treeID (the broadleaf and conifer stand presets);
 #   4. treels/pine_plot.las: stems found, with their positions and diameters (--stand conifer,
@@ -110,9 +110,10 @@ print(f"  {folder.split('/')[-1]}: {area / side ** 2:.2f}")
 PY
 done
 echo
-echo "== sparse airborne surveys: the open and crowded stands above at 0.1-4 pulses per m^2, the CHM's"
-echo "   cell and discs from the returns' spacing (default) and fixed at 0.5 m cells and 0.15 m discs"
-for pd in 0.1 0.25 0.5 1 2 4; do
+echo "== sparse airborne surveys: the open and crowded stands above at 0.025-4 pulses per m^2, the CHM's"
+echo "   cell and discs from the returns' spacing (default) and fixed at 0.5 m cells and 0.15 m discs;"
+echo "   pulses = the survey's pulse density as tile reads it (first returns over the footprint)"
+for pd in 0.025 0.05 0.1 0.25 0.5 1 2 4; do
   for s in 11 12 13 14; do tile "als_open_${s}_pd$pd" "$s" --trees 25 --size 100 --scanner als --pulse-density "$pd"; done
   for s in 1 2 3 4; do tile "als_crowded_${s}_pd$pd" "$s" --trees 30 --size 80 --scanner als --pulse-density "$pd"; done
 done
@@ -131,11 +132,13 @@ right = [r["score"]["points_right"] for r in runs]
 found = sum(r["score"]["found_trees"] for r in runs)
 true = sum(r["score"]["reference_trees"] for r in runs)
 chm = runs[0]["chm"]
+pulses = [r["chm"]["pulse_density"] for r in runs]
 print(f"{sys.argv[1]:<40} {' '.join(f'{v:.3f}' for v in f1)}  mean F1 {sum(f1) / len(f1):.3f}  right {100 * sum(right) / len(right):5.1f} %"
-      f"  found {found} of {true}  (first tile: spacing {chm['return_spacing']:.2f} m, cell {chm['cell']:.2f} m, disc {chm['point_radius']:.2f} m)")
+      f"  found {found} of {true}  pulses {min(pulses):.3f}-{max(pulses):.3f}/m^2"
+      f"  (first tile: spacing {chm['return_spacing']:.2f} m, cell {chm['cell']:.2f} m, disc {chm['point_radius']:.2f} m)")
 PY
 }
-for pd in 0.1 0.25 0.5 1 2 4; do
+for pd in 0.025 0.05 0.1 0.25 0.5 1 2 4; do
   for stand in open crowded; do
     tiles=("$WORK"/als_${stand}_*_pd$pd)
     group_row "$pd pulses/m^2, $stand" -- "${tiles[@]}"
