@@ -1,5 +1,5 @@
 // `treelobes merge DIR... --out OUT`: the results of tiles and batches (shards) joined into one
-// trees.csv, trees.geojson, survey.forest and summary.json, sorted by the global tree id so that
+// trees.csv, trees.geojson, crowns.geojson, survey.forest and summary.json, sorted by the global tree id so that
 // the bytes do not depend on the order of the folders or on how the tiles were sharded.
 #include "apps/command.hpp"
 #include "apps/option_table.hpp"
@@ -43,6 +43,7 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
     const fs::path out(o.out);
     write_file_atomically(out / "trees.csv", merged.trees_csv);
     write_file_atomically(out / "trees.geojson", merged.trees_geojson);
+    write_file_atomically(out / "crowns.geojson", merged.crowns_geojson);
     write_file_atomically(out / "survey.forest", std::string(merged.forest.begin(), merged.forest.end()));
     write_file_atomically(out / "summary.json", merged.summary_json);
     if (merged.failures_jsonl.empty())
@@ -57,8 +58,8 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
         summary["merge_options"] = table.json();
         std::cout << summary.dump(2) << "\n";
     } else {
-        std::printf("merge: %zu tiles, %zu trees -> %s (trees.csv, trees.geojson, survey.forest, summary.json)%s\n", merged.tiles,
-                    merged.trees, o.out.c_str(),
+        std::printf("merge: %zu tiles, %zu trees -> %s (trees.csv, trees.geojson, crowns.geojson, survey.forest, summary.json)%s\n",
+                    merged.tiles, merged.trees, o.out.c_str(),
                     partial ? "; some tiles failed or are unfinished (failures.jsonl, summary.json: tiles_incomplete)" : "");
     }
     return partial ? static_cast<int>(ExitCode::PartialFailure) : 0;
@@ -68,9 +69,10 @@ int run_merge(const MergeCliOptions& o, const OptionTable& table, const GlobalOp
 
 void add_merge_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     auto o = std::make_shared<MergeCliOptions>();
-    CLI::App* sub = app.add_subcommand("merge",
-                                       "Join tile and batch outputs into one trees.csv, trees.geojson, survey.forest and summary.json, "
-                                       "order-independent (docs/survey.md)");
+    CLI::App* sub = app.add_subcommand(
+            "merge",
+            "Join tile and batch outputs into one trees.csv, trees.geojson, crowns.geojson, survey.forest and summary.json, "
+            "order-independent (docs/survey.md)");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("dirs", o->inputs, "Tile output folders or batch output folders (their finished tiles)")->required();
     table->add("--out", o->out, "Output folder")->required();

@@ -82,12 +82,13 @@ struct TileCliOptions {
 
 // Names of the outputs in DIR (docs/tile.md).
 struct TileOutputs {
-    fs::path dir, points, csv, geojson, forest, dtm, hillshade, map, summary, failures, trees;
+    fs::path dir, points, csv, geojson, crowns, forest, dtm, hillshade, map, summary, failures, trees;
     explicit TileOutputs(const fs::path& out)
             : dir(out),
               points(out / "points.las"),
               csv(out / "trees.csv"),
               geojson(out / "trees.geojson"),
+              crowns(out / "crowns.geojson"),
               forest(out / "tile.forest"),
               dtm(out / "dtm.asc"),
               hillshade(out / "hillshade.png"),
@@ -623,6 +624,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     });
     write_file_atomically(out.csv, forestry::trees_csv(rows, cloud.origin));
     write_file_atomically(out.geojson, forestry::trees_geojson(rows, cloud.origin, cloud.georef.crs_wkt));
+    write_file_atomically(out.crowns, forestry::crowns_geojson(rows, cloud.origin, cloud.georef.crs_wkt));
     encode::write_forest_file(forest, o.trees.dbf6, out.forest);
     write_output(out.dtm, o.overwrite, [&] { write_ascii_grid(terrain.dtm, cloud.origin, out.dtm); });
     write_output(out.hillshade, o.overwrite, [&] { write_hillshade_png(terrain.dtm, out.hillshade); });
@@ -677,6 +679,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                            {{"points", out.points.string()},
                             {"trees_csv", out.csv.string()},
                             {"trees_geojson", out.geojson.string()},
+                            {"crowns_geojson", out.crowns.string()},
                             {"forest", out.forest.string()},
                             {"dtm", out.dtm.string()},
                             {"hillshade", out.hillshade.string()},
@@ -700,7 +703,8 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
                 options["mode_used"].get<std::string>().c_str(), stand_note.c_str(), outcomes.size(), modelled, rows.size() - modelled,
                 o.trees.min_points, failures.size(), failure_note.c_str());
         std::printf("DBH: %s; %.1f s, peak memory %.0f MB\n", dbh_text.c_str(), seconds["total"].get<double>(), peak_memory_mb());
-        std::printf("trees: %s and %s; picture: %s\n", out.csv.string().c_str(), out.geojson.string().c_str(), out.map.string().c_str());
+        std::printf("trees: %s and %s, crown outlines: %s; picture: %s\n", out.csv.string().c_str(), out.geojson.string().c_str(),
+                    out.crowns.string().c_str(), out.map.string().c_str());
     }
     return failures.empty() ? 0 : static_cast<int>(ExitCode::PartialFailure);
 }

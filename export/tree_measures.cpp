@@ -57,7 +57,7 @@ TreeMeasures measure_tree(const ExportTree& tree, double crown_branch_fraction) 
     if (!points.empty()) {
         Eigen::Vector3f lo = points.front(), hi = points.front();
         for (const auto& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
-        m.crown_diameter = equal_area_diameter(projected_hull_area(points));
+        m.crown_diameter = equal_area_diameter(ring_area(projected_hull(points)));
         m.crown_base_height = std::max(0.0, tree.skeleton.origin.z() + lo.z() - m.base.z());
     }
     m.crown_hull = convex_hull(points, tree.skeleton.origin);

@@ -283,8 +283,8 @@ CrownMeasure measure_crown(std::span<const Eigen::Vector3f> points, const Eigen:
         if (horizontal_distance(points[i], base) >= offset) crown_heights.push_back(points[i].z() - base.z());
     if (crown_heights.size() >= options.min_points) m.base_height = std::max(0.0, quantile(crown_heights, options.base_quantile));
 
-    const double area = projected_hull_area(points);
-    if (area > 0) {
+    m.outline = projected_hull(points);
+    if (const double area = ring_area(m.outline); area > 0) {
         m.projected_area = area;
         m.diameter = equal_area_diameter(area);
     }

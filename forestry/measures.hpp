@@ -11,6 +11,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace treelobes::forestry {
 
@@ -73,6 +74,9 @@ struct CrownMeasure {
     std::optional<double> base_height;     // metres above the ground at the stem (as the tree height)
     std::optional<double> diameter;        // metres: diameter of the circle with the projected area
     std::optional<double> projected_area;  // square metres: convex hull of the points seen from above
+    // That hull's corners (local x, y; counter-clockwise, the first not repeated): the crown's
+    // outline in crowns.geojson. Empty when there is no projected area.
+    std::vector<Eigen::Vector2d> outline;
     std::optional<double> volume;          // cubic metres: alpha shape of the crown points
     std::string volume_failure;            // why there is no volume, or empty
 };

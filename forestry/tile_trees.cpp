@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -36,6 +37,11 @@ json value_or_null(const std::optional<double>& value, int digits) {
 }
 
 json optional_json(const std::optional<double>& value) { return value ? json(*value) : json(nullptr); }
+json outline_json(const std::vector<Eigen::Vector2d>& outline) {
+    json corners = json::array();
+    for (const Eigen::Vector2d& corner : outline) corners.push_back({corner.x(), corner.y()});
+    return corners;
+}
 std::optional<double> optional_from(const json& j) {
     if (j.is_null()) return std::nullopt;
     return j.get<double>();
@@ -45,6 +51,14 @@ DbhQuality parse_quality(const std::string& name) {
     for (DbhQuality q : {DbhQuality::Ok, DbhQuality::PartialArc, DbhQuality::NotVisible})
         if (name == dbh_quality_name(q)) return q;
     throw Error::input("tree record", "unknown DBH quality '" + name + "'");
+}
+
+double millimetres(double metres) { return std::round(metres * 1000.0) / 1000.0; }
+
+std::string feature_collection(json features, const std::string& crs_wkt) {
+    json collection = {{"type", "FeatureCollection"}, {"features", std::move(features)}};
+    if (!crs_wkt.empty()) collection["crs_wkt"] = crs_wkt;
+    return collection.dump(1) + "\n";
 }
 
 // Whether the tree has a model, or why not.
@@ -154,14 +168,30 @@ std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3
     json features = json::array();
     for (const TreeRow& row : rows) {
         const Eigen::Vector3d p = origin + row.measures.position;
-        auto mm = [](double v) { return std::round(v * 1000.0) / 1000.0; };
-        features.push_back({{"type", "Feature"},
-                            {"geometry", {{"type", "Point"}, {"coordinates", {mm(p.x()), mm(p.y()), mm(p.z())}}}},
-                            {"properties", row_properties(row, origin)}});
+        features.push_back(
+                {{"type", "Feature"},
+                 {"geometry", {{"type", "Point"}, {"coordinates", {millimetres(p.x()), millimetres(p.y()), millimetres(p.z())}}}},
+                 {"properties", row_properties(row, origin)}});
     }
-    json collection = {{"type", "FeatureCollection"}, {"features", features}};
-    if (!crs_wkt.empty()) collection["crs_wkt"] = crs_wkt;
-    return collection.dump(1) + "\n";
+    return feature_collection(std::move(features), crs_wkt);
+}
+
+std::string crowns_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin, const std::string& crs_wkt) {
+    json features = json::array();
+    for (const TreeRow& row : rows) {
+        const std::vector<Eigen::Vector2d>& outline = row.measures.crown.outline;
+        json geometry = nullptr;  // a tree without a projected area: an unlocated feature (RFC 7946, 3.2)
+        if (!outline.empty()) {
+            json ring = json::array();
+            for (std::size_t i = 0; i <= outline.size(); ++i) {  // closed: the first corner again at the end
+                const Eigen::Vector2d& corner = outline[i % outline.size()];
+                ring.push_back({millimetres(origin.x() + corner.x()), millimetres(origin.y() + corner.y())});
+            }
+            geometry = {{"type", "Polygon"}, {"coordinates", json::array({ring})}};
+        }
+        features.push_back({{"type", "Feature"}, {"geometry", geometry}, {"properties", row_properties(row, origin)}});
+    }
+    return feature_collection(std::move(features), crs_wkt);
 }
 
 std::string tree_record(const TreeRow& row, const Eigen::Vector3d& origin, const std::string& options_key) {
@@ -184,6 +214,7 @@ std::string tree_record(const TreeRow& row, const Eigen::Vector3d& origin, const
                         {{"base_height", optional_json(m.crown.base_height)},
                          {"diameter", optional_json(m.crown.diameter)},
                          {"projected_area", optional_json(m.crown.projected_area)},
+                         {"outline", outline_json(m.crown.outline)},
                          {"volume", optional_json(m.crown.volume)},
                          {"volume_failure", m.crown.volume_failure}}},
                        {"woody_volume", optional_json(m.woody_volume)},
@@ -220,6 +251,8 @@ std::optional<TreeRow> read_tree_record(const std::string& text, const std::stri
         m.crown.base_height = optional_from(crown.at("base_height"));
         m.crown.diameter = optional_from(crown.at("diameter"));
         m.crown.projected_area = optional_from(crown.at("projected_area"));
+        for (const auto& corner : crown.at("outline").get<std::vector<std::array<double, 2>>>())
+            m.crown.outline.emplace_back(corner[0], corner[1]);
         m.crown.volume = optional_from(crown.at("volume"));
         m.crown.volume_failure = crown.at("volume_failure").get<std::string>();
         m.woody_volume = optional_from(e.at("woody_volume"));

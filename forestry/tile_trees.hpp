@@ -1,5 +1,5 @@
 // From a labelled tile to per-tree inputs, and the per-tree table that `treelobes tile` writes
-// (trees.csv, trees.geojson, and one JSON record per tree that lets a re-run skip it).
+// (trees.csv, trees.geojson, crowns.geojson, and one JSON record per tree that lets a re-run skip it).
 #pragma once
 
 #include "forestry/tree_pipeline.hpp"
@@ -49,6 +49,10 @@ std::string trees_csv(const std::vector<TreeRow>& rows, const Eigen::Vector3d& o
 // trees.geojson: a FeatureCollection of points (x, y, z in the tile's CRS) with the csv's values
 // as properties (null when not available); the tile's CRS as WKT in a "crs_wkt" member when known.
 std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin, const std::string& crs_wkt);
+// crowns.geojson: the same features with each crown's outline as their geometry, a polygon (the
+// convex hull of the tree's points seen from above, whose area is crown_area_m2; x, y in the
+// tile's CRS); null geometry for a tree without one (fewer than 3 points, or all on a line).
+std::string crowns_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3d& origin, const std::string& crs_wkt);
 
 // The revision of the per-tree measures and records: part of the key a re-run checks before it
 // keeps a finished tree, and raised whenever a measure's definition changes, so that a tree
@@ -57,8 +61,9 @@ std::string trees_geojson(const std::vector<TreeRow>& rows, const Eigen::Vector3
 // trees and the stem count; 6: the DBH circle cut level, not along the terrain, and a
 // multi-stemmed tree's trunks followed down below their twigs; 7: a crown seen from above placed
 // at the centre of its points without their outer fifth, and whether a modelled tree looks like a
-// building, not_a_tree; 8: not_a_tree judged by faces, without an airborne crown's scan lines).
-inline constexpr int kTreeRecordRevision = 8;
+// building, not_a_tree; 8: not_a_tree judged by faces, without an airborne crown's scan lines;
+// 9: the crown's outline kept for crowns.geojson).
+inline constexpr int kTreeRecordRevision = 9;
 
 // The record of one finished tree (trees/tree_<id>.json): its row in full precision plus the
 // options key it was made with. read_tree_record returns nullopt when the text is not such a

@@ -140,16 +140,27 @@ TriangleMesh convex_hull(const std::vector<Eigen::Vector3f>& points, const Eigen
     return mesh;
 }
 
-double projected_hull_area(std::span<const Eigen::Vector3f> points) {
+std::vector<Eigen::Vector2d> projected_hull(std::span<const Eigen::Vector3f> points) {
     namespace bg = boost::geometry;
     using Point = bg::model::d2::point_xy<double>;
+    if (points.size() < 3) return {};
     bg::model::multi_point<Point> cloud;
     cloud.reserve(points.size());
     for (const auto& p : points) cloud.emplace_back(p.x(), p.y());
-    if (cloud.size() < 3) return 0.0;
-    bg::model::polygon<Point> hull;
+    bg::model::polygon<Point> hull;  // clockwise and closed: the first corner repeated last
     bg::convex_hull(cloud, hull);
-    return std::abs(bg::area(hull));
+    const auto& corners = hull.outer();
+    std::vector<Eigen::Vector2d> ring;
+    for (auto corner = corners.rbegin() + 1; corner < corners.rend(); ++corner) ring.emplace_back(corner->x(), corner->y());
+    if (ring_area(ring) <= 0.0) return {};
+    return ring;
+}
+
+double ring_area(std::span<const Eigen::Vector2d> ring) {
+    if (ring.size() < 3) return 0.0;
+    double twice = 0.0;  // the shoelace formula
+    for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++) twice += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
+    return std::abs(twice) / 2.0;
 }
 
 double equal_area_diameter(double area) { return area > 0 ? 2.0 * std::sqrt(area / std::numbers::pi) : 0.0; }

@@ -22,9 +22,14 @@ namespace treelobes {
 // fanned from its lexicographically smallest corner; vertices are sorted by coordinates.
 TriangleMesh convex_hull(const std::vector<Eigen::Vector3f>& points, const Eigen::Vector3d& origin);
 
-// Area of the convex hull of the points seen from above (x, y; square metres): a crown's
-// projected area. 0 for fewer than 3 points or collinear ones.
-double projected_hull_area(std::span<const Eigen::Vector3f> points);
+// The convex hull of the points seen from above: its corners (x, y), counter-clockwise as
+// GeoJSON's exterior rings go, the first not repeated at the end. A crown's outline. Empty for
+// fewer than 3 points or collinear ones.
+std::vector<Eigen::Vector2d> projected_hull(std::span<const Eigen::Vector3f> points);
+
+// Area enclosed by a ring of corners (either orientation; square metres): of projected_hull, a
+// crown's projected area. 0 for fewer than 3 corners.
+double ring_area(std::span<const Eigen::Vector2d> ring);
 
 // Diameter of the circle of the given area: the crown diameter of every treelobes measure (the
 // tile's trees.csv from points, the exports from a skeleton and its lobes), so that one tree

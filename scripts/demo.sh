@@ -44,7 +44,8 @@ if [[ -f "$OUT/tile/failures.jsonl" ]]; then
     echo "$(wc -l <"$OUT/tile/failures.jsonl") trees failed: $OUT/tile/failures.jsonl"
 fi
 echo "picture: $OUT/tile/top_view.png (each tree in its colour, stems as dots with their ids)"
-echo "also: $OUT/tile/points.las (treeID, HeightAboveGround), trees.geojson, tile.forest, trees/ (per tree skeleton, mesh, .tlobe, .dbf6)"
+echo "also: $OUT/tile/points.las (treeID, HeightAboveGround), trees.geojson, crowns.geojson (crown outlines), tile.forest,"
+echo "      trees/ (per tree skeleton, mesh, .tlobe, .dbf6)"
 
 step "reconstruct: skeleton, radii and branch mesh of two scanned trees"
 # A leaf-off tree of heaven (a winter scan, as QSM campaigns take them) and a leafy palm.

@@ -139,13 +139,15 @@ std::vector<std::string> duplicated_ids(const CsvRows& csv) {
     return duplicated;
 }
 
-void add_features(std::map<TreeKey, json>& features, std::string& crs, const fs::path& tile_dir) {
+// The features of the tile's `file` (trees.geojson, crowns.geojson), each with its tile's name.
+void add_features(std::map<TreeKey, json>& features, std::string& crs, const fs::path& tile_dir, const char* file) {
     const std::string tile = tile_of(tile_dir);
-    const json collection = read_json(tile_dir / "trees.geojson");
+    const fs::path path = tile_dir / file;
+    if (!fs::exists(path)) throw Error::input(path.string(), "missing (a tile made by an older treelobes): run the tile again");
+    const json collection = read_json(path);
     const std::string tile_crs = collection.value("crs_wkt", std::string());
     if (!tile_crs.empty()) {
-        if (!crs.empty() && crs != tile_crs)
-            throw Error::input((tile_dir / "trees.geojson").string(), "its CRS differs from the other tiles'");
+        if (!crs.empty() && crs != tile_crs) throw Error::input(path.string(), "its CRS differs from the other tiles'");
         crs = tile_crs;
     }
     for (json feature : collection.at("features")) {
@@ -153,6 +155,13 @@ void add_features(std::map<TreeKey, json>& features, std::string& crs, const fs:
         feature["properties"]["tile"] = tile;
         features[{global, tile}] = std::move(feature);
     }
+}
+
+std::string feature_collection(std::map<TreeKey, json>& features, const std::string& crs) {
+    json collection = {{"type", "FeatureCollection"}, {"features", json::array()}};
+    for (auto& [id, feature] : features) collection["features"].push_back(std::move(feature));
+    if (!crs.empty()) collection["crs_wkt"] = crs;
+    return collection.dump(1) + "\n";
 }
 
 // The tile's forest trees, placed as `treelobes tile` places them (root at the position).
@@ -228,7 +237,7 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
     if (folders.complete.empty()) throw Error::input("merge", "no finished tiles in the given folders");
     MergedSurvey merged;
     CsvRows csv;
-    std::map<TreeKey, json> features;
+    std::map<TreeKey, json> features, crowns;
     std::map<TreeKey, encode::ForestTree> forest_trees;
     std::string crs;
     json counts = json::object();
@@ -258,7 +267,8 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
                              {"trees", count_in(tile_counts, "trees", dir / "summary.json")},
                              {"trees_failed", count_in(tile_counts, "trees_failed", dir / "summary.json")}});
             add_csv(csv, dir);
-            add_features(features, crs, dir);
+            add_features(features, crs, dir, "trees.geojson");
+            add_features(crowns, crs, dir, "crowns.geojson");
             add_forest_trees(forest_trees, csv, dir);
         } catch (const json::exception& e) {
             // Files that parse but miss a field or hold one of another type: the tile's outputs
@@ -272,10 +282,8 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
     std::sort(merged.trees_at_buffer_edge.begin(), merged.trees_at_buffer_edge.end());
     merged.trees_csv = "global_id,tile," + csv.header.substr(std::string("global_id,").size()) + "\n";
     for (const auto& [id, row] : csv.rows) merged.trees_csv += row;
-    json collection = {{"type", "FeatureCollection"}, {"features", json::array()}};
-    for (auto& [id, feature] : features) collection["features"].push_back(std::move(feature));
-    if (!crs.empty()) collection["crs_wkt"] = crs;
-    merged.trees_geojson = collection.dump(1) + "\n";
+    merged.trees_geojson = feature_collection(features, crs);
+    merged.crowns_geojson = feature_collection(crowns, crs);
     std::vector<encode::ForestTree> ordered;
     ordered.reserve(forest_trees.size());
     for (auto& [id, tree] : forest_trees) ordered.push_back(std::move(tree));

@@ -22,6 +22,7 @@ TileFolders find_tile_folders(const std::vector<std::filesystem::path>& dirs);
 struct MergedSurvey {
     std::string trees_csv;             // global_id,tile, then the tiles' columns
     std::string trees_geojson;         // the tiles' features with global_id and tile properties
+    std::string crowns_geojson;        // the same with the crown outlines (the tiles' crowns.geojson)
     std::vector<std::uint8_t> forest;  // every tree, named by its global id
     std::string summary_json;          // tiles, summed counts, CRS, options; no paths or timings
     std::string failures_jsonl;        // the batches' tile failures, sorted; empty when none

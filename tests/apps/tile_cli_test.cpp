@@ -112,6 +112,29 @@ TEST(TileCli, OutputsArePresentAndConsistent) {
     }
     for (const char* file : {"dtm.asc", "hillshade.png", "top_view.png", "points.las"}) EXPECT_TRUE(fs::exists(dir / "out" / file)) << file;
 
+    // The crowns: the same features with each crown's outline, a closed counter-clockwise ring
+    // (RFC 7946) whose area is the tree's crown_area_m2.
+    const auto crowns = nlohmann::json::parse(slurp(dir / "out" / "crowns.geojson"));
+    EXPECT_EQ(crowns["crs_wkt"], kWkt);
+    ASSERT_EQ(crowns["features"].size(), geojson["features"].size());
+    for (std::size_t f = 0; f < crowns["features"].size(); ++f) {
+        const auto& crown = crowns["features"][f];
+        EXPECT_EQ(crown["properties"], geojson["features"][f]["properties"]);
+        ASSERT_EQ(crown["geometry"]["type"], "Polygon");
+        const auto ring = crown["geometry"]["coordinates"][0];
+        ASSERT_GE(ring.size(), 4u);
+        EXPECT_EQ(ring.front(), ring.back());
+        double twice_signed_area = 0.0;
+        for (std::size_t i = 1; i < ring.size(); ++i) {
+            const double x0 = ring[i - 1][0].get<double>() - 500000.0, y0 = ring[i - 1][1].get<double>() - 5400000.0;
+            const double x1 = ring[i][0].get<double>() - 500000.0, y1 = ring[i][1].get<double>() - 5400000.0;
+            twice_signed_area += x0 * y1 - x1 * y0;
+            EXPECT_GT(x1, -1.0);
+            EXPECT_LT(x1, 21.0);
+        }
+        EXPECT_NEAR(twice_signed_area / 2.0, crown["properties"]["crown_area_m2"].get<double>(), 0.05);
+    }
+
     // The labelled points: treeID (int32), ground class 2, heights; scale/offset and CRS kept.
     const PointCloud input = read_point_cloud(small_tile());
     const PointCloud points = read_point_cloud(dir / "out" / "points.las");
@@ -233,12 +256,14 @@ TEST(TileCli, ResumeKeepsFinishedOutputsAndOverwriteRedoesThemIdentically) {
     const fs::path skeleton = dir / "a" / "trees" / "tree_0001_skeleton.ply";
     const auto made = fs::last_write_time(skeleton);
     const std::string csv = slurp(dir / "a" / "trees.csv");
+    fs::copy_file(dir / "a" / "crowns.geojson", dir / "b_first_crowns.geojson");
 
     const auto again = run_cli("--json " + run_tile(dir / "a"));
     ASSERT_EQ(again.exit_code, 0) << again.err;
     EXPECT_EQ(nlohmann::json::parse(again.out)["counts"]["trees_reused"], 5);
     EXPECT_EQ(fs::last_write_time(skeleton), made);
     EXPECT_EQ(slurp(dir / "a" / "trees.csv"), csv);
+    EXPECT_EQ(slurp(dir / "a" / "crowns.geojson"), slurp(dir / "b_first_crowns.geojson"));  // outlines kept in the records
 
     // A record made by another treelobes (another version or measures revision) is not kept.
     const fs::path record = dir / "a" / "trees" / "tree_0001.json";
@@ -259,8 +284,8 @@ TEST(TileCli, ResumeKeepsFinishedOutputsAndOverwriteRedoesThemIdentically) {
 
     // A fresh run elsewhere gives the same bytes (deterministic, whatever the thread schedule).
     ASSERT_EQ(run_cli("--threads 1 " + run_tile(dir / "b")).exit_code, 0);
-    for (const char* file : {"trees.csv", "trees.geojson", "tile.forest", "dtm.asc", "top_view.png", "trees/tree_0002.dbf6",
-                             "trees/tree_0002.tlobe", "trees/tree_0002_skeleton.ply", "trees/tree_0002.json"})
+    for (const char* file : {"trees.csv", "trees.geojson", "crowns.geojson", "tile.forest", "dtm.asc", "top_view.png",
+                             "trees/tree_0002.dbf6", "trees/tree_0002.tlobe", "trees/tree_0002_skeleton.ply", "trees/tree_0002.json"})
         EXPECT_EQ(slurp(dir / "a" / file), slurp(dir / "b" / file)) << file;
 }
 

@@ -64,9 +64,24 @@ TEST(ConvexHull, FlatOrTooFewPointsGiveAnEmptyMesh) {
 
 TEST(ProjectedHull, AreaOfASquareSeenFromAboveAndItsEqualAreaDiameter) {
     const std::vector<Eigen::Vector3f> points{{0, 0, 1}, {2, 0, 3}, {2, 2, 0}, {0, 2, 5}, {1, 1, 9}};
-    EXPECT_NEAR(projected_hull_area(points), 4.0, 1e-9);
+    EXPECT_NEAR(ring_area(projected_hull(points)), 4.0, 1e-9);
     EXPECT_NEAR(equal_area_diameter(std::numbers::pi), 2.0, 1e-12);
-    EXPECT_NEAR(equal_area_diameter(projected_hull_area(points)), 4.0 / std::sqrt(std::numbers::pi), 1e-9);
-    EXPECT_EQ(projected_hull_area(std::vector<Eigen::Vector3f>{{0, 0, 0}, {1, 1, 1}}), 0.0);
+    EXPECT_NEAR(equal_area_diameter(ring_area(projected_hull(points))), 4.0 / std::sqrt(std::numbers::pi), 1e-9);
+    EXPECT_TRUE(projected_hull(std::vector<Eigen::Vector3f>{{0, 0, 0}, {1, 1, 1}}).empty());
+    EXPECT_TRUE(projected_hull(std::vector<Eigen::Vector3f>{{0, 0, 0}, {1, 1, 1}, {2, 2, 5}}).empty());  // on a line
+    EXPECT_EQ(ring_area({}), 0.0);
     EXPECT_EQ(equal_area_diameter(0.0), 0.0);
+}
+
+// The outline GeoJSON takes: the hull's corners only (the inner point and the one on an edge
+// left out), counter-clockwise, not closed.
+TEST(ProjectedHull, CornersRunCounterClockwise) {
+    const std::vector<Eigen::Vector3f> points{{0, 0, 1}, {2, 0, 3}, {1, 0, 2}, {2, 2, 0}, {0, 2, 5}, {1, 1, 9}};
+    const std::vector<Eigen::Vector2d> ring = projected_hull(points);
+    ASSERT_EQ(ring.size(), 4u);
+    double twice_signed_area = 0.0;
+    for (std::size_t i = 0, j = ring.size() - 1; i < ring.size(); j = i++)
+        twice_signed_area += ring[j].x() * ring[i].y() - ring[i].x() * ring[j].y();
+    EXPECT_NEAR(twice_signed_area, 8.0, 1e-9);  // positive: counter-clockwise
+    for (const Eigen::Vector2d& corner : ring) EXPECT_TRUE((corner.x() == 0 || corner.x() == 2) && (corner.y() == 0 || corner.y() == 2));
 }

@@ -77,6 +77,13 @@ TEST(SurveyCli, SingleRunMergesEveryTree) {
     EXPECT_EQ(summary["forest_trees"], summary["counts"]["trees_modelled"]);  // trees measured only have no skeleton
     const std::string csv = file_bytes(r.merged / "trees.csv");
     EXPECT_EQ(csv.rfind("global_id,tile,tree_id,x,y", 0), 0u) << csv.substr(0, 80);
+    const auto crowns = nlohmann::json::parse(file_bytes(r.merged / "crowns.geojson"))["features"];
+    const auto points = nlohmann::json::parse(file_bytes(r.merged / "trees.geojson"))["features"];
+    ASSERT_EQ(crowns.size(), points.size());
+    for (std::size_t i = 0; i < crowns.size(); ++i) {  // the same trees in the same order, each with its tile
+        EXPECT_EQ(crowns[i]["properties"], points[i]["properties"]);
+        EXPECT_TRUE(crowns[i]["properties"]["tile"].is_string());
+    }
     EXPECT_NE(csv.find("\n5000"), std::string::npos);  // survey-wide ids from the stem base: "<x>_<y>" of its 1 cm cell
     EXPECT_NE(csv.find(",t_3,"), std::string::npos);
 }
@@ -106,6 +113,14 @@ TEST(SurveyCli, MalformedTileOutputsAreOneLineErrors) {
         EXPECT_EQ(std::count(result.err.begin(), result.err.end(), '\n'), 1) << result.err;
         EXPECT_FALSE(fs::exists(dir / "out"));
     }
+    // A tile made before crowns.geojson existed.
+    write_text(tile / "summary.json", summary.dump());
+    fs::remove(tile / "crowns.geojson");
+    const CommandResult older = run_cli("merge '" + (dir / "batch").string() + "' --out '" + (dir / "out").string() + "'");
+    EXPECT_EQ(older.exit_code, 2) << older.err;
+    EXPECT_NE(older.err.find("t_1/crowns.geojson: missing (a tile made by an older treelobes): run the tile again"), std::string::npos)
+            << older.err;
+    EXPECT_FALSE(fs::exists(dir / "out"));
 }
 
 TEST(SurveyCli, FourShardsMergeToTheBytesOfOneRun) {

@@ -43,7 +43,7 @@ std::string file_bytes(const fs::path& path) {
 }
 
 void expect_same_merge(const fs::path& a, const fs::path& b) {
-    for (const char* name : {"trees.csv", "trees.geojson", "survey.forest", "summary.json"}) {
+    for (const char* name : {"trees.csv", "trees.geojson", "crowns.geojson", "survey.forest", "summary.json"}) {
         ASSERT_TRUE(fs::exists(a / name)) << a / name;
         ASSERT_TRUE(fs::exists(b / name)) << b / name;
         EXPECT_TRUE(file_bytes(a / name) == file_bytes(b / name)) << name << " differs between " << a << " and " << b;
