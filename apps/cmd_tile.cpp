@@ -719,7 +719,7 @@ void add_tile_command(CLI::App& app, const GlobalOptions& global, Job& job) {
     CLI::App* sub = app.add_subcommand(
             "tile",
             "A LiDAR tile in, every tree out: ground and DTM, tree segmentation, per-tree skeleton, lobes, DBF6, measures "
-            "(height, DBH, crown), species; tables, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
+            "(height, DBH, crown), species; tables, crown outlines, LAS with treeID, forest file and a top-view picture (docs/tile.md)");
     auto table = std::make_shared<OptionTable>(sub);
     sub->add_option("input", o->input, "The tile: LAS 1.0-1.4, LAZ or COPC, PLY, PCD or XYZ/CSV")->required();
     table->add("--out", o->out, "Output folder")->required();
