@@ -287,17 +287,25 @@ json points_left_out_by_class(const PointCloud& cloud, std::size_t own_points, c
 }
 
 // A sparse airborne survey splits its crowns: said once, with the survey's pulse density, so
-// that a user does not take the trees for what the scan can show.
-void warn_if_sparse_survey(const std::string& input, const TreeSegmentation& segmentation) {
+// that a user does not take the trees for what the scan can show. A spacing given for the survey
+// (--return-spacing, or batch's measure on a typical tile) decides the CHM whatever this tile's
+// own density, and the warning says so.
+void warn_if_sparse_survey(const std::string& input, const TreeSegmentation& segmentation, bool spacing_given) {
     if (segmentation.mode_used != ScanMode::Airborne) return;
     const double pulses = segmentation.pulse_density;
-    char text[400];
+    char text[480];
     if (pulses < kTooSparseForTrees)
         std::snprintf(text, sizeof text,
                       ": the survey holds about %.2g pulses per m^2 (first returns over its footprint), too few to tell single "
                       "trees apart: its trees are patches of a few returns (mean F1 0.33-0.43 on synthetic stands at "
                       "0.025-0.05 pulses per m^2; docs/segment.md, \"Sparse airborne surveys\")",
                       pulses);
+    else if (sparse_survey(segmentation) && spacing_given)
+        std::snprintf(text, sizeof text,
+                      ": the return spacing given, %.2f m (--return-spacing, or the survey's from batch), is a sparse survey's, "
+                      "fewer than about 0.5 pulses per m^2 (this tile holds about %.2g): its CHM takes discs of the whole spacing; "
+                      "expect crowns split into several trees (docs/segment.md, \"Sparse airborne surveys\")",
+                      static_cast<double>(segmentation.return_spacing), pulses);
     else if (sparse_survey(segmentation))
         std::snprintf(text, sizeof text,
                       ": the survey holds about %.2g pulses per m^2 (first returns over its footprint; the vegetation returns "
@@ -520,7 +528,7 @@ int run_tile(TileCliOptions& o, const OptionTable& table, const GlobalOptions& g
     } else {
         segmentation = segment_trees(cloud, terrain, o.segment);
         for (const auto& tree : segmentation.trees) bases[tree.id] = tree.base.cast<double>();
-        warn_if_sparse_survey(o.input, segmentation);
+        warn_if_sparse_survey(o.input, segmentation, o.segment.return_spacing > 0.0f);
     }
     const std::optional<float> reach = segmentation_reach(o, segmentation);
     if (plan.core) warn_if_buffer_is_narrow(o, reach);

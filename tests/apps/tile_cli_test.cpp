@@ -394,6 +394,15 @@ TEST(TileCli, ASparseAirborneSurveyIsSaidToBeSparse) {
     EXPECT_EQ(dense.err.find(warning), std::string::npos) << dense.err;
     EXPECT_EQ(dense.err.find(too_sparse), std::string::npos) << dense.err;
     EXPECT_GT(chm("c")["pulse_density_per_m2"].get<double>(), 1.0);
+    // A sparse survey's spacing given to a dense tile (batch passes the one it measured on a
+    // typical tile): the warning names the spacing given, not this tile's density, as sparse.
+    const auto given_sparse = run_cli(run_tile(dir / "e", measure_only + " --return-spacing 1.6"));
+    ASSERT_EQ(given_sparse.exit_code, 0) << given_sparse.err;
+    EXPECT_NE(given_sparse.err.find("the return spacing given, 1.60 m (--return-spacing, or the survey's from batch), is a sparse "
+                                    "survey's, fewer than about 0.5 pulses per m^2 (this tile holds about "),
+              std::string::npos)
+            << given_sparse.err;
+    EXPECT_EQ(given_sparse.err.find(warning), std::string::npos) << given_sparse.err;
     // A third of that tells too few crowns apart to be of use, and the warning says so.
     ASSERT_EQ(run_cli("--log-level warn synth tile --trees 6 --size 40 --seed 3 --scanner als --pulse-density 0.03 "
                       "--max-leaves 2000 --out " +
