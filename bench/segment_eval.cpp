@@ -22,8 +22,10 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <string>
+#include <vector>
 
 using namespace treelobes;
 using json = nlohmann::json;
@@ -130,6 +132,10 @@ void set_option(SegmentOptions& o, const std::string& assignment) {
                                                   {"stem_slice_low", &o.stem_slice_low},
                                                   {"stem_slice_high", &o.stem_slice_high},
                                                   {"min_circle_inliers", &o.min_circle_inliers},
+                                                  {"max_stem_radius", &o.max_stem_radius},
+                                                  {"stem_foot_reach", &o.stem_foot_reach},
+                                                  {"buttressed_stem_radius", &o.buttressed_stem_radius},
+                                                  {"buttressed_foot_reach", &o.buttressed_foot_reach},
                                                   {"min_arc_coverage", &o.min_arc_coverage},
                                                   {"circle_tolerance", &o.circle_tolerance},
                                                   {"ground_clearance", &o.ground_clearance}};
@@ -229,12 +235,20 @@ int run(int argc, char** argv) {
     if (!reference.empty())
         out["score"] = score_json(score_segmentation(reference, trees.tree_id, terrain.height_above_ground, min_height));
     if (list_trees) {
+        // Heights as `treelobes tile` measures them (docs/tile.md, height_m): the tree's highest
+        // point above the ground at its base, not the largest height above the terrain under its
+        // points, which on a slope is another point when the crown reaches downhill.
+        std::vector<float> highest(trees.trees.size() + 1, -std::numeric_limits<float>::infinity());
+        for (std::size_t i = 0; i < cloud.size(); ++i) {
+            float& z = highest[static_cast<std::size_t>(trees.tree_id[i])];
+            z = std::max(z, cloud.positions[i].z());
+        }
         json list = json::array();
         for (const auto& t : trees.trees)
             list.push_back({{"id", t.id},
                             {"x", t.base.x()},
                             {"y", t.base.y()},
-                            {"height", t.top.z() - t.base.z()},
+                            {"height", highest[static_cast<std::size_t>(t.id)] - t.base.z()},
                             {"stem_radius", t.stem_radius},
                             {"points", t.points}});
         out["tree_list"] = list;

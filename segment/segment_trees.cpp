@@ -57,6 +57,10 @@ void check_options(const SegmentOptions& o) {
     if (o.min_stem_points < 5) throw Error::usage("segment: min stem points must be >= 5");
     positive(o.min_stem_radius, "min stem radius");
     if (!(o.max_stem_radius > o.min_stem_radius)) throw Error::usage("segment: max stem radius must exceed min stem radius");
+    positive(o.stem_foot_reach, "stem foot reach");
+    if (!(o.buttressed_stem_radius >= 0.0f) || !std::isfinite(o.buttressed_stem_radius))
+        throw Error::usage("segment: buttressed stem radius must be >= 0");
+    positive(o.buttressed_foot_reach, "buttressed foot reach");
     positive(o.circle_tolerance, "circle tolerance");
     share(o.min_circle_inliers, "min circle inliers");
     share(o.min_arc_coverage, "min arc coverage");

@@ -98,6 +98,13 @@ struct SegmentOptions {
     float shared_top_stem_distance = 2.0f;
     float shared_top_distance = 1.0f;
     int min_stem_points = 15;            // smaller slice clusters are not stems
+    // A stem continues down to the ground: the points below the slice, within stem_foot_reach
+    // radii of its axis (a root flare), hold min_stem_points. A trunk at least
+    // buttressed_stem_radius thick may flare wider, into buttresses or a skirt of roots: within
+    // buttressed_foot_reach radii (metres; radii).
+    float stem_foot_reach = 1.5f;
+    float buttressed_stem_radius = 0.4f;
+    float buttressed_foot_reach = 2.5f;
     float min_stem_radius = 0.025f;      // accepted circle radii (metres)
     float max_stem_radius = 0.8f;
     float circle_tolerance = 0.03f;   // circle inlier band (metres)

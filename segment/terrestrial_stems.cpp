@@ -256,7 +256,9 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
     }
     // Points between the graph's floor and the slice, flattened: a stem continues down to the
     // ground (within 1.5 radii: root flare), a branch or a drooping crown that crosses the slice
-    // does not.
+    // does not. A thick trunk's flare can reach farther: the synthetic figs of 1.0-1.65 m DBH stand
+    // on a skirt of roots 1.9-2.5 radii wide up to 1-1.5 m above the ground, and measured within
+    // 1.5 radii they had nothing below them (docs/segment.md, "Thick trunks on buttresses").
     std::vector<Eigen::Vector3f> below;
     for (std::size_t i = 0; i < cloud.size(); ++i)
         if (vegetation[i] && terrain.height_above_ground[i] < options.stem_slice_low)
@@ -266,8 +268,9 @@ std::vector<Stem> find_stems(const PointCloud& cloud, const Terrain& terrain, co
     std::vector<int> near;
     std::vector<float> squared;
     const auto reaches_ground = [&](const Stem& stem) {
+        const float reach = stem.radius >= options.buttressed_stem_radius ? options.buttressed_foot_reach : options.stem_foot_reach;
         below_index.radius_search(Eigen::Vector3f(stem.centre.x(), stem.centre.y(), 0.0f),
-                                  1.5f * stem.radius + 2.0f * options.circle_tolerance, near, squared,
+                                  reach * stem.radius + 2.0f * options.circle_tolerance, near, squared,
                                   static_cast<std::size_t>(options.min_stem_points));
         return static_cast<int>(near.size()) >= options.min_stem_points;
     };

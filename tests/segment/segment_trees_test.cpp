@@ -418,6 +418,39 @@ TEST(SegmentTrees, ATaperingTrunkIsFoundLayerByLayer) {
     EXPECT_NEAR(whole_slice.trees[0].base.x(), 5.0f, 0.05f);
 }
 
+// A thick trunk (radius 0.5 m) on a skirt of roots 1.15 m wide up to 0.95 m above the ground, as
+// the synthetic figs stand: nothing lies below the slice within 1.5 radii of its axis, but a
+// trunk that thick may flare that far. A limb of 0.25 m hanging down to 1 m above the ground over
+// a bush 0.6 m from its axis is no stem: a thin stem's foot is looked for within 1.5 radii.
+TEST(SegmentTrees, AThickTrunkStandsOnItsButtresses) {
+    ToyTile tile = test::flat_ground(-4, 9, -4, 4);
+    const auto add_wall = [&](float cx, float radius, float z0, float z1, std::int32_t id) {
+        for (float z = z0; z <= z1; z += 0.02f)
+            for (int a = 0; a < 144; ++a) {
+                const float t = static_cast<float>(a) * 2.5f * std::numbers::pi_v<float> / 180.0f;
+                tile.add({cx + radius * std::cos(t), radius * std::sin(t), z}, id);
+            }
+    };
+    add_wall(0.0f, 0.5f, 1.0f, 8.0f, 1);    // the trunk
+    add_wall(0.0f, 1.15f, 0.0f, 0.95f, 1);  // its skirt of roots
+    add_wall(5.0f, 0.25f, 1.0f, 3.5f, 2);   // the hanging limb
+    add_wall(5.0f, 0.6f, 0.3f, 0.9f, 0);    // the bush under it
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, {});
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].base.x(), 0.0f, 0.05f);
+    EXPECT_NEAR(result.trees[0].stem_radius, 0.5f, 0.02f);
+
+    SegmentOptions no_buttresses;  // every stem's foot within 1.5 radii: the trunk is no stem
+    no_buttresses.buttressed_stem_radius = 10.0f;
+    EXPECT_TRUE(segment_trees(tile.cloud, terrain, no_buttresses).trees.empty());
+    SegmentOptions every_stem_buttressed;  // the limb over the bush would pass for a stem
+    every_stem_buttressed.buttressed_stem_radius = 0.0f;
+    EXPECT_EQ(segment_trees(tile.cloud, terrain, every_stem_buttressed).trees.size(), 2u);
+}
+
 // A flared trunk as above that neighbours hide but for a 120-degree arc, which turns from +x at
 // 1 m to -x at 2 m above the ground. The centroids of its slice points' lower and upper halves
 // then lie 0.8 m apart at 0.5 m of height, as if it leaned 58 degrees, while its layers'
@@ -731,9 +764,14 @@ TEST(SegmentTrees, RejectsBadOptionsAndAForeignTerrain) {
     for (const float distance : {-0.01f, 0.1f, nan}) EXPECT_TRUE(rejects(&SegmentOptions::stem_subcluster_distance, distance)) << distance;
     for (const float exponent : {-0.5f, 5.0f, nan}) EXPECT_TRUE(rejects(&SegmentOptions::stem_reach_exponent, exponent)) << exponent;
     for (const float share : {-0.1f, 1.5f, nan}) EXPECT_TRUE(rejects(&SegmentOptions::min_quarter_arc_share, share)) << share;
+    for (const float reach : {0.0f, -1.0f, nan}) {
+        EXPECT_TRUE(rejects(&SegmentOptions::stem_foot_reach, reach)) << reach;
+        EXPECT_TRUE(rejects(&SegmentOptions::buttressed_foot_reach, reach)) << reach;
+    }
     for (const float length : {-1.0f, inf, nan})
-        for (const auto field : {&SegmentOptions::stem_merge_distance, &SegmentOptions::attach_gap, &SegmentOptions::detached_min_height,
-                                 &SegmentOptions::shared_top_stem_distance, &SegmentOptions::shared_top_distance})
+        for (const auto field :
+             {&SegmentOptions::stem_merge_distance, &SegmentOptions::attach_gap, &SegmentOptions::detached_min_height,
+              &SegmentOptions::shared_top_stem_distance, &SegmentOptions::shared_top_distance, &SegmentOptions::buttressed_stem_radius})
             EXPECT_TRUE(rejects(field, length)) << length;
     SegmentOptions no_voxels;
     no_voxels.min_detached_voxels = 0;
