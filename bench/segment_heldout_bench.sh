@@ -44,9 +44,12 @@ for s in 28 29 30 31 32 33 34 35 36 37; do tile "tls_open_$s" "$s" "${TLS_OPEN[@
 for s in 7 8 9 10 11 12 13 14 15 16; do tile "tls_crowded_$s" "$s" "${TLS_CROWDED[@]}"; done
 
 results="$WORK/results.txt"
+done_count=0
 for name in "${tiles[@]}"; do
   mode=${name%%_*}
   echo "$name $("$EVAL" "$WORK/$name/tile.las" --reference treeID --mode "$mode")"
+  done_count=$((done_count + 1))
+  echo "scored $done_count/${#tiles[@]}: $name" >&2
 done >"$results"
 python3 - "$results" <<'PY'
 import collections, json, sys

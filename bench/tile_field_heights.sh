@@ -8,7 +8,7 @@
 # the RMSE and mean absolute difference of those.
 # Usage: bench/tile_field_heights.sh [OUT_DIR]   (default /tmp/treelobes_tile_field_heights)
 # Environment: TREELOBES_BIN (default build/bin/treelobes), TREELOBES_REAL_DATA (default
-# ../shared/data). Runs two clips at a time (GNU parallel).
+# ../shared/data). Runs two clips at a time (GNU parallel, with a progress bar on stderr).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=$(realpath "${TREELOBES_BIN:-build/bin/treelobes}")
@@ -20,14 +20,18 @@ LABELS="$DATA/idtrees/labels.csv"
 command -v parallel >/dev/null || { echo "tile_field_heights: GNU parallel not found (apt-get install parallel)" >&2; exit 1; }
 mkdir -p "$OUT"
 tail -n +2 "$LABELS" | cut -d, -f1 |
-  parallel -j2 --halt never "$BIN --log-level error tile $DATA/idtrees/{} --out $OUT/{//}_{/.} --overwrite --map-size 200 >/dev/null"
+  parallel -j2 --bar --halt never "$BIN --log-level error tile $DATA/idtrees/{} --out $OUT/{//}_{/.} --overwrite --map-size 200 >/dev/null"
 python3 - "$LABELS" "$OUT" <<'PY'
 import csv, math, os, sys
 labels, out = sys.argv[1], sys.argv[2]
-rows, empty = [], 0
+rows, empty, failed = [], 0, []
 for r in csv.DictReader(open(labels)):
     folder, name = os.path.split(r["file"])
-    trees = list(csv.DictReader(open(f"{out}/{folder}_{os.path.splitext(name)[0]}/trees.csv")))
+    table = f"{out}/{folder}_{os.path.splitext(name)[0]}/trees.csv"
+    if not os.path.exists(table):  # tile refused the clip (its message is above)
+        failed.append(r["file"])
+        continue
+    trees = list(csv.DictReader(open(table)))
     if not trees:
         empty += 1
         continue
@@ -40,4 +44,6 @@ for site in sorted({s for s, _ in rows}) + ["all"]:
     rmse = lambda v: math.sqrt(sum(e * e for e in v) / len(v))
     print(f"{site:<8} {len(d):4d} {d[len(d) // 2]:+9.2f} {rmse(d):7.2f} {len(near):10d} {rmse(near):10.2f} {sum(abs(e) for e in near) / len(near):9.2f}")
 print(f"clips with no tree (ground only): {empty}")
+if failed:
+    print(f"clips tile could not run on: {len(failed)} ({', '.join(failed[:5])}{', ...' if len(failed) > 5 else ''})")
 PY

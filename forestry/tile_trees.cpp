@@ -1,6 +1,7 @@
 #include "forestry/tile_trees.hpp"
 
 #include "core/error.hpp"
+#include "core/geojson.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -54,12 +55,6 @@ DbhQuality parse_quality(const std::string& name) {
 }
 
 double millimetres(double metres) { return std::round(metres * 1000.0) / 1000.0; }
-
-std::string feature_collection(json features, const std::string& crs_wkt) {
-    json collection = {{"type", "FeatureCollection"}, {"features", std::move(features)}};
-    if (!crs_wkt.empty()) collection["crs_wkt"] = crs_wkt;
-    return collection.dump(1) + "\n";
-}
 
 // Whether the tree has a model, or why not.
 const char* model_name(const TreeRow& row) { return row.modelled ? "ok" : "too_few_points"; }

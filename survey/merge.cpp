@@ -1,6 +1,7 @@
 #include "survey/merge.hpp"
 
 #include "core/error.hpp"
+#include "core/geojson.hpp"
 #include "core/log.hpp"
 #include "core/version.hpp"
 #include "encode/forest_file.hpp"
@@ -157,11 +158,11 @@ void add_features(std::map<TreeKey, json>& features, std::string& crs, const fs:
     }
 }
 
-std::string feature_collection(std::map<TreeKey, json>& features, const std::string& crs) {
-    json collection = {{"type", "FeatureCollection"}, {"features", json::array()}};
-    for (auto& [id, feature] : features) collection["features"].push_back(std::move(feature));
-    if (!crs.empty()) collection["crs_wkt"] = crs;
-    return collection.dump(1) + "\n";
+// The features in the order of their keys (the survey-wide tree id), as one collection.
+std::string sorted_collection(std::map<TreeKey, json>& features, const std::string& crs) {
+    json sorted = json::array();
+    for (auto& [id, feature] : features) sorted.push_back(std::move(feature));
+    return feature_collection(std::move(sorted), crs);
 }
 
 // The tile's forest trees, placed as `treelobes tile` places them (root at the position).
@@ -282,8 +283,8 @@ MergedSurvey merge_tiles(const TileFolders& folders) {
     std::sort(merged.trees_at_buffer_edge.begin(), merged.trees_at_buffer_edge.end());
     merged.trees_csv = "global_id,tile," + csv.header.substr(std::string("global_id,").size()) + "\n";
     for (const auto& [id, row] : csv.rows) merged.trees_csv += row;
-    merged.trees_geojson = feature_collection(features, crs);
-    merged.crowns_geojson = feature_collection(crowns, crs);
+    merged.trees_geojson = sorted_collection(features, crs);
+    merged.crowns_geojson = sorted_collection(crowns, crs);
     std::vector<encode::ForestTree> ordered;
     ordered.reserve(forest_trees.size());
     for (auto& [id, tree] : forest_trees) ordered.push_back(std::move(tree));
