@@ -526,7 +526,8 @@ void add_synth_command(CLI::App& app, const GlobalOptions& global, Job& job) {
                          "Neighbours compete for crown space: branches growing where a neighbour owns the canopy are cut "
                          "(without it, crowded crowns interpenetrate)");
     tile_table->add("--origin", tile->origin, "Coordinates of the tile corner: X Y Z")->expected(3);
-    tile_table->add("--station-spacing", tile->station_spacing, "TLS: distance between stations on the grid, m");
+    tile_table->add("--station-spacing", tile->station_spacing,
+                    "TLS: distance between stations on the grid, m (a station on a trunk moves clear of it)");
     add_common_flags(*tile_table, *tile_flags);
     tile_cmd->callback([tile_flags, tile, tile_table, &global, &job] {
         job = [tile_flags, tile, tile_table, &global] { return run_tile(*tile_flags, *tile, *tile_table, global); };

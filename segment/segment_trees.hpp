@@ -101,7 +101,8 @@ struct SegmentOptions {
     // A stem continues down to the ground: the points below the slice, within stem_foot_reach
     // radii of its axis (a root flare), hold min_stem_points. A trunk at least
     // buttressed_stem_radius thick may flare wider, into buttresses or a skirt of roots: within
-    // buttressed_foot_reach radii (metres; radii).
+    // buttressed_foot_reach radii; its flare may also fill the slice's lower layers, whose wider
+    // circles on its axis then count for it (metres; radii).
     float stem_foot_reach = 1.5f;
     float buttressed_stem_radius = 0.4f;
     float buttressed_foot_reach = 2.5f;

@@ -96,10 +96,24 @@ bool circle_holds(const CircleFit& circle, std::size_t points, const SegmentOpti
            circle.coverage >= options.min_arc_coverage;
 }
 
+// A layer below a thick trunk's circles that holds no trunk circle may be its root flare: a
+// wider circle on the same axis, up to the buttresses' reach. Buttresses are not round, so the
+// circle holds only some of the layer's points, at least half the share a trunk's circle must
+// hold (the synthetic figs of 1.3-1.7 m DBH: circles of 0.95-1.35 m round trunks of 0.63-0.75 m,
+// through 25-55 % of the points, 1.0-1.75 m above the ground), around as much of its
+// circumference as a trunk's, and its centre lies within half the trunk's radius of the axis.
+bool is_flare_of(const std::vector<Eigen::Vector2f>& layer, const Stem& stem, const SegmentOptions& options) {
+    if (static_cast<int>(layer.size()) < options.min_stem_points) return false;
+    const CircleFit flare = fit_circle(layer, options.circle_tolerance, stem.radius, options.buttressed_foot_reach * stem.radius);
+    return flare.ok && static_cast<float>(flare.inliers) >= 0.5f * options.min_circle_inliers * static_cast<float>(layer.size()) &&
+           flare.coverage >= options.min_arc_coverage && (flare.centre - stem.centre).norm() <= 0.5f * stem.radius;
+}
+
 // A trunk that tapers within the slice (a root flare: the synthetic oaks, figs and mahoganies of
 // 1.0-1.5 m narrow by a third between 1 and 2 m above the ground) holds no single circle over the
 // slice's height, but each thin horizontal layer of it does. The stem is then the median of the
-// layers' circles when at least half of the layers (two at least) hold one, every layer's
+// layers' circles when at least half of the layers (two at least) hold one, or, under a thick
+// trunk, hold one or its flare (`is_flare_of`: a flare can fill most of the slice), every layer's
 // centre lies within half that radius of the median centre and every layer's radius within a
 // factor 2 of it: one trunk, layer above layer, not a limb and a twig curtain that happen to
 // fit circles at different places, nor a clump of twigs that fits a 7 cm circle in one layer and
@@ -110,27 +124,31 @@ bool circle_holds(const CircleFit& circle, std::size_t points, const SegmentOpti
 std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vector<int>& cluster, float low, float high,
                                        const SegmentOptions& options) {
     const int count = std::max(1, static_cast<int>(std::ceil((high - low) / options.stem_layer_height)));
-    std::vector<std::vector<int>> layers(static_cast<std::size_t>(count));
+    std::vector<std::vector<Eigen::Vector2f>> layers(static_cast<std::size_t>(count));
+    std::vector<std::vector<int>> layer_points(static_cast<std::size_t>(count));
     for (int i : cluster) {
-        const float z = cloud.positions[static_cast<std::size_t>(i)].z();
-        layers[static_cast<std::size_t>(std::min(count - 1, static_cast<int>((z - low) / options.stem_layer_height)))].push_back(i);
+        const Eigen::Vector3f& p = cloud.positions[static_cast<std::size_t>(i)];
+        const auto k = static_cast<std::size_t>(std::min(count - 1, static_cast<int>((p.z() - low) / options.stem_layer_height)));
+        layers[k].push_back(p.head<2>());
+        layer_points[k].push_back(i);
     }
     std::vector<CircleFit> circles;
     std::vector<Eigen::Vector3f> centres;  // of the circles, at their layers' mid-heights
     std::vector<int> on_circles;
+    int lowest_holding = count;
     for (int k = 0; k < count; ++k) {
-        const std::vector<int>& layer = layers[static_cast<std::size_t>(k)];
-        if (static_cast<int>(layer.size()) < options.min_stem_points) continue;
-        std::vector<Eigen::Vector2f> xy;
-        for (int i : layer) xy.push_back(cloud.positions[static_cast<std::size_t>(i)].head<2>());
+        const std::vector<Eigen::Vector2f>& xy = layers[static_cast<std::size_t>(k)];
+        if (static_cast<int>(xy.size()) < options.min_stem_points) continue;
         const CircleFit circle = fit_circle(xy, options.circle_tolerance, options.min_stem_radius, options.max_stem_radius);
-        if (!circle_holds(circle, layer.size(), options)) continue;
+        if (!circle_holds(circle, xy.size(), options)) continue;
+        lowest_holding = std::min(lowest_holding, k);
         circles.push_back(circle);
         centres.emplace_back(circle.centre.x(), circle.centre.y(), low + (static_cast<float>(k) + 0.5f) * options.stem_layer_height);
-        for (std::size_t j = 0; j < layer.size(); ++j)
-            if (std::abs((xy[j] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance) on_circles.push_back(layer[j]);
+        for (std::size_t j = 0; j < xy.size(); ++j)
+            if (std::abs((xy[j] - circle.centre).norm() - circle.radius) <= 2.0f * options.circle_tolerance)
+                on_circles.push_back(layer_points[static_cast<std::size_t>(k)][j]);
     }
-    if (circles.size() < 2 || 2 * static_cast<int>(circles.size()) < count) return std::nullopt;
+    if (circles.size() < 2) return std::nullopt;
     const auto median = [&](auto value) {
         std::vector<float> values;
         for (const CircleFit& c : circles) values.push_back(value(c));
@@ -140,6 +158,10 @@ std::optional<Stem> fit_stem_by_layers(const PointCloud& cloud, const std::vecto
     Stem stem;
     stem.centre = {median([](const CircleFit& c) { return c.centre.x(); }), median([](const CircleFit& c) { return c.centre.y(); })};
     stem.radius = median([](const CircleFit& c) { return c.radius; });
+    int supporting = static_cast<int>(circles.size());
+    if (2 * supporting < count && stem.radius >= options.buttressed_stem_radius)
+        for (int k = 0; k < lowest_holding; ++k) supporting += is_flare_of(layers[static_cast<std::size_t>(k)], stem, options);
+    if (2 * supporting < count) return std::nullopt;
     for (const CircleFit& c : circles) {
         if ((c.centre - stem.centre).norm() > 0.5f * stem.radius) return std::nullopt;            // one trunk, layer above layer
         if (c.radius > 2.0f * stem.radius || 2.0f * c.radius < stem.radius) return std::nullopt;  // ... of one girth

@@ -228,6 +228,35 @@ Window tls_window(const Eigen::Vector3d& station, const Eigen::Vector3d& lo, con
     return w;
 }
 
+// An operator sets the tripod up beside a trunk, never inside one or on its root flare. A station
+// that falls within `kTripodClearance` of a trunk's base (its flared root radius) is moved to the
+// nearest spot that is clear of every trunk, searched on rings 0.25 m apart. Before, a grid of
+// stations could stand inside a trunk (3 of the 66 synthetic plots of the terrestrial benches,
+// docs/segment.md), and the scan then held hundreds of thousands of returns from the trunk's
+// inner wall.
+constexpr double kTripodClearance = 0.5;
+
+bool clear_of_every_trunk(const Scene& scene, const Eigen::Vector2d& p) {
+    return std::none_of(scene.trees.begin(), scene.trees.end(), [&](const PlacedTree& placed) {
+        const double base_radius = placed.tree.skeleton.empty() ? 0.0 : placed.tree.skeleton.nodes[0].radius;
+        return (p - placed.position.head<2>()).norm() < base_radius + kTripodClearance;
+    });
+}
+
+Eigen::Vector2d clear_of_trunks(const Scene& scene, const Eigen::Vector2d& p) {
+    constexpr int kDirections = 16;
+    constexpr int kRings = 40;
+    constexpr double kRingStep = 0.25;
+    if (clear_of_every_trunk(scene, p)) return p;
+    for (int ring = 1; ring <= kRings; ++ring)
+        for (int k = 0; k < kDirections; ++k) {
+            const double a = 2 * std::numbers::pi * k / kDirections;
+            const Eigen::Vector2d candidate = p + ring * kRingStep * Eigen::Vector2d(std::cos(a), std::sin(a));
+            if (clear_of_every_trunk(scene, candidate)) return candidate;
+        }
+    return p;  // no clear spot within 10 m: trunks that dense leave the tripod nowhere better
+}
+
 std::vector<Eigen::Vector3d> tls_stations(const Scene& scene, const TlsOptions& o, const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
                                           std::uint64_t seed) {
     std::vector<Eigen::Vector2d> xy = o.station_xy;
@@ -247,7 +276,8 @@ std::vector<Eigen::Vector3d> tls_stations(const Scene& scene, const TlsOptions& 
         }
     }
     std::vector<Eigen::Vector3d> stations;
-    for (const auto& p : xy) {
+    for (Eigen::Vector2d p : xy) {
+        p = clear_of_trunks(scene, p);
         const double ground = scene.ground ? scene.ground->height(p.x(), p.y()) : lo.z();
         stations.emplace_back(p.x(), p.y(), ground + o.station_height_m);
     }

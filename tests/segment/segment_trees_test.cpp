@@ -451,6 +451,48 @@ TEST(SegmentTrees, AThickTrunkStandsOnItsButtresses) {
     EXPECT_EQ(segment_trees(tile.cloud, terrain, every_stem_buttressed).trees.size(), 2u);
 }
 
+// A thick trunk (0.65 m) whose root flare reaches 1.7 m up the 1-2 m slice: below that, each layer
+// shows the outer rim of its buttresses over half its circumference (1.35 m wide at 1 m, 0.95 m at
+// 1.7 m) and six fins running in from the rim to the trunk, so that no circle holds half of a
+// layer's points. Only the slice's top layers hold the trunk's circle: too few for a stem, unless
+// the layers below are taken for what they are, the flare of that trunk (fine layers stand in for
+// the many a slice cut on a slope holds).
+TEST(SegmentTrees, AThickTrunkIsFoundAboveItsFlare) {
+    ToyTile tile = test::flat_ground(-4, 4, -4, 4);
+    constexpr float kTrunk = 0.65f;
+    for (float z = 0.0f; z <= 6.0f; z += 0.02f) {
+        if (z >= 1.7f) {
+            for (int a = 0; a < 144; ++a) {
+                const float t = static_cast<float>(a) * 2.5f * std::numbers::pi_v<float> / 180.0f;
+                tile.add({kTrunk * std::cos(t), kTrunk * std::sin(t), z}, 1);
+            }
+            continue;
+        }
+        const float rim = 1.35f - 0.4f * std::max(0.0f, z - 1.0f) / 0.7f - 0.1f * std::max(0.0f, 1.0f - z);
+        for (int a = 0; a < 144; a += 2) {  // the buttresses' outer edges, half the circumference
+            const float t = static_cast<float>(a) * 2.5f * std::numbers::pi_v<float> / 180.0f;
+            tile.add({rim * std::cos(t), rim * std::sin(t), z}, 1);
+        }
+        for (int fin = 0; fin < 6; ++fin) {
+            const float t = static_cast<float>(fin) * std::numbers::pi_v<float> / 3.0f + 0.1f;
+            for (float r = kTrunk; r < rim; r += 0.02f) tile.add({r * std::cos(t), r * std::sin(t), z}, 1);
+        }
+    }
+    test::classify_flat_ground(tile);
+    const Terrain terrain = analyse_terrain(tile.cloud, {});
+    SegmentOptions fine_layers;
+    fine_layers.stem_layer_height = 0.125f;
+
+    const TreeSegmentation result = segment_trees(tile.cloud, terrain, fine_layers);
+    ASSERT_EQ(result.trees.size(), 1u);
+    EXPECT_NEAR(result.trees[0].base.x(), 0.0f, 0.05f);
+    EXPECT_NEAR(result.trees[0].stem_radius, kTrunk, 0.03f);
+
+    SegmentOptions thin_only = fine_layers;  // flares are looked for under thick trunks only
+    thin_only.buttressed_stem_radius = 1.0f;
+    EXPECT_TRUE(segment_trees(tile.cloud, terrain, thin_only).trees.empty());
+}
+
 // A flared trunk as above that neighbours hide but for a 120-degree arc, which turns from +x at
 // 1 m to -x at 2 m above the ground. The centroids of its slice points' lower and upper halves
 // then lie 0.8 m apart at 0.5 m of height, as if it leaned 58 degrees, while its layers'

@@ -95,6 +95,26 @@ TEST(Scan, OcclusionUndersamplesTheFarSide) {
     EXPECT_GT(near, 2 * far) << "near " << near << " far " << far;
 }
 
+TEST(Scan, TlsTripodsStandClearOfTrunks) {
+    // Grid stations fall where they fall; one inside a fig's flared trunk recorded the trunk's inner
+    // wall. It is moved clear of the root flare; a station already clear stays where it was put.
+    const synth::Scene scene = one_tree("ficus_virens", 10.0);
+    const double base_radius = scene.trees[0].tree.skeleton.nodes[0].radius;
+    synth::TlsOptions o = coarse_tls();
+    o.angular_step_deg = 1.0;
+    o.station_xy = {Eigen::Vector2d(0.1, 0.0), Eigen::Vector2d(0.0, base_radius + 0.2), Eigen::Vector2d(5.0, 0.0)};
+    synth::ScanSummary summary;
+    synth::scan_tls(scene, o, 1, &summary);
+    ASSERT_EQ(summary.stations.size(), 3u);
+    for (int s = 0; s < 2; ++s) {
+        const double from_axis = summary.stations[static_cast<std::size_t>(s)].head<2>().norm();
+        EXPECT_GE(from_axis, base_radius + 0.5) << "station " << s;
+        EXPECT_LT(from_axis, base_radius + 0.5 + 0.25 + 1e-9) << "station " << s << " moved farther than the nearest clear ring";
+    }
+    EXPECT_NEAR(summary.stations[2].x(), 5.0, 1e-12);
+    EXPECT_NEAR(summary.stations[2].y(), 0.0, 1e-12);
+}
+
 TEST(Scan, AlsRecordsMultipleReturnsThroughCrowns) {
     synth::TileOptions t;
     t.trees = 8;
