@@ -1,8 +1,8 @@
 // Ray casting against a synth::Scene with Intel Embree 3 (kept inside ray_scene.cpp).
-// Branches are traced as Embree round linear curves, one cone segment per internode with the
-// true radii at both ends (exact tubes, no tessellation), leaves as quads, the ground and scene
-// meshes (CG tree models, labelled wood/leaf per face) as triangles; every hit says which tree,
-// which internode and what kind of surface it struck.
+// Branches are traced as Embree linear curves, one segment per internode with the true radii at
+// both ends (exact tubes, no tessellation; round joints, steep root flares as plain cones),
+// leaves as quads, the ground and scene meshes (CG tree models, labelled wood/leaf per face) as
+// triangles; every hit says which tree, which internode and what kind of surface it struck.
 #pragma once
 
 #include "synth/scene.hpp"

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace treelobes;
@@ -113,6 +114,40 @@ TEST(Scan, TlsTripodsStandClearOfTrunks) {
     }
     EXPECT_NEAR(summary.stations[2].x(), 5.0, 1e-12);
     EXPECT_NEAR(summary.stations[2].y(), 0.0, 1e-12);
+}
+
+TEST(Scan, AFlaredTrunkIsScannedAtItsSkeletonRadius) {
+    // A 24 m fig's root internode narrows from its flare (1.49 m radius) to its bole (0.76 m)
+    // within a metre. Traced as a round curve, the hull of its end spheres, it bulged up past
+    // breast height: the bark at 1.3 m lay 0.79 m from the axis where the skeleton, and so the
+    // true DBH, says 0.72 m. The scanned bark at 1.3 m lies on the skeleton.
+    const synth::Scene scene = one_tree("ficus_virens", 24.0);
+    const auto& tree = scene.trees[0].tree;
+    const auto& root = tree.skeleton.nodes[0];
+    const auto& first = tree.skeleton.nodes[1];
+    ASSERT_GT(root.radius - first.radius, 0.3 * first.position.z()) << "the test needs a steep root flare";
+    int spanning = 1;  // the trunk internode that spans breast height
+    while (tree.skeleton.nodes[static_cast<std::size_t>(spanning)].position.z() < 1.3f) ++spanning;
+    const auto& top = tree.skeleton.nodes[static_cast<std::size_t>(spanning)];
+    const auto& bottom = tree.skeleton.nodes[static_cast<std::size_t>(top.parent)];
+    const float share = (1.3f - bottom.position.z()) / (top.position.z() - bottom.position.z());
+    const float radius = tree.internode_start_radius[static_cast<std::size_t>(spanning)] * (1 - share) + top.radius * share;
+
+    synth::TlsOptions o = coarse_tls();
+    o.stations = 4;
+    const PointCloud cloud = synth::scan_tls(scene, o, 1);
+    const auto* wood = cloud.extra("wood");
+    ASSERT_TRUE(wood);
+    std::vector<double> from_axis;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const Eigen::Vector3f& p = cloud.positions[i];
+        if (wood->values[i] < 0.5 || std::abs(p.z() - 1.3f) > 0.05f) continue;
+        const double d = distance_to_segment(p, bottom.position, top.position);
+        if (d < 2.0 * root.radius) from_axis.push_back(d);
+    }
+    ASSERT_GT(from_axis.size(), 100u);
+    std::nth_element(from_axis.begin(), from_axis.begin() + from_axis.size() / 2, from_axis.end());
+    EXPECT_NEAR(from_axis[from_axis.size() / 2], radius, 0.02) << "skeleton radius at 1.3 m " << radius;
 }
 
 TEST(Scan, AlsRecordsMultipleReturnsThroughCrowns) {
